@@ -1,0 +1,61 @@
+#pragma once
+// A scalar volume: samples d_i at integer index positions p = (i, j, k), world position
+// x = origin + S p with S = diag(spacing). Samples are float, x fastest, then y, then z.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace splat {
+
+/// Largest number of voxels a volume may hold (2^32, 16 GiB of floats); larger requests
+/// are refused with a clear error rather than attempted.
+inline constexpr std::uint64_t kMaxVoxels = std::uint64_t(1) << 32;
+
+struct Volume {
+    glm::ivec3 dims{0};         ///< samples along x, y, z (all >= 1 for a valid volume)
+    glm::dvec3 spacing{1.0};    ///< world units (usually mm) between samples per axis
+    glm::dvec3 origin{0.0};     ///< world position of sample (0, 0, 0)
+    std::vector<float> data;    ///< dims.x * dims.y * dims.z samples, x fastest
+    std::string source;         ///< how it was obtained, e.g. "NIfTI-1 int16 (ch2.nii.gz)"
+    std::string note;           ///< anything a user should know (oblique rotation dropped, ...)
+
+    std::size_t voxelCount() const {
+        return std::size_t(dims.x) * std::size_t(dims.y) * std::size_t(dims.z);
+    }
+    std::size_t index(int i, int j, int k) const {
+        return (std::size_t(k) * std::size_t(dims.y) + std::size_t(j)) * std::size_t(dims.x) +
+               std::size_t(i);
+    }
+    float at(int i, int j, int k) const { return data[index(i, j, k)]; }
+    float& at(int i, int j, int k) { return data[index(i, j, k)]; }
+    /// World position of a (possibly fractional) index position.
+    glm::dvec3 world(const glm::dvec3& p) const { return origin + spacing * p; }
+    /// World position of the volume centre, index (n - 1) / 2 on every axis.
+    glm::dvec3 center() const { return world((glm::dvec3(dims) - 1.0) * 0.5); }
+    /// Smallest spacing: the world length of "one voxel" in DESIGN.md.
+    double minSpacing() const { return glm::min(spacing.x, glm::min(spacing.y, spacing.z)); }
+    /// Memory held by the samples, in bytes.
+    std::size_t bytes() const { return data.size() * sizeof(float); }
+};
+
+/// Allocates a zero-filled volume after validating its size: every dimension >= 1, the
+/// voxel count within kMaxVoxels without overflow, spacings finite and > 0.
+/// Throws splat::Error naming `what` (a file name or description) otherwise.
+Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::string& what);
+
+/// Statistics of a volume's samples.
+struct VolumeStats {
+    float minValue = 0, maxValue = 0;
+    double mean = 0;
+    std::vector<std::size_t> histogram;  ///< equal-width bins over [minValue, maxValue]
+};
+VolumeStats volumeStats(const Volume& v, int bins = 16);
+
+/// Multi-line human description (`splat info`): dimensions, spacing, extent, source,
+/// value range, mean, a text histogram and memory use.
+std::string describeVolume(const Volume& v);
+
+}  // namespace splat
