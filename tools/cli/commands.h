@@ -1,0 +1,15 @@
+#pragma once
+// Subcommands of the `splat` program. Each registers itself on the CLI11 app and sets a
+// callback; the callbacks throw splat::Error on bad input, and main() turns that into one
+// line on stderr and a non-zero exit status.
+#include <CLI/CLI.hpp>
+
+namespace splat::cli {
+
+void registerInfo(CLI::App& app);     // cmd_info.cpp
+void registerRender(CLI::App& app);   // cmd_render.cpp
+void registerRotate(CLI::App& app);   // cmd_rotate.cpp
+void registerCompare(CLI::App& app);  // cmd_compare.cpp
+void registerBench(CLI::App& app);    // cmd_bench.cpp
+
+}  // namespace splat::cli

@@ -1,0 +1,28 @@
+// The `splat` command-line program: see README.md ("Command line") and DESIGN.md.
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"splat: splatting volume renderer (axis-aligned and image-aligned sheet "
+                 "buffers, reference ray caster)"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "splat 0.1.0");
+    splat::cli::registerInfo(app);
+    splat::cli::registerRender(app);
+    splat::cli::registerRotate(app);
+    splat::cli::registerCompare(app);
+    splat::cli::registerBench(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "splat: error: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,25 @@
+#pragma once
+// Command-line options that say how to read VOLUME (shared by every subcommand).
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "splat/volume_io.h"
+
+namespace splat::cli {
+
+struct VolumeArgs {
+    std::string spec;                 // the VOLUME positional argument
+    std::string dims, type, spacing;  // raw options as typed: "256x256x128", "uint8", "1,1,2"
+    bool bigEndian = false;
+    std::size_t headerBytes = 0;
+    std::string nanPolicy = "error";  // error | zero
+};
+
+/// Adds VOLUME and --dims/--type/--spacing/--big-endian/--header-bytes/--nan-policy.
+void addVolumeOptions(CLI::App& cmd, VolumeArgs& args);
+
+/// Parses the options and loads the volume; throws splat::Error on bad input.
+Volume loadVolumeFromArgs(const VolumeArgs& args);
+
+}  // namespace splat::cli
