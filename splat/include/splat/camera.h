@@ -1,0 +1,55 @@
+#pragma once
+// The camera of DESIGN.md ("Camera convention"): world z is up; azimuth a, elevation e give
+// the view direction (-sin a cos e, cos a cos e, -sin e), image right (cos a, sin a, 0) and
+// image up = right x view. The view is centred on the volume centre; pixel (0, 0) is the
+// top-left corner and pixel centres sit at half-integers.
+#include <glm/glm.hpp>
+
+#include "splat/volume.h"
+
+namespace splat {
+
+enum class Projection { Orthographic, Perspective };
+
+struct CameraParams {
+    int width = 512, height = 512;
+    double azimuthDeg = 0, elevationDeg = 0;
+    Projection projection = Projection::Orthographic;
+    /// World units per pixel (orthographic; for perspective at the volume centre's depth).
+    /// 0: fit the volume's bounding sphere into the smaller image side.
+    double pixelSize = 0;
+    /// Perspective: vertical field of view in degrees; the eye is placed so that the
+    /// bounding sphere fits.
+    double fovDeg = 30;
+};
+
+struct Ray {
+    glm::dvec3 origin, dir;  ///< dir is unit length
+};
+
+class Camera {
+public:
+    Camera(const CameraParams& params, const Volume& volume);
+
+    const CameraParams& params() const { return params_; }
+    int width() const { return params_.width; }
+    int height() const { return params_.height; }
+    bool perspective() const { return params_.projection == Projection::Perspective; }
+
+    glm::dvec3 right, up, view;  ///< unit vectors; view points into the scene
+    glm::dvec3 target;           ///< volume centre (world)
+    glm::dvec3 eye;              ///< perspective eye (orthographic: target - view * radius)
+    double pixelSize = 1;        ///< world units per pixel at the target's depth
+    double focal = 1;            ///< perspective: distance of the target plane from the eye
+    double boundingRadius = 0;   ///< of the volume (world)
+
+    /// The ray through continuous pixel position (px, py) (pixel centres: x + 0.5).
+    /// Orthographic rays start on the plane through the target, perpendicular to view,
+    /// moved back by boundingRadius along -view; perspective rays start at the eye.
+    Ray ray(double px, double py) const;
+    /// Continuous pixel position (x, y) and depth of a world point; depth is the distance
+    /// along view from the ray origin plane (orthographic) or from the eye (perspective).
+    glm::dvec3 project(const glm::dvec3& world) const;
+};
+
+}  // namespace splat

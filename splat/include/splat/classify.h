@@ -1,0 +1,37 @@
+#pragma once
+// Classification: turns the voxels that the scene needs into a splat list (structure of
+// arrays). Only what is visible is modelled: with pre-classification a voxel becomes a
+// splat only if its extinction is > 0; with post-classification (and for xray/mip) only
+// voxels with d != 0 in bricks whose value range, widened by the kernel radius, can be
+// made visible by the transfer function.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "splat/transfer.h"
+#include "splat/volume.h"
+
+namespace splat {
+
+enum class RenderMode { Dvr, Mip, Xray, Iso };
+enum class Classification { Pre, Post };
+
+struct SplatList {
+    std::vector<float> x, y, z;            ///< world position of the voxel
+    std::vector<std::uint16_t> i, j, k;    ///< index position
+    std::vector<float> density;            ///< d_i
+    std::vector<float> extinction;         ///< rho_i = f_rho(d_i), per world unit (pre)
+    std::vector<float> r, g, b;            ///< premultiplied emission e_i = colour * rho_i (pre)
+    std::size_t voxels = 0;                ///< voxels considered
+    std::size_t size() const { return x.size(); }
+    std::size_t bytes() const;
+};
+
+/// Builds the splat list. `tf` must be resolved (absolute densities). For `Xray` and
+/// `Mip` the transfer function is not used: every voxel with d != 0 is a splat. `radius`
+/// is the kernel radius in voxels (for the brick dilation of post-classification).
+/// Throws splat::Error if a dimension exceeds 65535.
+SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
+                   Classification classification, double radius);
+
+}  // namespace splat
