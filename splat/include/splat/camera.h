@@ -50,6 +50,9 @@ public:
     /// Continuous pixel position (x, y) and depth of a world point; depth is the distance
     /// along view from the ray origin plane (orthographic) or from the eye (perspective).
     glm::dvec3 project(const glm::dvec3& world) const;
+
+private:
+    CameraParams params_;
 };
 
 }  // namespace splat

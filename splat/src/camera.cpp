@@ -1,0 +1,65 @@
+// Orthographic and perspective cameras following DESIGN.md's convention.
+#include "splat/camera.h"
+
+#include <cmath>
+#include <string>
+
+#include "splat/error.h"
+
+namespace splat {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kMaxImageSide = 32768;
+}  // namespace
+
+Camera::Camera(const CameraParams& params, const Volume& volume) : params_(params) {
+    if (params.width < 1 || params.height < 1 || params.width > kMaxImageSide ||
+        params.height > kMaxImageSide)
+        throw Error("image size " + std::to_string(params.width) + "x" +
+                    std::to_string(params.height) + " is outside 1.." +
+                    std::to_string(kMaxImageSide) + " per side");
+    if (!std::isfinite(params.azimuthDeg) || !std::isfinite(params.elevationDeg))
+        throw Error("azimuth and elevation must be finite numbers");
+    if (!(params.pixelSize >= 0) || !std::isfinite(params.pixelSize))
+        throw Error("pixel size must be a positive number of world units (0 = fit)");
+    if (params.projection == Projection::Perspective &&
+        !(params.fovDeg > 0.1 && params.fovDeg < 170))
+        throw Error("perspective field of view must be between 0.1 and 170 degrees");
+
+    const double a = params.azimuthDeg * kPi / 180.0, e = params.elevationDeg * kPi / 180.0;
+    view = glm::dvec3(-std::sin(a) * std::cos(e), std::cos(a) * std::cos(e), -std::sin(e));
+    right = glm::dvec3(std::cos(a), std::sin(a), 0.0);
+    up = glm::cross(right, view);
+
+    target = volume.center();
+    boundingRadius = 0.5 * glm::length(glm::dvec3(volume.dims) * volume.spacing);
+    const double side = double(std::min(params.width, params.height));
+    if (params.projection == Projection::Orthographic) {
+        pixelSize = params.pixelSize > 0 ? params.pixelSize : 2.0 * boundingRadius / side;
+        eye = target - view * (1.5 * boundingRadius + 1.0);
+        focal = glm::length(target - eye);
+    } else {
+        const double half = 0.5 * params.fovDeg * kPi / 180.0;
+        focal = boundingRadius / std::sin(half) + 1e-9;
+        eye = target - view * focal;
+        pixelSize = params.pixelSize > 0 ? params.pixelSize : 2.0 * focal * std::tan(half) / side;
+    }
+}
+
+Ray Camera::ray(double px, double py) const {
+    const double sx = (px - 0.5 * params_.width) * pixelSize;
+    const double sy = (py - 0.5 * params_.height) * pixelSize;
+    if (!perspective()) return {eye + right * sx - up * sy, view};
+    return {eye, glm::normalize(view * focal + right * sx - up * sy)};
+}
+
+glm::dvec3 Camera::project(const glm::dvec3& world) const {
+    const glm::dvec3 d = world - eye;
+    const double depth = glm::dot(d, view);
+    const double scale = perspective() ? focal / depth : 1.0;
+    return {0.5 * params_.width + glm::dot(d, right) * scale / pixelSize,
+            0.5 * params_.height - glm::dot(d, up) * scale / pixelSize, depth};
+}
+
+}  // namespace splat

@@ -1,0 +1,118 @@
+// Image files through OpenImageIO, written atomically (temporary file, then rename).
+#include "splat/image_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imageio.h>
+
+#include "splat/error.h"
+
+namespace splat {
+
+namespace fs = std::filesystem;
+
+float srgbEncode(float x) {
+    x = std::clamp(x, 0.0f, 1.0f);
+    return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+}
+
+namespace {
+
+std::string lowerExtension(const std::string& path) {
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    return ext;
+}
+
+// A sibling temporary name with the same extension (OpenImageIO picks the format by it).
+std::string temporaryName(const std::string& path) {
+    const fs::path p(path);
+    std::random_device rd;
+    const std::string tag = std::to_string(rd() % 1000000u);
+    return (p.parent_path() / ("." + p.stem().string() + ".tmp" + tag + p.extension().string())).string();
+}
+
+std::vector<float> displayValues(const Image& image, const WriteOptions& o) {
+    std::vector<float> out(std::size_t(image.width) * image.height * 3);
+    const float span = o.windowHigh > o.windowLow ? o.windowHigh - o.windowLow : 1.0f;
+    for (std::size_t n = 0; n < image.pixels.size(); ++n) {
+        const glm::vec4 c = image.pixels[n];
+        for (int ch = 0; ch < 3; ++ch) {
+            float v;
+            if (o.mapping == DisplayMapping::Window)
+                v = std::clamp((c.r - o.windowLow) / span, 0.0f, 1.0f);
+            else
+                v = srgbEncode(std::isfinite(c[ch]) ? c[ch] : 0.0f);
+            out[n * 3 + ch] = v;
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+void writeImage(const std::string& path, const Image& image, const WriteOptions& options) {
+    const std::string ext = lowerExtension(path);
+    const bool isFloat = ext == ".exr" || ext == ".tif" || ext == ".tiff";
+    if (!isFloat && ext != ".png" && ext != ".gif" && ext != ".jpg" && ext != ".jpeg")
+        throw Error(path + ": unsupported image type '" + ext + "' (use .png, .exr or .tif)");
+    if (image.width < 1 || image.height < 1) throw Error(path + ": image is empty");
+    const fs::path parent = fs::path(path).parent_path();
+    if (!parent.empty() && !fs::is_directory(parent))
+        throw Error(path + ": folder '" + parent.string() + "' does not exist");
+
+    const std::string tmp = temporaryName(path);
+    auto out = OIIO::ImageOutput::create(tmp);
+    if (!out) throw Error(path + ": cannot create an image writer for '" + ext + "'");
+    bool ok;
+    if (isFloat) {
+        OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
+        spec.channelnames = {"R", "G", "B", "A"};
+        spec.alpha_channel = 3;
+        ok = out->open(tmp, spec) &&
+             out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
+    } else {
+        const std::vector<float> v = displayValues(image, options);
+        OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+        ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, v.data());
+    }
+    const std::string err = out->geterror();
+    ok = out->close() && ok;
+    if (!ok) {
+        std::error_code ec;
+        fs::remove(tmp, ec);
+        throw Error(path + ": cannot write image (" + (err.empty() ? "write failed" : err) + ")");
+    }
+    std::error_code ec;
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw Error(path + ": cannot write image (" + ec.message() + ")");
+    }
+}
+
+Image readImage(const std::string& path) {
+    if (!fs::exists(path)) throw Error(path + ": file not found");
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw Error(path + ": cannot read image (" + OIIO::geterror() + ")");
+    const OIIO::ImageSpec& spec = in->spec();
+    const int nc = spec.nchannels;
+    std::vector<float> buf(std::size_t(spec.width) * spec.height * nc);
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, buf.data()))
+        throw Error(path + ": cannot read image (" + in->geterror() + ")");
+    Image img(spec.width, spec.height);
+    for (std::size_t n = 0; n < img.pixels.size(); ++n) {
+        glm::vec4 c(0.0f, 0.0f, 0.0f, 1.0f);
+        for (int ch = 0; ch < std::min(nc, 4); ++ch) c[ch] = buf[n * nc + ch];
+        if (nc < 3) c.g = c.b = c.r;
+        if (nc == 2) c.a = buf[n * nc + 1];
+        img.pixels[n] = c;
+    }
+    return img;
+}
+
+}  // namespace splat

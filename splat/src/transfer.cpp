@@ -1,0 +1,146 @@
+// Piecewise-linear transfer functions, presets, JSON files and opacity correction.
+#include "splat/transfer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "splat/error.h"
+
+namespace splat {
+
+namespace {
+
+TransferPoint pt(float v, float r, float g, float b, float a) { return {v, {r, g, b, a}}; }
+
+// Presets live on the normalized domain [0, 1] = the volume's [min, max]. Opacities are
+// per millimetre (unit distance 1): small numbers, because a ray crosses hundreds of them.
+TransferFunction makePreset(const std::string& name) {
+    TransferFunction tf;
+    tf.name = name;
+    tf.normalized = true;
+    if (name == "gray-ramp") {
+        tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.1f, 0.1f, 0.1f, 0.1f, 0),
+                     pt(1.0f, 1, 1, 1, 0.08f)};
+    } else if (name == "ct-bone") {
+        tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.55f, 0.8f, 0.6f, 0.45f, 0),
+                     pt(0.62f, 0.95f, 0.85f, 0.7f, 0.6f), pt(1.0f, 1, 1, 0.95f, 0.9f)};
+    } else if (name == "ct-soft") {
+        tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.12f, 0.8f, 0.4f, 0.3f, 0),
+                     pt(0.3f, 0.9f, 0.5f, 0.4f, 0.02f), pt(0.5f, 0.9f, 0.55f, 0.45f, 0.04f),
+                     pt(0.6f, 1, 0.95f, 0.85f, 0.5f), pt(1.0f, 1, 1, 1, 0.8f)};
+    } else if (name == "mri-head") {
+        tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.12f, 0.75f, 0.5f, 0.4f, 0),
+                     pt(0.3f, 0.9f, 0.65f, 0.55f, 0.08f), pt(0.6f, 1.0f, 0.85f, 0.75f, 0.3f),
+                     pt(1.0f, 1, 1, 1, 0.6f)};
+    } else {
+        std::string all;
+        for (const auto& n : TransferFunction::presetNames()) all += (all.empty() ? "" : ", ") + n;
+        throw Error("unknown transfer function preset '" + name + "' (presets: " + all +
+                    "; or give a .json file)");
+    }
+    return tf;
+}
+
+void validate(const TransferFunction& tf, const std::string& what) {
+    if (tf.points.empty()) throw Error(what + ": transfer function has no points");
+    if (!(tf.unitDistance > 0) || !std::isfinite(tf.unitDistance))
+        throw Error(what + ": unit_distance must be a positive number");
+    for (std::size_t n = 0; n < tf.points.size(); ++n) {
+        const auto& p = tf.points[n];
+        if (!std::isfinite(p.value)) throw Error(what + ": point " + std::to_string(n) + " has a non-finite value");
+        for (int c = 0; c < 4; ++c)
+            if (!(p.rgba[c] >= 0.0f && p.rgba[c] <= 1.0f))
+                throw Error(what + ": point " + std::to_string(n) + " has a colour or opacity outside [0, 1]");
+        if (n > 0 && p.value < tf.points[n - 1].value)
+            throw Error(what + ": point values must be non-decreasing (point " + std::to_string(n) + ")");
+    }
+}
+
+}  // namespace
+
+std::vector<std::string> TransferFunction::presetNames() {
+    return {"ct-bone", "ct-soft", "mri-head", "gray-ramp"};
+}
+
+TransferFunction TransferFunction::preset(const std::string& name) { return makePreset(name); }
+
+TransferFunction TransferFunction::fromJson(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw Error(path + ": cannot open transfer function file");
+    nlohmann::json j;
+    try {
+        in >> j;
+    } catch (const std::exception& e) {
+        throw Error(path + ": not valid JSON (" + std::string(e.what()) + ")");
+    }
+    TransferFunction tf;
+    tf.name = path;
+    try {
+        const std::string domain = j.value("domain", "absolute");
+        if (domain != "absolute" && domain != "normalized")
+            throw Error(path + ": \"domain\" must be \"absolute\" or \"normalized\"");
+        tf.normalized = domain == "normalized";
+        tf.unitDistance = j.value("unit_distance", 1.0);
+        if (!j.contains("points") || !j["points"].is_array())
+            throw Error(path + ": missing \"points\": [[value, r, g, b, a], ...]");
+        for (const auto& p : j["points"]) {
+            if (!p.is_array() || p.size() != 5)
+                throw Error(path + ": each point must be [value, r, g, b, a]");
+            tf.points.push_back(pt(p[0].get<float>(), p[1].get<float>(), p[2].get<float>(),
+                                   p[3].get<float>(), p[4].get<float>()));
+        }
+    } catch (const nlohmann::json::exception& e) {
+        throw Error(path + ": bad transfer function (" + std::string(e.what()) + ")");
+    }
+    validate(tf, path);
+    return tf;
+}
+
+TransferFunction TransferFunction::load(const std::string& nameOrPath) {
+    if (nameOrPath.size() > 5 && nameOrPath.substr(nameOrPath.size() - 5) == ".json")
+        return fromJson(nameOrPath);
+    return preset(nameOrPath);
+}
+
+TransferFunction TransferFunction::resolved(float lo, float hi) const {
+    if (!normalized) return *this;
+    TransferFunction tf = *this;
+    tf.normalized = false;
+    const float span = hi > lo ? hi - lo : 1.0f;
+    for (auto& p : tf.points) p.value = lo + p.value * span;
+    return tf;
+}
+
+glm::vec4 TransferFunction::sample(float d) const {
+    if (points.empty()) return glm::vec4(0.0f);
+    if (!(d > points.front().value)) return points.front().rgba;
+    if (!(d < points.back().value)) return points.back().rgba;
+    const auto it = std::upper_bound(points.begin(), points.end(), d,
+                                     [](float v, const TransferPoint& p) { return v < p.value; });
+    const TransferPoint& b = *it;
+    const TransferPoint& a = *(it - 1);
+    const float span = b.value - a.value;
+    const float f = span > 0 ? (d - a.value) / span : 1.0f;
+    return a.rgba + f * (b.rgba - a.rgba);
+}
+
+float TransferFunction::extinctionFromOpacity(float alpha) const {
+    // rho = -ln(1 - alpha) / unit distance, with 1 - alpha clamped below so that
+    // alpha = 1 gives a large finite extinction instead of inf.
+    const float transmittance = std::max(1.0f - alpha, kMinTransmittance);
+    if (alpha <= 0.0f) return 0.0f;
+    return float(-std::log(double(transmittance)) / unitDistance);
+}
+
+bool TransferFunction::invisibleOver(float lo, float hi) const {
+    if (points.empty()) return true;
+    if (sample(lo).a > 0.0f || sample(hi).a > 0.0f) return false;
+    for (const auto& p : points)
+        if (p.value > lo && p.value < hi && p.rgba.a > 0.0f) return false;
+    return true;
+}
+
+}  // namespace splat
