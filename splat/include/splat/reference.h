@@ -19,4 +19,11 @@ Image renderReference(const Volume& volume, const SplatList& splats,
                       const footprint::Kernel& kernel, const Camera& camera,
                       const RenderSettings& settings, RenderStats* stats = nullptr);
 
+/// Iso mode only: per pixel, the world distance along the ray from Camera::ray's origin to
+/// the first hit of f = settings.isoLevel in r = g = b with alpha 1; (0, 0, 0, 0) where the
+/// ray misses. Same error control as renderReference.
+Image renderReferenceDepth(const Volume& volume, const SplatList& splats,
+                           const footprint::Kernel& kernel, const Camera& camera,
+                           const RenderSettings& settings, RenderStats* stats = nullptr);
+
 }  // namespace splat

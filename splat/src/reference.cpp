@@ -1,0 +1,588 @@
+// The reference ray caster (DESIGN.md, "The model"): one ray per pixel through the
+// continuous fields f(x) = sum_i d_i h(|S^-1 (x - x_i)|) (and rho, e for pre-classification),
+// integrated with error control.
+//
+// Acceleration (exact, no change of the model):
+//  - the splat list is scattered into a dense per-voxel grid (absent splats are 0), so a
+//    field sample visits only the (2R + 1)^3 lattice points around it;
+//  - a brick grid (8^3 voxels) marks bricks whose points lie within R of a non-zero voxel;
+//    each ray is clipped to the volume bounds padded by R and cut into the segments that
+//    cross marked bricks (3D DDA); the fields are exactly 0 elsewhere;
+//  - h is tabulated in u^2 (65536 entries, linear interpolation; its error is far below
+//    1e-6 of the peak, see tests/test_reference.cpp).
+//
+// Error control, per ray (each pixel is computed independently, so the image does not
+// depend on the thread count): each segment is integrated with composite Simpson at sample
+// spacing s = settings.referenceStep voxels (one voxel = the smallest spacing), then s/2,
+// s/4, ... reusing the samples of the coarser pass, until the pixel's RGBA changes by at
+// most settings.referenceTolerance (for xray: tolerance * max(1, |value|), the values being
+// world lengths) or kMaxLevels halvings were made. The result of the finest pass is used.
+// stats->referenceStep is the finest spacing any ray needed.
+//
+//  - dvr: optical depth tau(t) by Simpson/quadratic interpolation of rho at every sample,
+//    I = int e exp(-tau) by Simpson; a ray stops once T < tolerance * 1e-3 (what follows
+//    can change the pixel by at most that much, colours being <= 1).
+//  - xray: int f dt (world units). mip: max of the samples, polished by a golden-section
+//    search around the largest one (0 when the ray meets nothing).
+//  - iso: first sample pair bracketing f = level, refined by bisection to 1e-9 voxels,
+//    shaded with the normalised gradient of f (central differences) under a headlight.
+#include "splat/reference.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "splat/error.h"
+
+namespace splat {
+namespace {
+
+constexpr int kBrick = 8;       // brick edge, voxels
+constexpr int kMaxLevels = 6;   // step halvings after the first pass
+constexpr int kLutSize = 1 << 16;
+constexpr double kAmbient = 0.25, kDiffuse = 0.75;
+
+// h(u) tabulated over u^2 in [0, R^2].
+class KernelLut {
+public:
+    explicit KernelLut(const footprint::Kernel& kernel) {
+        const double r = kernel.radius();
+        r2Max_ = r * r;
+        const double step = r2Max_ / kLutSize;
+        inv_ = 1.0 / step;
+        values_.resize(kLutSize + 2, 0.0f);
+        for (int n = 0; n <= kLutSize; ++n) {
+            const double u2 = std::min(n * step, r2Max_);
+            values_[n] = n == kLutSize ? 0.0f : float(kernel(std::sqrt(u2)));
+        }
+    }
+    double r2Max() const { return r2Max_; }
+    float operator()(double u2) const {
+        if (!(u2 < r2Max_)) return 0.0f;
+        const double t = u2 * inv_;
+        const int n = int(t);
+        const float f = float(t - n);
+        return values_[n] + f * (values_[n + 1] - values_[n]);
+    }
+
+private:
+    double r2Max_ = 0, inv_ = 0;
+    std::vector<float> values_;
+};
+
+// Dense per-voxel values (C channels interleaved) plus the brick occupancy grid.
+template <int C>
+struct FieldGrid {
+    glm::ivec3 dims{0};
+    double radius = 0;
+    std::vector<float> values;
+    glm::ivec3 nb{0};
+    std::vector<std::uint8_t> bricks;
+    const KernelLut* lut = nullptr;
+
+    std::size_t index(int i, int j, int k) const {
+        return ((std::size_t(k) * dims.y + j) * dims.x + i) * C;
+    }
+    bool brick(int bx, int by, int bz) const {
+        return bricks[(std::size_t(bz) * nb.y + by) * nb.x + bx] != 0;
+    }
+
+    // Sum of the C channels times h at index position p.
+    void eval(const glm::dvec3& p, double out[C]) const {
+        for (int c = 0; c < C; ++c) out[c] = 0.0;
+        const double r = radius, r2 = lut->r2Max();
+        const int i0 = std::max(0, int(std::ceil(p.x - r))), i1 = std::min(dims.x - 1, int(std::floor(p.x + r)));
+        const int j0 = std::max(0, int(std::ceil(p.y - r))), j1 = std::min(dims.y - 1, int(std::floor(p.y + r)));
+        const int k0 = std::max(0, int(std::ceil(p.z - r))), k1 = std::min(dims.z - 1, int(std::floor(p.z + r)));
+        if (i0 > i1 || j0 > j1 || k0 > k1) return;
+        double dx2[64];
+        const int ni = std::min(i1 - i0 + 1, 64);
+        for (int n = 0; n < ni; ++n) {
+            const double d = p.x - (i0 + n);
+            dx2[n] = d * d;
+        }
+        for (int k = k0; k <= k1; ++k) {
+            const double dz = p.z - k, dz2 = dz * dz;
+            if (dz2 >= r2) continue;
+            for (int j = j0; j <= j1; ++j) {
+                const double dy = p.y - j, dyz = dy * dy + dz2;
+                if (dyz >= r2) continue;
+                const float* row = values.data() + index(i0, j, k);
+                for (int n = 0; n < ni; ++n) {
+                    const float w = (*lut)(dyz + dx2[n]);
+                    if (w == 0.0f) continue;
+                    for (int c = 0; c < C; ++c) out[c] += double(w) * double(row[n * C + c]);
+                }
+            }
+        }
+    }
+};
+
+template <int C>
+FieldGrid<C> buildGrid(const Volume& volume, const SplatList& splats, const KernelLut& lut,
+                       double radius, const std::array<const std::vector<float>*, C>& channels) {
+    FieldGrid<C> g;
+    g.dims = volume.dims;
+    g.radius = radius;
+    g.lut = &lut;
+    g.values.assign(volume.voxelCount() * C, 0.0f);
+    // Brick b covers index positions [-R + b B, -R + (b + 1) B) on each axis.
+    g.nb = glm::ivec3(glm::ceil((glm::dvec3(volume.dims) - 1.0 + 2.0 * radius) / double(kBrick))) + 1;
+    g.bricks.assign(std::size_t(g.nb.x) * g.nb.y * g.nb.z, 0);
+    for (const auto* ch : channels)
+        if (ch->size() != splats.size())
+            throw Error("reference: the splat list lacks the channels this mode needs");
+    for (std::size_t s = 0; s < splats.size(); ++s) {
+        const int i = splats.i[s], j = splats.j[s], k = splats.k[s];
+        if (i >= volume.dims.x || j >= volume.dims.y || k >= volume.dims.z)
+            throw Error("reference: splat index outside the volume");
+        bool any = false;
+        for (int c = 0; c < C; ++c) {
+            const float v = (*channels[c])[s];
+            g.values[g.index(i, j, k) + c] = v;
+            any = any || v != 0.0f;
+        }
+        if (!any) continue;
+        // Points within R of voxel p lie in [p - R, p + R]: bricks floor(p / B) ..
+        // floor((p + 2R) / B) in the brick frame that starts at -R.
+        const glm::ivec3 p(i, j, k);
+        glm::ivec3 lo, hi;
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::max(0, int(std::floor(p[a] / double(kBrick))));
+            hi[a] = std::min(g.nb[a] - 1, int(std::floor((p[a] + 2.0 * radius) / kBrick)));
+        }
+        for (int bz = lo.z; bz <= hi.z; ++bz)
+            for (int by = lo.y; by <= hi.y; ++by)
+                for (int bx = lo.x; bx <= hi.x; ++bx)
+                    g.bricks[(std::size_t(bz) * g.nb.y + by) * g.nb.x + bx] = 1;
+    }
+    return g;
+}
+
+struct Segment {
+    double a, b;
+};
+
+// Cuts the line p0 + t v (index space, t world units) into the segments crossing marked
+// bricks, within [tLo, tHi] and the volume bounds padded by R.
+template <int C>
+void raySegments(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& v, double tLo,
+                 double tHi, std::vector<Segment>& out) {
+    out.clear();
+    const double r = g.radius;
+    double tA = tLo, tB = tHi;
+    for (int a = 0; a < 3; ++a) {
+        const double lo = -r, hi = g.dims[a] - 1 + r;
+        if (std::abs(v[a]) < 1e-300) {
+            if (p0[a] < lo || p0[a] > hi) return;
+            continue;
+        }
+        double t0 = (lo - p0[a]) / v[a], t1 = (hi - p0[a]) / v[a];
+        if (t0 > t1) std::swap(t0, t1);
+        tA = std::max(tA, t0);
+        tB = std::min(tB, t1);
+    }
+    if (!(tA < tB)) return;
+    const double origin = -r;
+    const glm::dvec3 pa = p0 + tA * v;
+    glm::ivec3 cell, step;
+    glm::dvec3 tMax, tDelta;
+    for (int a = 0; a < 3; ++a) {
+        cell[a] = std::clamp(int(std::floor((pa[a] - origin) / kBrick)), 0, g.nb[a] - 1);
+        if (v[a] > 1e-300) {
+            step[a] = 1;
+            tMax[a] = (origin + (cell[a] + 1.0) * kBrick - p0[a]) / v[a];
+            tDelta[a] = kBrick / v[a];
+        } else if (v[a] < -1e-300) {
+            step[a] = -1;
+            tMax[a] = (origin + cell[a] * double(kBrick) - p0[a]) / v[a];
+            tDelta[a] = -kBrick / v[a];
+        } else {
+            step[a] = 0;
+            tMax[a] = std::numeric_limits<double>::infinity();
+            tDelta[a] = tMax[a];
+        }
+    }
+    double t = tA;
+    while (t < tB) {
+        const int axis = tMax.x <= tMax.y ? (tMax.x <= tMax.z ? 0 : 2) : (tMax.y <= tMax.z ? 1 : 2);
+        const double tn = std::min(tMax[axis], tB);
+        if (tn > t && g.brick(cell.x, cell.y, cell.z)) {
+            if (!out.empty() && out.back().b == t)
+                out.back().b = tn;
+            else
+                out.push_back({t, tn});
+        }
+        t = std::max(t, tn);
+        cell[axis] += step[axis];
+        tMax[axis] += tDelta[axis];
+        if (cell[axis] < 0 || cell[axis] >= g.nb[axis]) break;
+    }
+}
+
+// Per-thread scratch of one ray.
+template <int C>
+struct RayScratch {
+    std::vector<Segment> segments;
+    std::vector<int> baseN;                              // subintervals of pass 0
+    std::vector<std::vector<std::array<float, C>>> old, cur;  // samples per segment
+    std::vector<std::array<float, C>> tmp;
+};
+
+using Sample4 = std::array<float, 4>;
+
+class Caster {
+public:
+    Caster(const Volume& volume, const SplatList& splats, const footprint::Kernel& kernel,
+           const Camera& camera, const RenderSettings& settings)
+        : volume_(volume), camera_(camera), settings_(settings), lut_(kernel),
+          radius_(kernel.radius()) {
+        if (!(settings.referenceStep > 0) || !std::isfinite(settings.referenceStep))
+            throw Error("reference: referenceStep must be > 0 voxels");
+        if (!(settings.referenceTolerance > 0))
+            throw Error("reference: referenceTolerance must be > 0");
+        if (volume.voxelCount() == 0) throw Error("reference: empty volume");
+        invSpacing_ = 1.0 / volume.spacing;
+        stepWorld_ = settings.referenceStep * volume.minSpacing();
+        preDvr_ = settings.mode == RenderMode::Dvr && settings.classification == Classification::Pre;
+        if (preDvr_)
+            grid4_ = buildGrid<4>(volume, splats, lut_, radius_,
+                                  {&splats.extinction, &splats.r, &splats.g, &splats.b});
+        else
+            grid1_ = buildGrid<1>(volume, splats, lut_, radius_, {&splats.density});
+    }
+
+    Image render(RenderStats* stats, Image* depth) {
+        const int w = camera_.width(), h = camera_.height();
+        Image image(w, h);
+        if (depth) *depth = Image(w, h);
+        std::atomic<int> finest{0};
+        auto body = [&](const tbb::blocked_range<int>& rows) {
+            RayScratch<4> s4;
+            RayScratch<1> s1;
+            int localFinest = 0;
+            for (int y = rows.begin(); y != rows.end(); ++y)
+                for (int x = 0; x < w; ++x) {
+                    int level = 0;
+                    double hitDepth = -1;
+                    image.at(x, y) = preDvr_ ? pixel(grid4_, s4, x, y, level, hitDepth)
+                                             : pixel(grid1_, s1, x, y, level, hitDepth);
+                    if (depth)
+                        depth->at(x, y) = hitDepth >= 0 ? glm::vec4(glm::vec3(float(hitDepth)), 1.0f)
+                                                        : glm::vec4(0.0f);
+                    localFinest = std::max(localFinest, level);
+                }
+            int cur = finest.load();
+            while (localFinest > cur && !finest.compare_exchange_weak(cur, localFinest)) {
+            }
+        };
+        const int threads = settings_.threads > 0 ? settings_.threads : tbb::task_arena::automatic;
+        tbb::task_arena arena(threads);
+        arena.execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), body); });
+        if (stats) stats->referenceStep = settings_.referenceStep / double(1 << finest.load());
+        return image;
+    }
+
+private:
+    // Converts a grid sample into the quantities integrated: dvr -> (rho, e rgb), else f.
+    template <int C>
+    void sampleAt(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& v, double t,
+                  float* out) const {
+        double val[C];
+        g.eval(p0 + t * v, val);
+        if constexpr (C == 4) {
+            for (int c = 0; c < 4; ++c) out[c] = float(val[c]);
+        } else {
+            out[0] = float(val[0]);
+        }
+    }
+
+    // rho and emission of one post-classified / pre-classified sample.
+    void dvrQuantities(const float* s, int channels, double& rho, glm::dvec3& e) const {
+        if (channels == 4) {
+            rho = s[0];
+            e = glm::dvec3(s[1], s[2], s[3]);
+        } else {
+            const glm::vec4 c = settings_.transfer.sample(s[0]);
+            rho = settings_.transfer.extinctionFromOpacity(c.a);
+            e = glm::dvec3(c) * rho;
+        }
+    }
+
+    template <int C>
+    glm::vec4 pixel(const FieldGrid<C>& g, RayScratch<C>& sc, int x, int y, int& levelUsed,
+                    double& hitDepth) const {
+        const Ray ray = camera_.ray(x + 0.5, y + 0.5);
+        const glm::dvec3 p0 = (ray.origin - volume_.origin) * invSpacing_;
+        const glm::dvec3 v = ray.dir * invSpacing_;
+        const double inf = std::numeric_limits<double>::infinity();
+        raySegments(g, p0, v, camera_.perspective() ? 0.0 : -inf, inf, sc.segments);
+        const RenderMode mode = settings_.mode;
+        const glm::vec4 bg = settings_.background;
+        auto finish = [&](glm::dvec4 c) -> glm::vec4 {
+            if (mode == RenderMode::Dvr) {
+                const double T = 1.0 - c.a;
+                c += T * glm::dvec4(bg);
+            } else if (mode == RenderMode::Iso && c.a == 0.0) {
+                c = glm::dvec4(bg);
+            }
+            return glm::vec4(c);
+        };
+        levelUsed = 0;
+        hitDepth = -1;
+        if (sc.segments.empty()) {
+            if (mode == RenderMode::Xray || mode == RenderMode::Mip) return glm::vec4(0, 0, 0, 1);
+            return finish(glm::dvec4(0.0));
+        }
+        const std::size_t ns = sc.segments.size();
+        sc.baseN.resize(ns);
+        sc.old.resize(ns);
+        sc.cur.resize(ns);
+        for (std::size_t s = 0; s < ns; ++s) {
+            const double len = sc.segments[s].b - sc.segments[s].a;
+            sc.baseN[s] = 2 * std::max(1, int(std::ceil(len / (2.0 * stepWorld_))));
+            sc.old[s].clear();
+            sc.cur[s].clear();
+        }
+        glm::dvec4 prev(0.0), result(0.0);
+        double prevDepth = -1;
+        const double tol = settings_.referenceTolerance;
+        for (int level = 0; level <= kMaxLevels; ++level) {
+            double depthHere = -1;
+            result = integrate(g, sc, p0, v, level, depthHere);
+            levelUsed = level;
+            hitDepth = depthHere;
+            if (level > 0) {
+                const glm::dvec4 d = glm::abs(result - prev);
+                double scale = 1.0;
+                if (mode == RenderMode::Xray) scale = std::max(1.0, std::abs(result.r));
+                const bool depthStable =
+                    mode != RenderMode::Iso || (depthHere < 0) == (prevDepth < 0);
+                if (std::max(std::max(d.r, d.g), std::max(d.b, d.a)) <= tol * scale && depthStable)
+                    break;
+            }
+            prev = result;
+            prevDepth = depthHere;
+            std::swap(sc.old, sc.cur);
+        }
+        return finish(result);
+    }
+
+    // One pass at `level`: fills sc.cur from sc.old (samples of level - 1) and new samples.
+    template <int C>
+    glm::dvec4 integrate(const FieldGrid<C>& g, RayScratch<C>& sc, const glm::dvec3& p0,
+                         const glm::dvec3& v, int level, double& depth) const {
+        const RenderMode mode = settings_.mode;
+        const double cutoff = settings_.referenceTolerance * 1e-3;
+        double tau = 0, xray = 0, mip = 0;
+        glm::dvec3 emission(0.0);
+        double T = 1.0;
+        bool stop = false;
+        depth = -1;
+        double mipT = 0;
+        int mipSeg = -1, mipIdx = -1;
+        for (std::size_t s = 0; s < sc.segments.size() && !stop; ++s) {
+            const Segment seg = sc.segments[s];
+            const int n = sc.baseN[s] << level;
+            const double h = (seg.b - seg.a) / n;
+            auto& old = sc.old[s];
+            auto& cur = sc.cur[s];
+            cur.clear();
+            auto sample = [&](int idx) -> const std::array<float, C>& {
+                if (level > 0 && (idx & 1) == 0 && std::size_t(idx / 2) < old.size()) {
+                    cur.push_back(old[idx / 2]);
+                } else {
+                    std::array<float, C> v4;
+                    sampleAt(g, p0, v, seg.a + idx * h, v4.data());
+                    cur.push_back(v4);
+                }
+                return cur.back();
+            };
+            if (mode == RenderMode::Dvr) {
+                double rhoA;
+                glm::dvec3 eA;
+                dvrQuantities(sample(0).data(), C, rhoA, eA);
+                for (int m = 0; m < n / 2; ++m) {
+                    double rhoB, rhoC;
+                    glm::dvec3 eB, eC;
+                    dvrQuantities(sample(2 * m + 1).data(), C, rhoB, eB);
+                    dvrQuantities(sample(2 * m + 2).data(), C, rhoC, eC);
+                    const double tauB = tau + h / 12.0 * (5.0 * rhoA + 8.0 * rhoB - rhoC);
+                    const double tauC = tau + h / 3.0 * (rhoA + 4.0 * rhoB + rhoC);
+                    const double TA = T, TB = std::exp(-tauB), TC = std::exp(-tauC);
+                    emission += h / 3.0 * (eA * TA + 4.0 * eB * TB + eC * TC);
+                    tau = tauC;
+                    T = TC;
+                    rhoA = rhoC;
+                    eA = eC;
+                    if (T < cutoff) {
+                        stop = true;
+                        break;
+                    }
+                }
+            } else if (mode == RenderMode::Xray) {
+                double acc = sample(0)[0];
+                for (int m = 0; m < n / 2; ++m) {
+                    acc += 4.0 * sample(2 * m + 1)[0];
+                    const double fc = sample(2 * m + 2)[0];
+                    acc += m + 1 < n / 2 ? 2.0 * fc : fc;
+                }
+                xray += acc * h / 3.0;
+            } else if (mode == RenderMode::Mip) {
+                for (int idx = 0; idx <= n; ++idx) {
+                    const double f = sample(idx)[0];
+                    if (f > mip) {
+                        mip = f;
+                        mipSeg = int(s);
+                        mipIdx = idx;
+                        mipT = seg.a + idx * h;
+                    }
+                }
+            } else {  // iso
+                const double level0 = settings_.isoLevel;
+                double fPrev = sample(0)[0];
+                for (int idx = 1; idx <= n; ++idx) {
+                    const double f = sample(idx)[0];
+                    if (fPrev < level0 && f >= level0) {
+                        depth = bisect(g, p0, v, seg.a + (idx - 1) * h, seg.a + idx * h);
+                        stop = true;
+                        break;
+                    }
+                    fPrev = f;
+                }
+            }
+        }
+        if (mode == RenderMode::Dvr) return glm::dvec4(emission, 1.0 - T);
+        if (mode == RenderMode::Xray) return glm::dvec4(xray, xray, xray, 1.0);
+        if (mode == RenderMode::Mip) {
+            if (mipSeg >= 0) {
+                const Segment seg = sc.segments[mipSeg];
+                const double h = (seg.b - seg.a) / (sc.baseN[mipSeg] << level);
+                const double lo = std::max(seg.a, mipT - h), hi = std::min(seg.b, mipT + h);
+                (void)mipIdx;
+                mip = std::max(mip, goldenMax(g, p0, v, lo, hi));
+            }
+            return glm::dvec4(mip, mip, mip, 1.0);
+        }
+        if (depth < 0) return glm::dvec4(0.0);
+        return glm::dvec4(shade(g, p0, v, depth), 1.0);
+    }
+
+    template <int C>
+    double field(const FieldGrid<C>& g, const glm::dvec3& p) const {
+        double val[C];
+        g.eval(p, val);
+        return val[0];
+    }
+
+    template <int C>
+    double bisect(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& v, double lo,
+                  double hi) const {
+        const double level = settings_.isoLevel;
+        const double eps = 1e-9 * volume_.minSpacing();
+        while (hi - lo > eps) {
+            const double mid = 0.5 * (lo + hi);
+            if (field(g, p0 + mid * v) >= level)
+                hi = mid;
+            else
+                lo = mid;
+            if (mid == lo && mid == hi) break;
+        }
+        return 0.5 * (lo + hi);
+    }
+
+    template <int C>
+    double goldenMax(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& v, double a,
+                     double b) const {
+        const double r = 0.5 * (std::sqrt(5.0) - 1.0);
+        double c = b - r * (b - a), d = a + r * (b - a);
+        double fc = field(g, p0 + c * v), fd = field(g, p0 + d * v);
+        for (int it = 0; it < 60 && b - a > 1e-10 * volume_.minSpacing(); ++it) {
+            if (fc > fd) {
+                b = d;
+                d = c;
+                fd = fc;
+                c = b - r * (b - a);
+                fc = field(g, p0 + c * v);
+            } else {
+                a = c;
+                c = d;
+                fc = fd;
+                d = a + r * (b - a);
+                fd = field(g, p0 + d * v);
+            }
+        }
+        return std::max(fc, fd);
+    }
+
+    // Headlight shading of the iso surface at ray parameter t.
+    template <int C>
+    glm::dvec3 shade(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& v,
+                     double t) const {
+        const glm::dvec3 p = p0 + t * v;
+        const double hIdx = 1e-3;
+        glm::dvec3 grad;  // world gradient: d/dx = S^-1 d/dp
+        for (int a = 0; a < 3; ++a) {
+            glm::dvec3 d(0.0);
+            d[a] = hIdx;
+            grad[a] = (field(g, p + d) - field(g, p - d)) / (2.0 * hIdx) * invSpacing_[a];
+        }
+        const glm::dvec3 colour(settings_.transfer.sample(float(settings_.isoLevel)));
+        const double len = glm::length(grad);
+        double diffuse = 1.0;
+        if (len > 0) {
+            const glm::dvec3 dir = glm::normalize(v * volume_.spacing);  // world ray direction
+            diffuse = std::abs(glm::dot(grad / len, dir));
+        }
+        return colour * (kAmbient + kDiffuse * diffuse);
+    }
+
+    const Volume& volume_;
+    const Camera& camera_;
+    const RenderSettings& settings_;
+    KernelLut lut_;
+    double radius_;
+    glm::dvec3 invSpacing_{1.0};
+    double stepWorld_ = 1;
+    bool preDvr_ = false;
+    FieldGrid<4> grid4_;
+    FieldGrid<1> grid1_;
+};
+
+}  // namespace
+
+Image renderReference(const Volume& volume, const SplatList& splats,
+                      const footprint::Kernel& kernel, const Camera& camera,
+                      const RenderSettings& settings, RenderStats* stats) {
+    const auto start = std::chrono::steady_clock::now();
+    Caster caster(volume, splats, kernel, camera, settings);
+    Image image = caster.render(stats, nullptr);
+    if (stats) {
+        stats->splats = splats.size();
+        stats->voxels = splats.voxels;
+        stats->milliseconds =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    }
+    return image;
+}
+
+Image renderReferenceDepth(const Volume& volume, const SplatList& splats,
+                           const footprint::Kernel& kernel, const Camera& camera,
+                           const RenderSettings& settings, RenderStats* stats) {
+    if (settings.mode != RenderMode::Iso)
+        throw Error("reference: hit depths exist only in iso mode");
+    Caster caster(volume, splats, kernel, camera, settings);
+    Image depth;
+    caster.render(stats, &depth);
+    return depth;
+}
+
+}  // namespace splat
