@@ -1,0 +1,71 @@
+// The shared compositing stage (see compositing.h).
+#include "compositing.h"
+
+#include <algorithm>
+
+#include "splat/error.h"
+
+namespace splat {
+
+namespace {
+constexpr int kBlock = 8;  // early-termination granularity, pixels
+}
+
+TileAccumulator::TileAccumulator(int width, int height, CompositeOrder order,
+                                 double earlyTermination)
+    : w_(width), h_(height), order_(order),
+      terminates_(order == CompositeOrder::FrontToBack && earlyTermination > 0),
+      threshold_(float(1.0 - earlyTermination)), blocksX_((width + kBlock - 1) / kBlock),
+      blocksY_((height + kBlock - 1) / kBlock) {
+    if (blocksX_ * blocksY_ > 64) throw Error("tile size above 64 pixels is not supported");
+    allBlocks_ = blocksX_ * blocksY_ == 64 ? ~std::uint64_t(0)
+                                           : (std::uint64_t(1) << (blocksX_ * blocksY_)) - 1;
+    const std::size_t n = std::size_t(w_) * h_;
+    r_.assign(n, 0.0f);
+    g_.assign(n, 0.0f);
+    b_.assign(n, 0.0f);
+    a_.assign(n, 0.0f);
+}
+
+bool TileAccumulator::rectOpaque(int x0, int y0, int x1, int y1) const {
+    if (!terminates_) return false;
+    for (int by = y0 / kBlock; by <= y1 / kBlock; ++by)
+        for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx)
+            if (!(opaqueBlocks_ >> (by * blocksX_ + bx) & 1)) return false;
+    return true;
+}
+
+void TileAccumulator::updateOpacity(int x0, int y0, int x1, int y1) {
+    if (!terminates_) return;
+    for (int by = y0 / kBlock; by <= y1 / kBlock; ++by)
+        for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx) {
+            const std::uint64_t bit = std::uint64_t(1) << (by * blocksX_ + bx);
+            if (opaqueBlocks_ & bit) continue;
+            bool opaque = true;
+            const int ye = std::min(h_, (by + 1) * kBlock), xe = std::min(w_, (bx + 1) * kBlock);
+            for (int y = by * kBlock; y < ye && opaque; ++y)
+                for (int x = bx * kBlock; x < xe; ++x)
+                    if (a_[y * w_ + x] < threshold_) {
+                        opaque = false;
+                        break;
+                    }
+            if (opaque) opaqueBlocks_ |= bit;
+        }
+}
+
+void TileAccumulator::resolve(Image& image, int ox, int oy, RenderMode mode,
+                              const glm::vec4& bg) const {
+    for (int y = 0; y < h_; ++y)
+        for (int x = 0; x < w_; ++x) {
+            const int p = y * w_ + x;
+            glm::vec4& out = image.at(ox + x, oy + y);
+            if (mode == RenderMode::Dvr) {
+                const float t = 1.0f - a_[p];
+                out = glm::vec4(r_[p], g_[p], b_[p], a_[p]) + t * bg;
+            } else {
+                out = glm::vec4(r_[p], r_[p], r_[p], 1.0f);
+            }
+        }
+}
+
+}  // namespace splat

@@ -1,0 +1,76 @@
+#pragma once
+// The shared compositing stage. A sheet becomes one compositing sample per pixel; samples
+// are composited back-to-front with `over` (I = C + (1 - a) I) or front-to-back with
+// `under` (I += (1 - b) C; b += (1 - b) a), colour premultiplied. Each screen tile owns one
+// TileAccumulator, so no pixel is ever shared between threads.
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "splat/render.h"
+
+namespace splat {
+
+/// Opacity and premultiplied colour of a sheet pixel from its optical depth tau and
+/// emission E: a = 1 - exp(-tau), C = E a / tau, with the tau -> 0 limit C -> E.
+struct Sample {
+    float alpha, r, g, b;
+};
+inline Sample sampleFromOpticalDepth(float tau, float er, float eg, float eb) {
+    const float alpha = -std::expm1(-tau);
+    // a / tau = 1 - tau/2 + tau^2/6 - ... ; the series is exact to float for tau < 1e-3.
+    const float k = tau > 1e-3f ? alpha / tau : 1.0f - 0.5f * tau + tau * tau * (1.0f / 6.0f);
+    return {alpha, er * k, eg * k, eb * k};
+}
+
+/// Compositing state of one tile: premultiplied colour and opacity (b in DESIGN.md) for
+/// dvr; for mip the running maximum and for xray the running sum, both in r.
+class TileAccumulator {
+public:
+    TileAccumulator(int width, int height, CompositeOrder order, double earlyTermination);
+
+    int width() const { return w_; }
+    int height() const { return h_; }
+    int size() const { return w_ * h_; }
+
+    void composite(int p, const Sample& s) {
+        if (order_ == CompositeOrder::FrontToBack) {
+            const float t = 1.0f - a_[p];
+            r_[p] += t * s.r;
+            g_[p] += t * s.g;
+            b_[p] += t * s.b;
+            a_[p] += t * s.alpha;
+        } else {
+            const float t = 1.0f - s.alpha;
+            r_[p] = s.r + t * r_[p];
+            g_[p] = s.g + t * g_[p];
+            b_[p] = s.b + t * b_[p];
+            a_[p] = s.alpha + t * a_[p];
+        }
+    }
+    void maximum(int p, float v) { r_[p] = std::max(r_[p], v); }
+    void add(int p, float v) { r_[p] += v; }
+
+    /// Early termination (front-to-back dvr only): true when every pixel of the tile, or
+    /// of the 8x8 blocks overlapping the tile-local inclusive rectangle, is opaque.
+    bool terminates() const { return terminates_; }
+    bool allOpaque() const { return terminates_ && opaqueBlocks_ == allBlocks_; }
+    bool rectOpaque(int x0, int y0, int x1, int y1) const;
+    /// Re-evaluates the opaque blocks inside the tile-local rectangle (after a sheet).
+    void updateOpacity(int x0, int y0, int x1, int y1);
+
+    /// Writes the tile into `image` at (ox, oy): dvr composites over `background`; mip and
+    /// xray write the value to r, g, b with alpha 1.
+    void resolve(Image& image, int ox, int oy, RenderMode mode, const glm::vec4& background) const;
+
+private:
+    int w_, h_;
+    CompositeOrder order_;
+    bool terminates_;
+    float threshold_;
+    int blocksX_, blocksY_;
+    std::uint64_t opaqueBlocks_ = 0, allBlocks_ = 0;
+    std::vector<float> r_, g_, b_, a_;
+};
+
+}  // namespace splat

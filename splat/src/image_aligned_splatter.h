@@ -1,0 +1,10 @@
+#pragma once
+// The image-aligned sheet-buffer splatter (Mueller & Crawfis 1998).
+#include "projection.h"
+#include "splatter.h"
+
+namespace splat {
+
+Image renderImageAligned(const FrameInputs& in, const ProjectedSplats& proj, RenderStats* stats);
+
+}  // namespace splat

@@ -1,0 +1,31 @@
+#pragma once
+// Pipeline stage "project": splat centres to screen positions and depths, and the
+// elliptical footprint of each splat (one shared ellipse for orthographic views, a local
+// affine approximation per splat for perspective ones).
+#include <vector>
+
+#include "footprint/ellipse.h"
+#include "splat/camera.h"
+#include "splat/classify.h"
+
+namespace splat {
+
+struct ProjectedSplats {
+    std::vector<float> sx, sy;    ///< continuous pixel position of the centre
+    std::vector<float> depth;     ///< world depth along the view direction
+    bool perspective = false;
+    footprint::EllipticalFootprint shared;             ///< orthographic: all splats
+    std::vector<footprint::EllipticalFootprint> each;  ///< perspective: per splat
+    std::vector<float> depthPerRay;  ///< perspective: 1 / (ray direction . view) per splat
+    float depthExtent = 0;           ///< max |depth - centre depth| over a kernel, R |S view|
+
+    const footprint::EllipticalFootprint& ellipse(std::size_t s) const {
+        return perspective ? each[s] : shared;
+    }
+};
+
+/// Projects every splat. Screen units are pixels: x right, y down.
+ProjectedSplats projectSplats(const SplatList& splats, const Camera& camera,
+                              const glm::dvec3& spacing, double radius);
+
+}  // namespace splat

@@ -1,0 +1,49 @@
+// Shared pieces of the splatters (see splatter.h) and the transfer table.
+#include "splatter.h"
+
+#include <cmath>
+
+namespace splat {
+
+std::vector<std::uint32_t> orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys) {
+    std::vector<std::uint32_t> start(std::size_t(keys) + 1, 0);
+    for (std::uint32_t k : key) ++start[std::size_t(k) + 1];
+    for (std::size_t k = 0; k < keys; ++k) start[k + 1] += start[k];
+    std::vector<std::uint32_t> order(key.size());
+    for (std::size_t s = 0; s < key.size(); ++s) order[start[key[s]]++] = std::uint32_t(s);
+    return order;
+}
+
+std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& axis) {
+    if (!camera.perspective()) return {};
+    const int w = camera.width(), h = camera.height();
+    std::vector<float> scale(std::size_t(w) * h);
+    const double ref = std::abs(glm::dot(camera.view, axis));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const Ray r = camera.ray(x + 0.5, y + 0.5);
+            scale[std::size_t(y) * w + x] = float(ref / std::abs(glm::dot(r.dir, axis)));
+        }
+    return scale;
+}
+
+TransferTable::TransferTable(const TransferFunction& tf, int n) : n_(std::max(n, 2)) {
+    if (tf.points.empty()) {
+        v_.assign(std::size_t(n_) * 4, 0.0f);
+        return;
+    }
+    lo_ = tf.points.front().value;
+    const float hi = tf.points.back().value;
+    const float step = hi > lo_ ? (hi - lo_) / float(n_ - 1) : 1.0f;
+    inv_ = 1.0f / step;
+    v_.resize(std::size_t(n_) * 4);
+    for (int i = 0; i < n_; ++i) {
+        const glm::vec4 c = tf.sample(lo_ + step * float(i));
+        v_[std::size_t(i) * 4 + 0] = tf.extinctionFromOpacity(c.a);
+        v_[std::size_t(i) * 4 + 1] = c.r;
+        v_[std::size_t(i) * 4 + 2] = c.g;
+        v_[std::size_t(i) * 4 + 3] = c.b;
+    }
+}
+
+}  // namespace splat

@@ -1,0 +1,59 @@
+#pragma once
+// What both splatters share: the inputs of a frame, the visiting order of the splats, and
+// the driver that renders screen tiles in parallel (each tile owns its sheet buffer and
+// its compositing state) and assembles the image. The two splatters differ only in how
+// they cut kernels into sheets: axis_splatter.cpp and image_aligned_splatter.cpp.
+#include <cstdint>
+#include <vector>
+
+#include "footprint/footprint_table.h"
+#include "footprint/slab_table.h"
+#include "sheet_buffer.h"
+#include "splat/render.h"
+
+namespace splat {
+
+struct FrameInputs {
+    const Volume& volume;
+    const SplatList& splats;
+    const Camera& camera;
+    const RenderSettings& settings;  ///< transfer already resolved
+    const footprint::FootprintTable& table;
+    const footprint::SlabTable* slabs;  ///< image-aligned only
+    const TransferTable& transfer;
+};
+
+/// Per-tile counters, summed into RenderStats.
+struct TileCounters {
+    std::size_t footprintPixels = 0, sheets = 0, culled = 0;
+};
+
+/// Stable counting sort: splat indices ordered by key[s] in [0, keys).
+std::vector<std::uint32_t> orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys);
+
+/// Per-pixel ray direction factor for perspective views, 1 / |dir . axis| * |view . axis|
+/// style path-length scales; empty for orthographic views. `axis` is the sheet normal.
+std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& axis);
+
+/// The values a splat contributes to a sheet: (rho, e_r, e_g, e_b) or (density).
+template <int NCh>
+inline void splatValues(const SplatList& s, std::size_t i, float (&v)[NCh]) {
+    if constexpr (NCh == 4) {
+        v[0] = s.extinction[i];
+        v[1] = s.r[i];
+        v[2] = s.g[i];
+        v[3] = s.b[i];
+    } else {
+        v[0] = s.density[i];
+    }
+}
+
+/// Runs `tileFn(bins, tileIndex, sheet, accumulator, pathScaleOfTile, counters)` for
+/// every tile in parallel (settings.threads), then writes the tiles into the image.
+template <int NCh, class TileFn>
+Image renderTiles(const FrameInputs& in, const TileBins& bins, const std::vector<float>& pathScale,
+                  RenderStats* stats, TileFn&& tileFn);
+
+}  // namespace splat
+
+#include "splatter_impl.h"

@@ -1,0 +1,84 @@
+// Pipeline stage "bin to tiles" (see tile_binning.h).
+#include "tile_binning.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+namespace splat {
+
+PixelRect footprintPixels(const ProjectedSplats& p, std::size_t s, const TileGrid& grid) {
+    const auto& e = p.ellipse(s);
+    // Pixel centres px + 0.5 within [sx - halfWidth, sx + halfWidth].
+    const float fx0 = std::ceil(p.sx[s] - e.halfWidth - 0.5f);
+    const float fx1 = std::floor(p.sx[s] + e.halfWidth - 0.5f);
+    const float fy0 = std::ceil(p.sy[s] - e.halfHeight - 0.5f);
+    const float fy1 = std::floor(p.sy[s] + e.halfHeight - 0.5f);
+    PixelRect r;
+    r.x0 = int(std::max(fx0, 0.0f));
+    r.y0 = int(std::max(fy0, 0.0f));
+    r.x1 = int(std::min(fx1, float(grid.width - 1)));
+    r.y1 = int(std::min(fy1, float(grid.height - 1)));
+    if (!(fx1 >= 0.0f) || !(fy1 >= 0.0f) || !(fx0 <= float(grid.width - 1)) ||
+        !(fy0 <= float(grid.height - 1)) || (p.perspective && !(p.depth[s] > 0.0f)))
+        r = {1, 1, 0, 0};
+    return r;
+}
+
+namespace {
+// A fixed number of chunks (not one per thread) keeps the result identical for any
+// thread count.
+constexpr std::size_t kChunks = 64;
+
+template <class F>
+void forTilesOf(const PixelRect& r, const TileGrid& g, F&& f) {
+    const int tx0 = r.x0 / g.tileSize, tx1 = r.x1 / g.tileSize;
+    const int ty0 = r.y0 / g.tileSize, ty1 = r.y1 / g.tileSize;
+    for (int ty = ty0; ty <= ty1; ++ty)
+        for (int tx = tx0; tx <= tx1; ++tx) f(ty * g.tilesX + tx);
+}
+}  // namespace
+
+TileBins binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& order,
+                    const TileGrid& grid) {
+    TileBins bins;
+    bins.grid = grid;
+    const std::size_t tiles = std::size_t(grid.count());
+    const std::size_t n = order.size();
+    const std::size_t chunk = (n + kChunks - 1) / kChunks;
+    std::vector<std::uint32_t> counts(kChunks * tiles, 0);
+
+    tbb::parallel_for(std::size_t(0), kChunks, [&](std::size_t c) {
+        std::uint32_t* cnt = &counts[c * tiles];
+        const std::size_t e = std::min(n, (c + 1) * chunk);
+        for (std::size_t o = c * chunk; o < e; ++o) {
+            const PixelRect r = footprintPixels(p, order[o], grid);
+            if (!r.empty()) forTilesOf(r, grid, [&](int t) { ++cnt[t]; });
+        }
+    });
+    // Exclusive prefix sum, tile-major then chunk, so each tile's list keeps `order`.
+    bins.begin.assign(tiles + 1, 0);
+    std::uint64_t total = 0;
+    for (std::size_t t = 0; t < tiles; ++t) {
+        bins.begin[t] = std::uint32_t(total);
+        for (std::size_t c = 0; c < kChunks; ++c) {
+            const std::uint32_t k = counts[c * tiles + t];
+            counts[c * tiles + t] = std::uint32_t(total);
+            total += k;
+        }
+    }
+    bins.begin[tiles] = std::uint32_t(total);
+    bins.splats.resize(total);
+    tbb::parallel_for(std::size_t(0), kChunks, [&](std::size_t c) {
+        std::uint32_t* next = &counts[c * tiles];
+        const std::size_t e = std::min(n, (c + 1) * chunk);
+        for (std::size_t o = c * chunk; o < e; ++o) {
+            const PixelRect r = footprintPixels(p, order[o], grid);
+            if (!r.empty()) forTilesOf(r, grid, [&](int t) { bins.splats[next[t]++] = order[o]; });
+        }
+    });
+    return bins;
+}
+
+}  // namespace splat
