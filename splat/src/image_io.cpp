@@ -55,15 +55,40 @@ std::vector<float> displayValues(const Image& image, const WriteOptions& o) {
 
 }  // namespace
 
-void writeImage(const std::string& path, const Image& image, const WriteOptions& options) {
+void checkImagePath(const std::string& path) {
     const std::string ext = lowerExtension(path);
-    const bool isFloat = ext == ".exr" || ext == ".tif" || ext == ".tiff";
-    if (!isFloat && ext != ".png" && ext != ".gif" && ext != ".jpg" && ext != ".jpeg")
+    if (ext != ".exr" && ext != ".tif" && ext != ".tiff" && ext != ".png" && ext != ".gif" &&
+        ext != ".jpg" && ext != ".jpeg")
         throw Error(path + ": unsupported image type '" + ext + "' (use .png, .exr or .tif)");
-    if (image.width < 1 || image.height < 1) throw Error(path + ": image is empty");
     const fs::path parent = fs::path(path).parent_path();
     if (!parent.empty() && !fs::is_directory(parent))
         throw Error(path + ": folder '" + parent.string() + "' does not exist");
+    if (fs::is_directory(path)) throw Error(path + ": is a folder, not an image file name");
+}
+
+namespace {
+// Renames the finished temporary file over the target, or removes it and throws.
+void commitTemporary(const std::string& tmp, const std::string& path) {
+    std::error_code ec;
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        std::error_code ignored;
+        fs::remove(tmp, ignored);
+        throw Error(path + ": cannot write image (" + ec.message() + ")");
+    }
+}
+void failTemporary(const std::string& tmp, const std::string& path, const std::string& err) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw Error(path + ": cannot write image (" + (err.empty() ? "write failed" : err) + ")");
+}
+}  // namespace
+
+void writeImage(const std::string& path, const Image& image, const WriteOptions& options) {
+    checkImagePath(path);
+    const std::string ext = lowerExtension(path);
+    const bool isFloat = ext == ".exr" || ext == ".tif" || ext == ".tiff";
+    if (image.width < 1 || image.height < 1) throw Error(path + ": image is empty");
 
     const std::string tmp = temporaryName(path);
     auto out = OIIO::ImageOutput::create(tmp);
@@ -82,17 +107,39 @@ void writeImage(const std::string& path, const Image& image, const WriteOptions&
     }
     const std::string err = out->geterror();
     ok = out->close() && ok;
-    if (!ok) {
-        std::error_code ec;
-        fs::remove(tmp, ec);
-        throw Error(path + ": cannot write image (" + (err.empty() ? "write failed" : err) + ")");
+    if (!ok) failTemporary(tmp, path, err);
+    commitTemporary(tmp, path);
+}
+
+void writeAnimatedGif(const std::string& path, const std::vector<Image>& frames,
+                      const WriteOptions& options, int fps) {
+    checkImagePath(path);
+    if (lowerExtension(path) != ".gif") throw Error(path + ": an animation must be a .gif file");
+    if (frames.empty()) throw Error(path + ": no frames to write");
+    const std::string tmp = temporaryName(path);
+    auto out = OIIO::ImageOutput::create(tmp);
+    if (!out || !out->supports("multiimage"))
+        throw Error(path + ": this OpenImageIO cannot write animated GIFs");
+    OIIO::ImageSpec spec(frames[0].width, frames[0].height, 3, OIIO::TypeDesc::UINT8);
+    const int rate[2] = {std::max(fps, 1), 1};
+    spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
+    spec.attribute("oiio:Movie", 1);
+    spec.attribute("oiio:LoopCount", 0);
+    std::vector<OIIO::ImageSpec> specs(frames.size(), spec);
+    bool ok = out->open(tmp, int(specs.size()), specs.data());
+    for (std::size_t f = 0; ok && f < frames.size(); ++f) {
+        if (frames[f].width != spec.width || frames[f].height != spec.height) {
+            ok = false;
+            break;
+        }
+        if (f > 0) ok = out->open(tmp, spec, OIIO::ImageOutput::AppendSubimage);
+        const std::vector<float> v = displayValues(frames[f], options);
+        ok = ok && out->write_image(OIIO::TypeDesc::FLOAT, v.data());
     }
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw Error(path + ": cannot write image (" + ec.message() + ")");
-    }
+    const std::string err = out->geterror();
+    ok = out->close() && ok;
+    if (!ok) failTemporary(tmp, path, err);
+    commitTemporary(tmp, path);
 }
 
 Image readImage(const std::string& path) {

@@ -1,5 +1,42 @@
-// TEMPORARY placeholder while the renderer is written.
+// `splat render VOLUME [options] -o OUT.(png|exr|tif)`: one frame.
+#include <cstdio>
+#include <memory>
+
 #include "commands.h"
+#include "render_options.h"
+#include "splat/error.h"
+#include "splat/image_io.h"
+#include "volume_options.h"
+
 namespace splat::cli {
-void registerRender(CLI::App&) {}
+
+namespace {
+struct RenderCommand {
+    VolumeArgs volume;
+    RenderArgs render;
+    std::string output;
+};
+}  // namespace
+
+void registerRender(CLI::App& app) {
+    auto args = std::make_shared<RenderCommand>();
+    CLI::App* cmd = app.add_subcommand("render", "render one image of a volume");
+    addVolumeOptions(*cmd, args->volume);
+    addRenderOptions(*cmd, args->render);
+    cmd->add_option("-o,--output", args->output, "output image: .png (8-bit display), .exr or .tif (float)")
+        ->required();
+    cmd->callback([args] {
+        checkImagePath(args->output);
+        const RenderSettings settings = settingsFromArgs(args->render);
+        const Volume volume = loadVolumeFromArgs(args->volume);
+        const Renderer renderer(volume, settings);
+        RenderStats stats;
+        const Image image = renderer.render(&stats);
+        writeImage(args->output, image, displayOptions(args->render, settings, image));
+        std::printf("wrote %s: %dx%d, %s %s, %zu splats of %zu voxels, %.1f ms\n",
+                    args->output.c_str(), image.width, image.height, toString(settings.renderer),
+                    toString(settings.mode), stats.splats, stats.voxels, stats.milliseconds);
+    });
+}
+
 }  // namespace splat::cli

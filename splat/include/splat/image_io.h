@@ -2,6 +2,7 @@
 // Image files through OpenImageIO. Writes are atomic: a temporary file in the same folder,
 // renamed over the target only when complete.
 #include <string>
+#include <vector>
 
 #include "splat/image.h"
 
@@ -18,9 +19,17 @@ struct WriteOptions {
     float windowLow = 0.0f, windowHigh = 1.0f;
 };
 
-/// Writes `.png`, `.gif`, `.tif`/`.tiff` (8-bit display values, RGB) or `.exr` (float
-/// RGBA, values as computed). Throws splat::Error naming the file on failure.
+/// Writes `.png`, `.gif`, `.jpg` (8-bit display values, RGB) or `.exr`, `.tif`/`.tiff`
+/// (32-bit float RGBA, values as computed). Throws splat::Error naming the file on failure.
 void writeImage(const std::string& path, const Image& image, const WriteOptions& options = {});
+
+/// Checks before a long render that `path` can be written: a supported extension and an
+/// existing folder. Throws splat::Error naming the file otherwise.
+void checkImagePath(const std::string& path);
+
+/// Writes frames (all the same size) as a looping animated GIF, `fps` frames per second.
+void writeAnimatedGif(const std::string& path, const std::vector<Image>& frames,
+                      const WriteOptions& options, int fps = 12);
 
 /// Reads any image OpenImageIO can read as float RGBA (missing alpha becomes 1).
 Image readImage(const std::string& path);
