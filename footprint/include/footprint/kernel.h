@@ -27,7 +27,8 @@
 // Cubic B-spline: h(u) = N B3(u / s), B3(x) = 2/3 - x^2 + x^3/2 on [0, 1),
 // (2 - x)^3 / 6 on [1, 2), 0 beyond; support R = 2 s, N = 3 / (2 pi s^3). The radial
 // profile is not the separable tensor B-spline, so it is not an exact partition of unity
-// (ripple ~2.3e-2 for s = 1, see tests); it is smoother and has compact support by itself.
+// (ripple 2.1e-3 for s = 1, see tests); it has compact support by itself (no taper
+// needed), its footprint has no simple closed form (the tests use quadrature).
 //
 // References: L. Westover, "Footprint evaluation for volume rendering", SIGGRAPH 1990.
 #include <string>
