@@ -20,6 +20,7 @@ FootprintTable::FootprintTable(const Kernel& kernel, int resolution)
     // values_[resolution] = fp(R) = 0 and the guard stay 0.
     r2Max_ = float(R * R);
     invStep_ = float(resolution / (R * R));
+    tMax_ = float(resolution);
 }
 
 double FootprintTable::exact(double r) const {

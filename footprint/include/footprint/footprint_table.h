@@ -28,11 +28,12 @@ public:
     static constexpr int kDefaultResolution = 4096;
 
     /// fp at squared distance r2 (voxels^2), linearly interpolated in r^2; 0 for r2 >= R^2
-    /// (and for NaN); tiny negative r2 (rounding of a quadratic form) is treated as 0.
+    /// (and for NaN or +inf); negative r2 (rounding of a quadratic form) is treated as 0.
+    /// Branch-free (two clamps, two loads), so loops over it can vectorise.
     float lookup(float r2) const {
-        if (!(r2 < r2Max_)) return 0.0f;
-        r2 = r2 > 0.0f ? r2 : 0.0f;
-        const float t = r2 * invStep_;
+        float t = r2 * invStep_;
+        t = t < tMax_ ? t : tMax_;  // r2 >= R^2, +inf and NaN land on the zero at R
+        t = t > 0.0f ? t : 0.0f;
         const int i = int(t);
         const float f = t - float(i);
         const float v0 = values_[i], v1 = values_[i + 1];
@@ -47,10 +48,16 @@ public:
     float peak() const { return values_.empty() ? 0.0f : values_[0]; }
     std::size_t bytes() const { return values_.size() * sizeof(float); }
 
+    /// The raw table, for vectorised lookups that replicate lookup(): entry n holds fp at
+    /// r^2 = n / invStep(), entries up to resolution() + 1 are readable.
+    const float* data() const { return values_.data(); }
+    float invStep() const { return invStep_; }
+    float r2Max() const { return r2Max_; }
+
 private:
     Kernel kernel_;
     int resolution_ = 0;
-    float r2Max_ = 0, invStep_ = 0;
+    float r2Max_ = 0, invStep_ = 0, tMax_ = 0;
     std::vector<float> values_;  // resolution + 2 entries (a guard for i + 1)
 };
 
