@@ -20,7 +20,7 @@
 // stats->referenceStep is the finest spacing any ray needed.
 //
 //  - dvr: optical depth tau(t) by Simpson/quadratic interpolation of rho at every sample,
-//    I = int e exp(-tau) by Simpson; a ray stops once T < tolerance * 1e-3 (what follows
+//    I = int e exp(-tau) by Simpson; a ray stops once T < min(tolerance, 1e-3) * 1e-3 (what follows
 //    can change the pixel by at most that much, colours being <= 1).
 //  - xray: int f dt (world units). mip: max of the samples, polished by a golden-section
 //    search around the largest one (0 when the ray meets nothing).
@@ -381,7 +381,7 @@ private:
     glm::dvec4 integrate(const FieldGrid<C>& g, RayScratch<C>& sc, const glm::dvec3& p0,
                          const glm::dvec3& v, int level, double& depth) const {
         const RenderMode mode = settings_.mode;
-        const double cutoff = settings_.referenceTolerance * 1e-3;
+        const double cutoff = std::min(settings_.referenceTolerance, 1e-3) * 1e-3;
         double tau = 0, xray = 0, mip = 0;
         glm::dvec3 emission(0.0);
         double T = 1.0;
