@@ -1,1 +1,115 @@
-// TEMPORARY placeholder
+// The Volume type: validated allocation, statistics and the `splat info` description.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "splat/error.h"
+#include "splat/volume.h"
+
+namespace splat {
+
+Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::string& what) {
+    const char* axis = "xyz";
+    for (int a = 0; a < 3; ++a)
+        if (dims[a] < 1)
+            throw Error(what + ": invalid dimensions " + std::to_string(dims.x) + " x " +
+                        std::to_string(dims.y) + " x " + std::to_string(dims.z) + " (" +
+                        axis[a] + " must be at least 1)");
+    // Overflow-safe product: each factor is < 2^31, check before every multiplication.
+    std::uint64_t count = 1;
+    for (int a = 0; a < 3; ++a) {
+        if (count > kMaxVoxels / std::uint64_t(dims[a]))
+            throw Error(what + ": dimensions " + std::to_string(dims.x) + " x " +
+                        std::to_string(dims.y) + " x " + std::to_string(dims.z) +
+                        " are too large (more than 2^32 voxels)");
+        count *= std::uint64_t(dims[a]);
+    }
+    for (int a = 0; a < 3; ++a)
+        if (!std::isfinite(spacing[a]) || spacing[a] <= 0) {
+            std::ostringstream s;
+            s << what << ": invalid spacing " << spacing.x << ", " << spacing.y << ", "
+              << spacing.z << " (" << axis[a] << " must be finite and > 0)";
+            throw Error(s.str());
+        }
+    Volume v;
+    v.dims = dims;
+    v.spacing = spacing;
+    try {
+        v.data.assign(std::size_t(count), 0.0f);
+    } catch (const std::bad_alloc&) {
+        throw Error(what + ": not enough memory for " + std::to_string(count) + " voxels");
+    }
+    v.source = what;
+    return v;
+}
+
+VolumeStats volumeStats(const Volume& v, int bins) {
+    VolumeStats s;
+    bins = std::max(bins, 1);
+    s.histogram.assign(std::size_t(bins), 0);
+    if (v.data.empty()) return s;
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    double sum = 0;
+    std::size_t finite = 0;
+    for (float d : v.data) {
+        if (!std::isfinite(d)) continue;
+        lo = std::min(lo, d);
+        hi = std::max(hi, d);
+        sum += d;
+        ++finite;
+    }
+    if (finite == 0) return s;
+    s.minValue = lo;
+    s.maxValue = hi;
+    s.mean = sum / double(finite);
+    double range = double(hi) - double(lo);
+    for (float d : v.data) {
+        if (!std::isfinite(d)) continue;
+        int b = range > 0 ? int((double(d) - lo) / range * bins) : 0;
+        s.histogram[std::size_t(std::clamp(b, 0, bins - 1))]++;
+    }
+    return s;
+}
+
+std::string describeVolume(const Volume& v) {
+    std::ostringstream out;
+    char buf[256];
+    auto line = [&](const char* fmt, auto... args) {
+        std::snprintf(buf, sizeof buf, fmt, args...);
+        out << buf << '\n';
+    };
+    out << "source:      " << v.source << '\n';
+    line("dimensions:  %d x %d x %d (%zu voxels)", v.dims.x, v.dims.y, v.dims.z,
+         v.voxelCount());
+    line("spacing:     %g x %g x %g mm", v.spacing.x, v.spacing.y, v.spacing.z);
+    glm::dvec3 extent = glm::dvec3(v.dims) * v.spacing;
+    glm::dvec3 last = v.world(glm::dvec3(v.dims) - 1.0);
+    line("extent:      %g x %g x %g mm", extent.x, extent.y, extent.z);
+    line("origin:      (%g, %g, %g), last sample at (%g, %g, %g)", v.origin.x, v.origin.y,
+         v.origin.z, last.x, last.y, last.z);
+    VolumeStats s = volumeStats(v, 16);
+    line("values:      %g .. %g, mean %g", double(s.minValue), double(s.maxValue), s.mean);
+    std::size_t peak = 1;
+    for (std::size_t c : s.histogram) peak = std::max(peak, c);
+    out << "histogram:\n";
+    const int width = 40;
+    double binWidth = (double(s.maxValue) - s.minValue) / double(s.histogram.size());
+    for (std::size_t b = 0; b < s.histogram.size(); ++b) {
+        std::size_t c = s.histogram[b];
+        // Bars on a linear scale; any non-empty bin shows at least one mark.
+        int n = int(std::lround(double(c) / double(peak) * width));
+        if (c > 0 && n == 0) n = 1;
+        std::snprintf(buf, sizeof buf, "  [%10.4g, %10.4g%c %-*s %zu",
+                      s.minValue + b * binWidth, s.minValue + (b + 1) * binWidth,
+                      b + 1 == s.histogram.size() ? ']' : ')', width,
+                      std::string(std::size_t(n), '#').c_str(), c);
+        out << buf << '\n';
+    }
+    line("memory:      %.1f MiB", double(v.bytes()) / (1024.0 * 1024.0));
+    if (!v.note.empty()) out << "note:        " << v.note << '\n';
+    return out.str();
+}
+
+}  // namespace splat

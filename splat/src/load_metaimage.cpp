@@ -1,0 +1,185 @@
+// MetaImage (ITK/VTK): .mhd header with a separate data file, or .mha with the data
+// after the header ("ElementDataFile = LOCAL").
+//
+// The header is "Key = Value" lines; ElementDataFile is the last one. Keys we use:
+// NDims (2 or 3), DimSize, ElementType (MET_UCHAR, MET_CHAR, MET_SHORT, MET_USHORT,
+// MET_INT, MET_UINT, MET_FLOAT, MET_DOUBLE), ElementSpacing, Offset (alias Origin,
+// Position), TransformMatrix (row a = direction of index axis a, as ITK writes it),
+// BinaryDataByteOrderMSB (alias ElementByteOrderMSB), CompressedData (zlib stream),
+// HeaderSize (bytes to skip in the data file, -1 = data at the end).
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "splat/error.h"
+#include "volume_detail.h"
+
+namespace fs = std::filesystem;
+
+namespace splat::detail {
+namespace {
+
+std::optional<SampleType> metaType(const std::string& s) {
+    static const std::map<std::string, SampleType> types = {
+        {"MET_UCHAR", SampleType::U8},  {"MET_CHAR", SampleType::I8},
+        {"MET_USHORT", SampleType::U16}, {"MET_SHORT", SampleType::I16},
+        {"MET_UINT", SampleType::U32},  {"MET_INT", SampleType::I32},
+        {"MET_ULONG", SampleType::U32}, {"MET_LONG", SampleType::I32},
+        {"MET_FLOAT", SampleType::F32}, {"MET_DOUBLE", SampleType::F64}};
+    auto it = types.find(s);
+    if (it == types.end()) return std::nullopt;
+    return it->second;
+}
+
+std::vector<double> numbers(const std::string& s, const std::string& what, const std::string& key) {
+    std::istringstream in(s);
+    std::vector<double> out;
+    double d;
+    while (in >> d) out.push_back(d);
+    if (!in.eof()) throw Error(what + ": bad MetaImage " + key + " '" + s + "'");
+    return out;
+}
+
+bool isTrue(const std::string& s) {
+    std::string l = toLower(s);
+    return l == "true" || l == "1" || l == "yes";
+}
+
+}  // namespace
+
+Volume loadMetaImage(const fs::path& p) {
+    const std::string name = displayName(p);
+    std::vector<unsigned char> file = readFileBytes(p);
+
+    std::map<std::string, std::string> keys;
+    std::size_t pos = 0;
+    bool sawDataFile = false;
+    while (pos < file.size() && !sawDataFile) {
+        std::size_t eol = pos;
+        while (eol < file.size() && file[eol] != '\n') ++eol;
+        std::string line(file.begin() + std::ptrdiff_t(pos), file.begin() + std::ptrdiff_t(eol));
+        pos = std::min(eol + 1, file.size());
+        line = trim(line);
+        if (line.empty()) continue;
+        std::size_t eq = line.find('=');
+        if (eq == std::string::npos)
+            throw Error(name + ": bad MetaImage header line '" + line.substr(0, 60) + "'");
+        std::string key = toLower(trim(line.substr(0, eq)));
+        keys[key] = trim(line.substr(eq + 1));
+        if (key == "elementdatafile") sawDataFile = true;
+    }
+    auto get = [&](const char* k) {
+        auto it = keys.find(k);
+        return it == keys.end() ? std::string() : it->second;
+    };
+    if (!sawDataFile) throw Error(name + ": MetaImage header has no ElementDataFile");
+    if (get("ndims").empty() || get("dimsize").empty() || get("elementtype").empty())
+        throw Error(name + ": MetaImage header lacks NDims, DimSize or ElementType");
+
+    int ndims = std::atoi(get("ndims").c_str());
+    if (ndims != 2 && ndims != 3)
+        throw Error(name + ": MetaImage NDims " + get("ndims") + " not supported (need 2 or 3)");
+    if (!get("elementnumberofchannels").empty() && std::atoi(get("elementnumberofchannels").c_str()) != 1)
+        throw Error(name + ": MetaImage with " + get("elementnumberofchannels") +
+                    " channels per voxel not supported (need scalar data)");
+    auto type = metaType(get("elementtype"));
+    if (!type) throw Error(name + ": unsupported MetaImage ElementType '" + get("elementtype") + "'");
+    std::vector<double> size = numbers(get("dimsize"), name, "DimSize");
+    if (int(size.size()) != ndims)
+        throw Error(name + ": DimSize has " + std::to_string(size.size()) + " entries, NDims is " +
+                    std::to_string(ndims));
+    glm::ivec3 dims(1);
+    for (int a = 0; a < ndims; ++a) {
+        if (size[a] < 1 || size[a] > 2147483647.0 || size[a] != std::floor(size[a]))
+            throw Error(name + ": invalid MetaImage DimSize '" + get("dimsize") + "'");
+        dims[a] = int(size[a]);
+    }
+    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
+
+    // Geometry.
+    glm::dvec3 spacing(1.0), origin(0.0);
+    std::string sp = get("elementspacing");
+    if (sp.empty()) sp = get("elementsize");
+    if (!sp.empty()) {
+        auto s = numbers(sp, name, "ElementSpacing");
+        for (int a = 0; a < ndims && a < int(s.size()); ++a) spacing[a] = s[a];
+    }
+    for (const char* k : {"offset", "origin", "position"})
+        if (!get(k).empty()) {
+            auto o = numbers(get(k), name, k);
+            for (int a = 0; a < ndims && a < int(o.size()); ++a) origin[a] = o[a];
+            break;
+        }
+    glm::dmat3 dirs(1.0);
+    for (const char* k : {"transformmatrix", "rotation", "orientation"})
+        if (!get(k).empty()) {
+            auto m = numbers(get(k), name, k);
+            if (int(m.size()) == ndims * ndims)
+                for (int a = 0; a < ndims; ++a)
+                    for (int r = 0; r < ndims; ++r) dirs[a][r] = m[std::size_t(a * ndims + r)];
+            break;
+        }
+    for (int a = 0; a < 3; ++a)
+        if (!std::isfinite(spacing[a]) || spacing[a] <= 0)
+            throw Error(name + ": invalid MetaImage ElementSpacing '" + sp + "'");
+    glm::dmat3 M;
+    for (int a = 0; a < 3; ++a) M[a] = dirs[a] * spacing[a];
+
+    // Data.
+    std::string byteOrder = get("binarydatabyteordermsb");
+    if (byteOrder.empty()) byteOrder = get("elementbyteordermsb");
+    bool bigEndian = isTrue(byteOrder);
+    bool compressed = isTrue(get("compresseddata"));
+    std::string dataFile = get("elementdatafile");
+    std::vector<unsigned char> separate;
+    const unsigned char* data;
+    std::size_t dataSize;
+    std::string dataName = name;
+    if (toLower(dataFile) == "local") {
+        data = file.data() + pos;
+        dataSize = file.size() - pos;
+    } else {
+        if (toLower(dataFile).rfind("list", 0) == 0 || dataFile.find('%') != std::string::npos)
+            throw Error(name + ": multi-file MetaImage data ('" + dataFile + "') is not supported");
+        fs::path dp = fs::path(dataFile).is_absolute() ? fs::path(dataFile) : p.parent_path() / dataFile;
+        dataName = displayName(dp);
+        std::error_code ec;
+        if (!fs::exists(dp, ec)) throw Error(name + ": data file " + dataName + " does not exist");
+        separate = readFileBytes(dp);
+        data = separate.data();
+        dataSize = separate.size();
+        long long headerSize = get("headersize").empty() ? 0 : std::atoll(get("headersize").c_str());
+        if (headerSize > 0 && !compressed) {
+            checkDataLength(std::size_t(headerSize), dataSize, dataName, false);
+            data += headerSize;
+            dataSize -= std::size_t(headerSize);
+        } else if (headerSize == -1 && !compressed) {
+            std::size_t need = v.voxelCount() * sampleSize(*type);
+            checkDataLength(need, dataSize, dataName, false);
+            data += dataSize - need;
+            dataSize = need;
+        }
+    }
+    const std::size_t expected = v.voxelCount() * sampleSize(*type);
+    std::vector<unsigned char> inflated;
+    if (compressed) {
+        std::string csize = get("compresseddatasize");
+        if (!csize.empty()) {
+            std::size_t n = std::size_t(std::atoll(csize.c_str()));
+            checkDataLength(n, dataSize, dataName, false);
+            dataSize = n;
+        }
+        inflated = inflateAll(data, dataSize, dataName);
+        data = inflated.data();
+        dataSize = inflated.size();
+    }
+    checkDataLength(expected, dataSize, dataName, true);
+    decodeSamples(data, v.voxelCount(), *type, bigEndian, v.data.data());
+
+    v.source = std::string("MetaImage ") + sampleTypeName(*type) +
+               (compressed ? " compressed" : "") + " (" + p.filename().string() + ")";
+    applyOrientation(v, M, origin, "TransformMatrix");
+    return v;
+}
+
+}  // namespace splat::detail

@@ -1,0 +1,219 @@
+// NRRD (.nrrd with attached data, .nhdr with a detached data file).
+//
+// Format (http://teem.sourceforge.net/nrrd/format.html): a first line "NRRD000N", then
+// "field: value" lines ("#" starts a comment, "key:=value" is a key/value pair we
+// ignore). In a .nrrd the header ends at the first blank line and the data follows; a
+// .nhdr names its data with "data file:" (relative to the header's folder). Fields we
+// use: type, dimension (2 or 3), sizes, encoding (raw, gzip/gz, text/txt/ascii),
+// endian, spacings or space directions, space origin, byte skip, line skip.
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "splat/error.h"
+#include "volume_detail.h"
+
+namespace fs = std::filesystem;
+
+namespace splat::detail {
+namespace {
+
+// Parses "(a,b,c)" vectors separated by spaces; "none" entries become nullopt.
+std::vector<std::optional<glm::dvec3>> parseVectors(const std::string& s,
+                                                    const std::string& what) {
+    std::vector<std::optional<glm::dvec3>> out;
+    std::size_t i = 0;
+    while (i < s.size()) {
+        if (std::isspace(static_cast<unsigned char>(s[i]))) { ++i; continue; }
+        if (s.compare(i, 4, "none") == 0) { out.push_back(std::nullopt); i += 4; continue; }
+        if (s[i] != '(') throw Error(what + ": cannot parse vector list '" + s + "'");
+        std::size_t close = s.find(')', i);
+        if (close == std::string::npos) throw Error(what + ": cannot parse vector list '" + s + "'");
+        std::string inner = s.substr(i + 1, close - i - 1);
+        for (char& c : inner) if (c == ',') c = ' ';
+        std::istringstream in(inner);
+        glm::dvec3 v;
+        if (!(in >> v.x >> v.y >> v.z)) throw Error(what + ": cannot parse vector '" + inner + "'");
+        out.push_back(v);
+        i = close + 1;
+    }
+    return out;
+}
+
+std::vector<double> parseNumbers(const std::string& s, const std::string& what,
+                                 const std::string& field) {
+    std::istringstream in(s);
+    std::vector<double> out;
+    std::string word;
+    while (in >> word) {
+        std::string w = toLower(word);
+        if (w == "nan") { out.push_back(std::nan("")); continue; }
+        char* end = nullptr;
+        double d = std::strtod(word.c_str(), &end);
+        if (end == word.c_str() || *end) throw Error(what + ": bad " + field + " '" + s + "'");
+        out.push_back(d);
+    }
+    return out;
+}
+
+}  // namespace
+
+Volume loadNrrd(const fs::path& p) {
+    const std::string name = displayName(p);
+    std::vector<unsigned char> file = readFileBytes(p);
+    const std::string magic(file.begin(), file.begin() + std::min<std::size_t>(file.size(), 7));
+    if (magic.size() < 7 || magic.compare(0, 4, "NRRD") != 0)
+        throw Error(name + ": not a NRRD file (missing NRRD000N magic line)");
+
+    // Header lines up to the first blank line (or the end of a detached header).
+    std::map<std::string, std::string> fields;
+    std::size_t pos = 0;
+    bool first = true, blankSeen = false;
+    while (pos < file.size()) {
+        std::size_t eol = pos;
+        while (eol < file.size() && file[eol] != '\n') ++eol;
+        std::string line(file.begin() + std::ptrdiff_t(pos), file.begin() + std::ptrdiff_t(eol));
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        pos = std::min(eol + 1, file.size());
+        if (first) { first = false; continue; }
+        if (line.empty()) { blankSeen = true; break; }
+        if (line[0] == '#') continue;
+        if (line.find(":=") != std::string::npos) continue;  // key/value pair
+        std::size_t colon = line.find(": ");
+        if (colon == std::string::npos) throw Error(name + ": bad NRRD header line '" + line + "'");
+        fields[toLower(trim(line.substr(0, colon)))] = trim(line.substr(colon + 2));
+    }
+    auto field = [&](const char* key) -> std::string {
+        auto it = fields.find(key);
+        return it == fields.end() ? std::string() : it->second;
+    };
+    auto required = [&](const char* key) {
+        std::string v = field(key);
+        if (v.empty()) throw Error(name + ": NRRD header has no '" + key + "' field");
+        return v;
+    };
+
+    auto type = parseSampleType(required("type"));
+    if (!type) throw Error(name + ": unsupported NRRD type '" + field("type") + "'");
+    int dimension = std::atoi(required("dimension").c_str());
+    if (dimension != 2 && dimension != 3)
+        throw Error(name + ": NRRD dimension " + field("dimension") +
+                    " not supported (need a 2D or 3D scalar volume)");
+    std::vector<double> sizes = parseNumbers(required("sizes"), name, "sizes");
+    if (int(sizes.size()) != dimension)
+        throw Error(name + ": 'sizes' has " + std::to_string(sizes.size()) + " entries, " +
+                    "dimension is " + std::to_string(dimension));
+    glm::ivec3 dims(1);
+    for (int a = 0; a < dimension; ++a) {
+        if (sizes[a] < 1 || sizes[a] > 2147483647.0 || sizes[a] != std::floor(sizes[a]))
+            throw Error(name + ": invalid NRRD sizes '" + field("sizes") + "'");
+        dims[a] = int(sizes[a]);
+    }
+    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
+
+    // Geometry: space directions (with optional space origin) or per-axis spacings.
+    glm::dmat3 M(1.0);
+    glm::dvec3 t(0.0);
+    bool oriented = false;
+    if (!field("space directions").empty()) {
+        auto dirs = parseVectors(field("space directions"), name);
+        if (int(dirs.size()) != dimension)
+            throw Error(name + ": 'space directions' has " + std::to_string(dirs.size()) +
+                        " entries, dimension is " + std::to_string(dimension));
+        for (int a = 0; a < dimension; ++a) {
+            if (!dirs[a]) throw Error(name + ": 'space directions' is 'none' for a spatial axis");
+            M[a] = *dirs[a];
+        }
+        if (dimension == 2) M[2] = glm::normalize(glm::cross(M[0], M[1])) * glm::length(M[0]);
+        oriented = true;
+    } else if (!field("spacings").empty()) {
+        auto sp = parseNumbers(field("spacings"), name, "spacings");
+        for (int a = 0; a < dimension && a < int(sp.size()); ++a)
+            if (std::isfinite(sp[a])) M[a][a] = std::abs(sp[a]);
+    }
+    if (!field("space origin").empty()) {
+        auto o = parseVectors(field("space origin"), name);
+        if (o.size() == 1 && o[0]) t = *o[0];
+    }
+
+    // Where the data is.
+    std::string dataFile = field("data file");
+    if (dataFile.empty()) dataFile = field("datafile");
+    std::vector<unsigned char> detached;
+    const unsigned char* data = nullptr;
+    std::size_t dataSize = 0;
+    std::string dataName = name;
+    if (!dataFile.empty()) {
+        if (dataFile.rfind("LIST", 0) == 0 || dataFile.find('%') != std::string::npos)
+            throw Error(name + ": multi-file NRRD data ('data file: " + dataFile +
+                        "') is not supported");
+        fs::path dp = fs::path(dataFile).is_absolute() ? fs::path(dataFile)
+                                                       : p.parent_path() / dataFile;
+        dataName = displayName(dp);
+        std::error_code ec;
+        if (!fs::exists(dp, ec))
+            throw Error(name + ": data file " + dataName + " does not exist");
+        detached = readFileBytes(dp);
+        data = detached.data();
+        dataSize = detached.size();
+        // line skip: lines of text to skip in the data file before byte skip.
+        int lineSkip = std::atoi(field("line skip").c_str());
+        std::size_t skipPos = 0;
+        for (int l = 0; l < lineSkip && skipPos < dataSize; ++l) {
+            while (skipPos < dataSize && data[skipPos] != '\n') ++skipPos;
+            if (skipPos < dataSize) ++skipPos;
+        }
+        data += skipPos;
+        dataSize -= skipPos;
+    } else {
+        if (!blankSeen) throw Error(name + ": NRRD header has no data (no blank line, no 'data file')");
+        data = file.data() + pos;
+        dataSize = file.size() - pos;
+    }
+
+    std::string encoding = toLower(field("encoding"));
+    if (encoding.empty()) encoding = "raw";
+    std::string endian = toLower(field("endian"));
+    bool bigEndian = endian == "big";
+    if (!endian.empty() && endian != "big" && endian != "little")
+        throw Error(name + ": bad NRRD endian '" + endian + "'");
+    const std::size_t expected = v.voxelCount() * sampleSize(*type);
+    long long byteSkip = field("byte skip").empty() ? 0 : std::atoll(field("byte skip").c_str());
+
+    std::vector<unsigned char> inflated;
+    if (encoding == "gzip" || encoding == "gz") {
+        if (byteSkip > 0) {
+            if (std::size_t(byteSkip) > dataSize) checkDataLength(std::size_t(byteSkip), dataSize, dataName, false);
+            data += byteSkip;
+            dataSize -= std::size_t(byteSkip);
+        }
+        inflated = inflateAll(data, dataSize, dataName);
+        checkDataLength(expected, inflated.size(), dataName, true);
+        decodeSamples(inflated.data(), v.voxelCount(), *type, bigEndian, v.data.data());
+    } else if (encoding == "raw") {
+        if (byteSkip == -1) {
+            // "-1": the data is the last `expected` bytes of the file.
+            checkDataLength(expected, dataSize, dataName, false);
+            data += dataSize - expected;
+            dataSize = expected;
+        } else if (byteSkip > 0) {
+            checkDataLength(std::size_t(byteSkip) + expected, dataSize, dataName, false);
+            data += byteSkip;
+            dataSize -= std::size_t(byteSkip);
+        }
+        checkDataLength(expected, dataSize, dataName, true);
+        decodeSamples(data, v.voxelCount(), *type, bigEndian, v.data.data());
+    } else if (encoding == "text" || encoding == "txt" || encoding == "ascii") {
+        decodeText(std::string(data, data + dataSize), v.voxelCount(), v.data.data(), dataName);
+    } else {
+        throw Error(name + ": unsupported NRRD encoding '" + encoding +
+                    "' (supported: raw, gzip, text)");
+    }
+
+    v.source = std::string("NRRD ") + sampleTypeName(*type) + " " + encoding + " (" +
+               p.filename().string() + ")";
+    applyOrientation(v, M, t, oriented ? "space directions" : "spacings");
+    return v;
+}
+
+}  // namespace splat::detail

@@ -1,0 +1,56 @@
+// Headerless .raw files: the caller says dims/type/spacing/byte order (RawOptions), or
+// the name does, as in skull_256x256x256_uint8.raw ("NAME_XxYxZ_TYPE.raw").
+#include <regex>
+
+#include "splat/error.h"
+#include "volume_detail.h"
+
+namespace fs = std::filesystem;
+
+namespace splat::detail {
+
+Volume loadRaw(const fs::path& p, const RawOptions& options) {
+    const std::string name = displayName(p);
+    std::error_code ec;
+    if (!fs::exists(p, ec)) throw Error(name + ": no such file");
+
+    std::optional<glm::ivec3> dims = options.dims;
+    std::string typeName = options.type;
+    // Name convention: ..._<X>x<Y>x<Z>_<type>.raw (type may be omitted if given).
+    static const std::regex pattern(R"(.*?(\d+)x(\d+)x(\d+)(?:_([A-Za-z0-9]+))?\.raw$)",
+                                    std::regex::icase);
+    std::smatch m;
+    const std::string file = p.filename().string();
+    if (std::regex_match(file, m, pattern)) {
+        if (!dims) {
+            glm::ivec3 d;
+            for (int a = 0; a < 3; ++a) {
+                long long n = std::atoll(m[std::size_t(a + 1)].str().c_str());
+                if (n > 2147483647LL) throw Error(name + ": dimension " + m[std::size_t(a + 1)].str() + " too large");
+                d[a] = int(n);
+            }
+            dims = d;
+        }
+        if (typeName.empty() && m[4].matched) typeName = m[4].str();
+    }
+    if (!dims || typeName.empty())
+        throw Error(name + ": raw data needs --dims and --type (or a name like "
+                           "skull_256x256x256_uint8.raw)");
+    auto type = parseSampleType(typeName);
+    if (!type)
+        throw Error(name + ": unsupported sample type '" + typeName +
+                    "' (uint8, int8, uint16, int16, uint32, int32, float32, float64)");
+    Volume v = makeVolume(*dims, options.spacing.value_or(glm::dvec3(1.0)), name);
+
+    std::vector<unsigned char> bytes = readFileBytes(p);
+    const std::size_t expected = options.headerBytes + v.voxelCount() * sampleSize(*type);
+    checkDataLength(expected, bytes.size(), name, true);
+    decodeSamples(bytes.data() + options.headerBytes, v.voxelCount(), *type, options.bigEndian,
+                  v.data.data());
+    v.source = std::string("raw ") + sampleTypeName(*type) +
+               (sampleSize(*type) > 1 ? (options.bigEndian ? " big-endian" : " little-endian") : "") +
+               " (" + file + ")";
+    return v;
+}
+
+}  // namespace splat::detail

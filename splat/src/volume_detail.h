@@ -1,0 +1,104 @@
+#pragma once
+// Private helpers shared by the volume loaders and writers (not installed).
+//
+// Every loader does the same three things once it has parsed its header: read the
+// sample bytes (possibly gzip/zlib-compressed), decode typed samples of either byte
+// order into float, and turn the file's index-to-world matrix into the axis-aligned
+// model of DESIGN.md (flips and permutations applied to the data, oblique rest
+// reported). Those pieces live here so no loader has its own copy.
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "splat/volume.h"
+#include "splat/volume_io.h"
+
+namespace splat::detail {
+
+// ---- sample types ----------------------------------------------------------------
+
+enum class SampleType { U8, I8, U16, I16, U32, I32, F32, F64 };
+
+std::size_t sampleSize(SampleType t);
+/// Canonical name: uint8, int8, uint16, int16, uint32, int32, float32, float64.
+const char* sampleTypeName(SampleType t);
+/// Parses a type name: canonical names, short forms (u8, i16, f32), C names (uchar,
+/// short, float, double) and the NRRD spellings ("unsigned char", "signed short int",
+/// "int16_t", ...). Returns nullopt for anything else.
+std::optional<SampleType> parseSampleType(const std::string& name);
+
+/// Decodes `count` samples of type `t` stored with the given byte order from `bytes`
+/// into `out[0..count)`. `bytes` must hold count * sampleSize(t) bytes.
+void decodeSamples(const unsigned char* bytes, std::size_t count, SampleType t,
+                   bool bigEndian, float* out);
+
+/// Parses ASCII numbers (whitespace separated) into `out[0..count)`; throws naming
+/// `what` if fewer numbers are present or one does not parse.
+void decodeText(const std::string& text, std::size_t count, float* out,
+                const std::string& what);
+
+// ---- files -----------------------------------------------------------------------
+
+/// Name used in error messages: the path as given by the user.
+std::string displayName(const std::filesystem::path& p);
+/// Whole file into memory; throws "FILE: no such file" / "FILE: cannot read".
+std::vector<unsigned char> readFileBytes(const std::filesystem::path& p);
+/// Inflates gzip or zlib data (auto-detected); throws "WHAT: corrupt gzip data ..."
+std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t size,
+                                      const std::string& what);
+/// Lower-case extension including double ones we know (".nii.gz").
+std::string lowerExtension(const std::filesystem::path& p);
+std::string toLower(std::string s);
+std::string trim(const std::string& s);
+
+/// A hidden temporary name next to `target`: ".STEM.tmpNNN EXT" (STEM defaults to
+/// target's file name), for writing before an atomic rename.
+std::filesystem::path temporarySibling(const std::filesystem::path& target,
+                                       const std::string& stem, const std::string& ext);
+/// Writes `bytes` to `path` atomically: a temporary file in the same folder, then
+/// std::filesystem::rename. The temporary is removed on failure.
+void writeFileAtomic(const std::filesystem::path& path, const void* bytes, std::size_t size);
+
+// ---- orientation -----------------------------------------------------------------
+
+/// Applies a file's index-to-world affine x = t + M p (columns of M = world step of one
+/// index along each file axis) to `v`, whose data and dims are in file index order.
+/// The signed axis permutation closest to M is applied to the data so that world axis
+/// w runs along index axis w in the positive direction; spacing becomes the column
+/// norms in their new places and origin the world position of the new first sample.
+/// A residual rotation larger than ~1e-3 is described in v.note (never dropped
+/// silently). `what` names the matrix's origin ("sform", "space directions").
+void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
+                      const std::string& what);
+
+// ---- the loaders (one per file) --------------------------------------------------
+
+Volume loadNifti(const std::filesystem::path& p);
+Volume loadNrrd(const std::filesystem::path& p);
+Volume loadMetaImage(const std::filesystem::path& p);
+Volume loadRaw(const std::filesystem::path& p, const RawOptions& options);
+Volume loadSliceFolder(const std::filesystem::path& dir);
+Volume loadDicomFolder(const std::filesystem::path& dir,
+                       const std::vector<std::filesystem::path>& files);
+
+/// Reads one 2D image file through OpenImageIO into `out` (width*height floats, the
+/// first channel or the luminance of RGB, native value range: 0..255 for 8-bit).
+/// Returns the image size; throws naming the file.
+glm::ivec2 readImageSlice(const std::filesystem::path& p, std::vector<float>& out,
+                          std::string* formatName = nullptr);
+
+/// "slice2" < "slice10": compares runs of digits by value.
+bool naturalLess(const std::string& a, const std::string& b);
+
+/// Checks a sample count against the available bytes; throws
+/// "WHAT: truncated data: expected N bytes, found M" (or "... file holds M bytes, more
+/// than the N the header describes" when there is too much data and `exact`).
+void checkDataLength(std::size_t expected, std::size_t found, const std::string& what,
+                     bool exact);
+
+}  // namespace splat::detail

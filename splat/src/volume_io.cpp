@@ -1,0 +1,111 @@
+// loadVolume: picks the loader for a VOLUME argument (synthetic:, folder, extension,
+// or the file's magic bytes) and applies the NaN/Inf policy to every loaded volume.
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include "splat/error.h"
+#include "splat/synthetic.h"
+#include "splat/volume_io.h"
+#include "volume_detail.h"
+
+namespace fs = std::filesystem;
+
+namespace splat {
+namespace {
+
+Volume loadSynthetic(const std::string& spec) {
+    // synthetic:NAME[:N]
+    std::string rest = spec.substr(std::strlen("synthetic:"));
+    std::string name = rest;
+    int n = 0;
+    std::size_t colon = rest.find(':');
+    if (colon != std::string::npos) {
+        name = rest.substr(0, colon);
+        std::string num = rest.substr(colon + 1);
+        char* end = nullptr;
+        long value = std::strtol(num.c_str(), &end, 10);
+        if (num.empty() || *end || value < 1 || value > 2048)
+            throw Error(spec + ": size must be an integer between 1 and 2048");
+        n = int(value);
+    } else {
+        n = syntheticDefaultSize(name);
+    }
+    return makeSynthetic(name, n);
+}
+
+// Content sniffing for files whose extension says nothing.
+std::string sniff(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    char head[352] = {};
+    in.read(head, sizeof head);
+    std::size_t got = std::size_t(in.gcount());
+    if (got >= 4 && std::string(head, 4) == "NRRD") return ".nrrd";
+    if (got >= 348 && (std::string(head + 344, 4) == std::string("n+1\0", 4))) return ".nii";
+    std::string text(head, got);
+    if (text.find("ObjectType") != std::string::npos || text.rfind("NDims", 0) == 0) return ".mha";
+    return "";
+}
+
+void applyNonFinitePolicy(Volume& v, NonFinitePolicy policy, const std::string& what) {
+    std::size_t count = 0, first = 0;
+    for (std::size_t i = 0; i < v.data.size(); ++i)
+        if (!std::isfinite(v.data[i])) {
+            if (count++ == 0) first = i;
+            if (policy == NonFinitePolicy::Zero) v.data[i] = 0.0f;
+        }
+    if (count == 0) return;
+    if (policy == NonFinitePolicy::Error) {
+        std::size_t nx = std::size_t(v.dims.x), ny = std::size_t(v.dims.y);
+        throw Error(what + ": " + std::to_string(count) + " NaN/Inf samples (first at voxel " +
+                    std::to_string(first % nx) + "," + std::to_string(first / nx % ny) + "," +
+                    std::to_string(first / (nx * ny)) +
+                    "); use --nan-policy zero to replace them by 0");
+    }
+    if (!v.note.empty()) v.note += "; ";
+    v.note += std::to_string(count) + " NaN/Inf samples replaced by 0";
+}
+
+Volume loadByType(const fs::path& p, const std::string& ext, const LoadOptions& options) {
+    if (ext == ".nii" || ext == ".nii.gz") return detail::loadNifti(p);
+    if (ext == ".nrrd" || ext == ".nhdr") return detail::loadNrrd(p);
+    if (ext == ".mhd" || ext == ".mha") return detail::loadMetaImage(p);
+    if (ext == ".raw") return detail::loadRaw(p, options.raw);
+    if (ext == ".dcm" || ext == ".dicom") return detail::loadDicomFolder(p.parent_path(), {p});
+    if (ext == ".png" || ext == ".tif" || ext == ".tiff")
+        throw Error(detail::displayName(p) + ": a single 2D image; give the folder of slices instead");
+    return Volume{};
+}
+
+}  // namespace
+
+Volume loadVolume(const std::string& spec, const LoadOptions& options) {
+    Volume v;
+    if (spec.rfind("synthetic:", 0) == 0) {
+        v = loadSynthetic(spec);
+    } else {
+        if (spec.empty()) throw Error("empty VOLUME argument");
+        fs::path p(spec);
+        std::error_code ec;
+        fs::file_status st = fs::status(p, ec);
+        if (!fs::exists(st)) throw Error(spec + ": no such file or folder");
+        if (fs::is_directory(st)) {
+            v = detail::loadSliceFolder(p);
+        } else {
+            std::string ext = detail::lowerExtension(p);
+            v = loadByType(p, ext, options);
+            if (v.data.empty()) {
+                std::string guess = sniff(p);
+                if (guess.empty() || guess == ext)
+                    throw Error(spec + ": unknown file type '" + p.extension().string() +
+                                "' (expected .nii, .nii.gz, .nrrd, .nhdr, .mhd, .mha, .raw, a "
+                                "folder of slices or synthetic:NAME)");
+                v = loadByType(p, guess, options);
+            }
+        }
+    }
+    applyNonFinitePolicy(v, options.nonFinite, spec);
+    return v;
+}
+
+}  // namespace splat

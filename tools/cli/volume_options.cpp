@@ -1,0 +1,82 @@
+// VOLUME and the options that say how to read it, shared by every subcommand.
+#include "volume_options.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "splat/error.h"
+
+namespace splat::cli {
+namespace {
+
+// "256x256x128" (also "256,256,128") -> dims; every entry a positive integer.
+glm::ivec3 parseDims(const std::string& s) {
+    std::string t = s;
+    for (char& c : t)
+        if (c == 'x' || c == 'X' || c == ',') c = ' ';
+    std::istringstream in(t);
+    long long v[3];
+    std::string rest;
+    if (!(in >> v[0] >> v[1] >> v[2]) || (in >> rest))
+        throw Error("--dims '" + s + "': expected XxYxZ, e.g. 256x256x128");
+    for (long long d : v)
+        if (d < 1 || d > 2147483647LL)
+            throw Error("--dims '" + s + "': every dimension must be between 1 and 2^31-1");
+    return {int(v[0]), int(v[1]), int(v[2])};
+}
+
+glm::dvec3 parseSpacing(const std::string& s) {
+    std::string t = s;
+    for (char& c : t)
+        if (c == ',' || c == 'x') c = ' ';
+    std::istringstream in(t);
+    double v[3];
+    std::string rest;
+    if (!(in >> v[0]) ) throw Error("--spacing '" + s + "': expected X,Y,Z, e.g. 1,1,2.5");
+    if (!(in >> v[1])) {
+        v[1] = v[2] = v[0];  // one number: isotropic
+    } else if (!(in >> v[2]) || (in >> rest)) {
+        throw Error("--spacing '" + s + "': expected X,Y,Z, e.g. 1,1,2.5");
+    }
+    for (double d : v)
+        if (!std::isfinite(d) || d <= 0)
+            throw Error("--spacing '" + s + "': spacings must be finite and > 0");
+    return {v[0], v[1], v[2]};
+}
+
+}  // namespace
+
+void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
+    cmd.add_option("VOLUME", args.spec,
+                   "volume file (.nii .nii.gz .nrrd .nhdr .mhd .mha .raw), folder of slices "
+                   "or DICOM files, or synthetic:NAME[:N] (phantom, blob, cube, sphere, "
+                   "marschner-lobb)")
+        ->required();
+    cmd.add_option("--dims", args.dims, "raw data: dimensions XxYxZ, e.g. 256x256x128");
+    cmd.add_option("--type", args.type,
+                   "raw data: sample type (uint8 int8 uint16 int16 uint32 int32 float32 float64)");
+    cmd.add_option("--spacing", args.spacing, "raw data: spacing X,Y,Z (default 1,1,1)");
+    cmd.add_flag("--big-endian", args.bigEndian, "raw data: samples are big-endian");
+    cmd.add_option("--header-bytes", args.headerBytes, "raw data: bytes to skip at the start");
+    cmd.add_option("--nan-policy", args.nanPolicy,
+                   "NaN/Inf samples: 'error' refuses the volume, 'zero' replaces them by 0")
+        ->default_str("error");
+}
+
+Volume loadVolumeFromArgs(const VolumeArgs& args) {
+    LoadOptions options;
+    if (!args.dims.empty()) options.raw.dims = parseDims(args.dims);
+    options.raw.type = args.type;
+    if (!args.spacing.empty()) options.raw.spacing = parseSpacing(args.spacing);
+    options.raw.bigEndian = args.bigEndian;
+    options.raw.headerBytes = args.headerBytes;
+    if (args.nanPolicy == "error")
+        options.nonFinite = NonFinitePolicy::Error;
+    else if (args.nanPolicy == "zero")
+        options.nonFinite = NonFinitePolicy::Zero;
+    else
+        throw Error("--nan-policy '" + args.nanPolicy + "': expected 'error' or 'zero'");
+    return loadVolume(args.spec, options);
+}
+
+}  // namespace splat::cli
