@@ -8,15 +8,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <limits>
-#include <system_error>
-#include <unistd.h>
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
 #include "splat/error.h"
+#include "splat/image_io.h"
 
 namespace splat {
 namespace {
@@ -103,30 +101,15 @@ void writeHeatmap(const std::string& path, const Image& test, const Image& refer
     OIIO::ImageBuf mapped = OIIO::ImageBufAlgo::color_map(grey, 0, "inferno");
     if (mapped.has_error()) throw Error("heat map: colour map failed: " + mapped.geterror());
 
-    // The map's colours are display values already: write them without any encoding,
-    // atomically (a temporary file in the same folder, renamed over the target).
-    namespace fs = std::filesystem;
-    const fs::path target(path);
-    const std::string ext = target.extension().string();
-    const fs::path tmp = target.parent_path() /
-                         ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()) + ext);
-    std::string lower = ext;
-    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    const bool floatFile = lower == ".exr";
-    if (!floatFile) mapped.set_write_format(OIIO::TypeDesc::UINT8);
-    if (!mapped.write(tmp.string())) {
-        std::error_code ec;
-        fs::remove(tmp, ec);
-        std::string why = mapped.geterror();
-        if (why.empty()) why = OIIO::geterror();
-        throw Error("heat map: cannot write " + path + ": " + why);
-    }
-    std::error_code ec;
-    fs::rename(tmp, target, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw Error("heat map: cannot write " + path + ": " + ec.message());
-    }
+    // OpenImageIO's maps hold linear values: writeImage sRGB-encodes them for 8-bit files
+    // and writes atomically (a temporary file in the same folder, renamed over the target).
+    Image heat(w, h, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    std::vector<float> rgb(std::size_t(w) * h * 3);
+    if (!mapped.get_pixels(OIIO::ROI(0, w, 0, h, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT, rgb.data()))
+        throw Error("heat map: colour map failed: " + mapped.geterror());
+    for (std::size_t n = 0; n < heat.pixels.size(); ++n)
+        heat.pixels[n] = glm::vec4(rgb[3 * n], rgb[3 * n + 1], rgb[3 * n + 2], 1.0f);
+    writeImage(path, heat);
 }
 
 }  // namespace splat
