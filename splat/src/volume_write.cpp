@@ -77,7 +77,7 @@ void saveNifti(const std::string& path, const Volume& v) {
     nifti_image_write(nim);
     nifti_image_free(nim);
     std::error_code ec;
-    if (!fs::exists(tmp, ec) || fs::file_size(tmp, ec) < 352) {
+    if (!fs::exists(tmp, ec) || fs::file_size(tmp, ec) == 0) {
         fs::remove(tmp, ec);
         throw Error(path + ": cannot write NIfTI file");
     }
