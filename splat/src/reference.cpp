@@ -250,6 +250,8 @@ public:
         if (!(settings.referenceTolerance > 0))
             throw Error("reference: referenceTolerance must be > 0");
         if (volume.voxelCount() == 0) throw Error("reference: empty volume");
+        if (!(kernel.radius() > 0) || kernel.radius() > 30)
+            throw Error("reference: kernel radius must be in (0, 30] voxels");
         invSpacing_ = 1.0 / volume.spacing;
         stepWorld_ = settings.referenceStep * volume.minSpacing();
         preDvr_ = settings.mode == RenderMode::Dvr && settings.classification == Classification::Pre;
@@ -388,7 +390,7 @@ private:
         bool stop = false;
         depth = -1;
         double mipT = 0;
-        int mipSeg = -1, mipIdx = -1;
+        int mipSeg = -1;
         for (std::size_t s = 0; s < sc.segments.size() && !stop; ++s) {
             const Segment seg = sc.segments[s];
             const int n = sc.baseN[s] << level;
@@ -442,7 +444,6 @@ private:
                     if (f > mip) {
                         mip = f;
                         mipSeg = int(s);
-                        mipIdx = idx;
                         mipT = seg.a + idx * h;
                     }
                 }
@@ -467,7 +468,6 @@ private:
                 const Segment seg = sc.segments[mipSeg];
                 const double h = (seg.b - seg.a) / (sc.baseN[mipSeg] << level);
                 const double lo = std::max(seg.a, mipT - h), hi = std::min(seg.b, mipT + h);
-                (void)mipIdx;
                 mip = std::max(mip, goldenMax(g, p0, v, lo, hi));
             }
             return glm::dvec4(mip, mip, mip, 1.0);
