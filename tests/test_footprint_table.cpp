@@ -222,6 +222,19 @@ TEST_CASE("slab table: edges and bad input", "[footprint][slab]") {
     CHECK(s.cumulative(0, 0.0f) == Approx(fp0 / 2).epsilon(1e-6));
     CHECK(s.section(0, -inf, inf) == fp0);
     CHECK(s.section(1.0f, 0.5f, 0.5f) == 0.0f);
+    CHECK(s.cumulative(-1e-7f, 7.0f) == fp0);  // rounding of a quadratic form
+    CHECK(s.section(-1e-7f, -0.1f, 0.1f) == s.section(0.0f, -0.1f, 0.1f));
+    // Monotone in z and never above the footprint, anywhere in the table.
+    for (int i = 0; i <= 64; ++i) {
+        const float q = 4.0f * i / 64;
+        float prevC = 0;
+        for (int j = 0; j <= 256; ++j) {
+            const float c = s.cumulative(q, -2.5f + 5.0f * j / 256);
+            CHECK(c >= prevC);
+            prevC = c;
+        }
+        CHECK(prevC == s.footprint().lookup(q));
+    }
     for (float r2 : {4.0f, 4.5f, 1e30f, inf, nan})
         for (float z : {-3.0f, 0.0f, 3.0f}) {
             CHECK(s.cumulative(r2, z) == 0.0f);
