@@ -22,17 +22,16 @@ template <int NCh>
 Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats* stats) {
     const SplatList& s = in.splats;
     const int m = majorAxis(in.camera.view);
-    const int slices = in.volume.dims[m];
     const bool ascending = (in.camera.view[m] >= 0) == (in.settings.order == CompositeOrder::FrontToBack);
     const std::vector<std::uint16_t>& index = m == 0 ? s.i : (m == 1 ? s.j : s.k);
 
-    // Visiting order: by slice, in visibility order for the compositing direction.
-    std::vector<std::uint32_t> key(s.size());
+    // Visiting order: by slice, in visibility order for the compositing direction. The
+    // list arrives sorted by slice along m, so the order is the list or its reverse.
+    std::vector<std::uint32_t> order(s.size());
     for (std::size_t n = 0; n < s.size(); ++n)
-        key[n] = ascending ? index[n] : std::uint32_t(slices - 1 - index[n]);
-    const TileBins bins = binToTiles(proj, orderByKey(key, std::uint32_t(slices)),
-                                     TileGrid(in.camera.width(), in.camera.height(),
-                                              in.settings.tileSize));
+        order[n] = std::uint32_t(ascending ? n : s.size() - 1 - n);
+    const TileBins bins = binToTiles(proj, order, TileGrid(in.camera.width(), in.camera.height(),
+                                                           in.settings.tileSize));
 
     // A ray crosses the slab around one slice over spacing_m / |view_m| world units.
     glm::dvec3 axis(0.0);
@@ -47,37 +46,29 @@ Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats
                                 const float* tileScale, TileCounters& cnt) {
         const int ox = (t % bins.grid.tilesX) * bins.grid.tileSize;
         const int oy = (t / bins.grid.tilesX) * bins.grid.tileSize;
-        std::int64_t current = -1;
+        int current = -1;
         for (std::uint32_t n = bins.begin[t]; n < bins.begin[t + 1]; ++n) {
             const std::uint32_t id = bins.splats[n];
-            if (std::int64_t(key[id]) != current) {
+            if (index[id] != current) {
                 if (sheet.dirty()) {
                     sheet.flush(acc, model, pathLength, tileScale);
                     ++cnt.sheets;
                 }
-                current = key[id];
+                current = index[id];
                 if (acc.allOpaque()) {
                     cnt.culled += bins.begin[t + 1] - n;
                     break;
                 }
             }
-            PixelRect r = footprintPixels(proj, id, bins.grid);
-            r.x0 = std::max(r.x0, ox);
-            r.y0 = std::max(r.y0, oy);
-            r.x1 = std::min(r.x1, ox + acc.width() - 1);
-            r.y1 = std::min(r.y1, oy + acc.height() - 1);
+            const PixelRect r = clipToTile(proj.rect[id], bins.grid, t);
             if (acc.rectOpaque(r.x0 - ox, r.y0 - oy, r.x1 - ox, r.y1 - oy)) {
                 ++cnt.culled;
                 continue;
             }
             const footprint::EllipticalFootprint& e = proj.ellipse(id);
-            const float scale = e.scale;
             float v[NCh];
             splatValues<NCh>(s, id, v);
-            cnt.footprintPixels += sheet.splat(v, proj.sx[id], proj.sy[id], e, r,
-                                               [&](float r2, float, float) {
-                                                   return table.lookup(r2) * scale;
-                                               });
+            cnt.footprintPixels += sheet.splatFootprint(v, proj.sx[id], proj.sy[id], e, r, table, in.poly);
         }
         if (sheet.dirty()) {
             sheet.flush(acc, model, pathLength, tileScale);

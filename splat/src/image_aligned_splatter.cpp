@@ -65,11 +65,7 @@ Image renderSlabs(const FrameInputs& in, const ProjectedSplats& proj, RenderStat
             keep.clear();
             for (std::uint32_t id : active) {
                 if ((ftb ? last[id] : first[id]) != slab) keep.push_back(id);
-                PixelRect r = footprintPixels(proj, id, bins.grid);
-                r.x0 = std::max(r.x0, ox);
-                r.y0 = std::max(r.y0, oy);
-                r.x1 = std::min(r.x1, ox + acc.width() - 1);
-                r.y1 = std::min(r.y1, oy + acc.height() - 1);
+                const PixelRect r = clipToTile(proj.rect[id], bins.grid, t);
                 if (acc.rectOpaque(r.x0 - ox, r.y0 - oy, r.x1 - ox, r.y1 - oy)) {
                     ++cnt.culled;
                     continue;

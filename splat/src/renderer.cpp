@@ -1,6 +1,8 @@
 // splat::Renderer: the view-independent state (kernel tables, resolved transfer function,
 // splat list) and the per-frame pipeline project -> bin -> splatter -> composite.
+#include <array>
 #include <chrono>
+#include <mutex>
 #include <cmath>
 #include <optional>
 
@@ -20,8 +22,20 @@ struct Renderer::Impl {
     footprint::Kernel kernel;
     std::optional<footprint::FootprintTable> table;
     std::optional<footprint::SlabTable> slabs;
+    std::optional<FootprintPoly> poly;
     TransferTable transfer;
-    SplatList splats;
+    SplatList splats;  // (k, j, i) order: sorted by slice along z
+    // Copies sorted by slice along x and y, made when a view first needs them, so that the
+    // splatters read the list in visiting order.
+    mutable std::mutex sortMutex;
+    mutable std::array<std::unique_ptr<SplatList>, 2> sorted;
+
+    const SplatList& sortedAlong(int axis) const {
+        if (axis == 2) return splats;
+        std::lock_guard<std::mutex> lock(sortMutex);
+        if (!sorted[axis]) sorted[axis] = std::make_unique<SplatList>(sortedBySlice(splats, axis));
+        return *sorted[axis];
+    }
 
     Impl(const Volume& v, const RenderSettings& s) : volume(v), settings(s), kernel(makeKernel(s)) {}
 
@@ -67,7 +81,11 @@ Renderer::Renderer(const Volume& volume, const RenderSettings& settings) {
     impl_->splats = classify(volume, impl_->settings.transfer, settings.mode,
                              settings.classification, impl_->kernel.radius());
     impl_->transfer = TransferTable(impl_->settings.transfer);
-    if (settings.renderer != RendererKind::Reference) impl_->table.emplace(impl_->kernel);
+    if (settings.renderer != RendererKind::Reference) {
+        impl_->table.emplace(impl_->kernel);
+        impl_->poly.emplace(*impl_->table);
+        if (impl_->poly->maxError() > FootprintPoly::kTolerance) impl_->poly.reset();
+    }
     if (settings.renderer == RendererKind::Sheet) impl_->slabs.emplace(impl_->kernel);
 }
 
@@ -93,9 +111,10 @@ Image Renderer::render(const CameraParams& params, RenderStats* stats) const {
     if (settings.renderer == RendererKind::Reference) {
         image = renderReference(m.volume, m.splats, m.kernel, camera, settings, &local);
     } else {
-        const FrameInputs in{m.volume, m.splats, camera, settings, *m.table,
-                             m.slabs ? &*m.slabs : nullptr, m.transfer};
-        const ProjectedSplats proj = projectSplats(m.splats, camera, m.volume.spacing,
+        const SplatList& list = m.sortedAlong(majorAxis(camera.view));
+        const FrameInputs in{m.volume, list, camera, settings, *m.table,
+                             m.poly ? &*m.poly : nullptr, m.slabs ? &*m.slabs : nullptr, m.transfer};
+        const ProjectedSplats proj = projectSplats(list, camera, m.volume.spacing,
                                                    m.kernel.radius());
         image = settings.renderer == RendererKind::Axis ? renderAxisAligned(in, proj, &local)
                                                         : renderImageAligned(in, proj, &local);

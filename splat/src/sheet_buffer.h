@@ -8,8 +8,14 @@
 #include <array>
 #include <vector>
 
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#endif
+
 #include "compositing.h"
 #include "footprint/ellipse.h"
+#include "footprint/footprint_table.h"
+#include "footprint_poly.h"
 #include "splat/transfer.h"
 #include "tile_binning.h"
 
@@ -53,9 +59,11 @@ struct SheetModel {
 template <int NCh>
 class SheetBuffer {
 public:
-    /// A sheet for the tile whose top-left pixel is (ox, oy) and size w x h.
+    /// A sheet for the tile whose top-left pixel is (ox, oy) and size w x h. Rows are
+    /// padded to a multiple of 8 floats so that vector loops may run past the tile edge.
     SheetBuffer(int ox, int oy, int w, int h)
-        : ox_(ox), oy_(oy), w_(w), h_(h), v_(std::size_t(NCh) * w * h, 0.0f) {
+        : ox_(ox), oy_(oy), w_(w), h_(h), stride_((w + 7) & ~7),
+          plane_(std::size_t(stride_) * h), v_(std::size_t(NCh) * plane_ + 8, 0.0f) {
         clearDirty();
     }
 
@@ -69,24 +77,29 @@ public:
     int splat(const float (&values)[NCh], float sx, float sy,
               const footprint::EllipticalFootprint& e, const PixelRect& rect, Weight&& weight) {
         const int x0 = rect.x0 - ox_, x1 = rect.x1 - ox_, y0 = rect.y0 - oy_, y1 = rect.y1 - oy_;
-        dx0_ = std::min(dx0_, x0);
-        dx1_ = std::max(dx1_, x1);
-        dy0_ = std::min(dy0_, y0);
-        dy1_ = std::max(dy1_, y1);
+        markDirty(x0, x1, y0, y1);
         const float fx0 = float(rect.x0) + 0.5f - sx;
         for (int y = y0; y <= y1; ++y) {
             const float dy = float(y + oy_) + 0.5f - sy;
             const float cyy = e.c * dy * dy, byy = 2.0f * e.b * dy;
-            float* row = &v_[std::size_t(y) * w_];
+            float* row = &v_[std::size_t(y) * stride_];
             for (int x = x0; x <= x1; ++x) {
                 const float dx = fx0 + float(x - x0);
                 const float r2 = (e.a * dx + byy) * dx + cyy;
                 const float wgt = weight(r2, dx, dy);
-                for (int c = 0; c < NCh; ++c) row[std::size_t(c) * w_ * h_ + x] += values[c] * wgt;
+                for (int c = 0; c < NCh; ++c) row[c * plane_ + x] += values[c] * wgt;
             }
         }
         return (x1 - x0 + 1) * (y1 - y0 + 1);
     }
+
+    /// splat() with the whole footprint as the weight, fp(r2) * e.scale: the inner loop of
+    /// the axis-aligned splatter, eight pixels at a time where AVX2 is available.
+    /// With `poly` (accurate to FootprintPoly::kTolerance) the table is evaluated without
+    /// gathers.
+    int splatFootprint(const float (&values)[NCh], float sx, float sy,
+                       const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                       const footprint::FootprintTable& table, const FootprintPoly* poly);
 
     /// Turns the dirty part of the sheet into samples composited into `acc`, clears it.
     /// `pathLength` is the world length of a ray's path through the sheet (for the mean
@@ -95,16 +108,15 @@ public:
     void flush(TileAccumulator& acc, const SheetModel& model, float pathLength,
                const float* pathScale) {
         if (!dirty()) return;
-        const std::size_t plane = std::size_t(w_) * h_;
-        for (int y = dy0_; y <= dy1_; ++y)
-            for (int x = dx0_; x <= dx1_; ++x) {
+        const int xe = std::min(dx1_, w_ - 1);
+        for (int y = dy0_; y <= dy1_; ++y) {
+            for (int x = dx0_; x <= xe; ++x) {
                 const int p = y * w_ + x;
-                float* v = &v_[p];
+                const float* v = &v_[std::size_t(y) * stride_ + x];
                 const float len = pathScale ? pathLength * pathScale[p] : pathLength;
                 if constexpr (NCh == 4) {
-                    acc.composite(p, sampleFromOpticalDepth(v[0], v[plane], v[2 * plane],
-                                                            v[3 * plane]));
-                    v[plane] = v[2 * plane] = v[3 * plane] = 0.0f;
+                    acc.composite(p, sampleFromOpticalDepth(v[0], v[plane_], v[2 * plane_],
+                                                            v[3 * plane_]));
                 } else if (model.mode == RenderMode::Dvr) {
                     float rho, r, g, b;
                     model.transfer->lookup(v[0] / len, rho, r, g, b);
@@ -115,20 +127,116 @@ public:
                 } else {
                     acc.add(p, v[0]);
                 }
-                v[0] = 0.0f;
             }
-        acc.updateOpacity(dx0_, dy0_, dx1_, dy1_);
+            for (int c = 0; c < NCh; ++c) {
+                float* row = &v_[c * plane_ + std::size_t(y) * stride_];
+                std::fill(row + dx0_, row + dx1_ + 1, 0.0f);
+            }
+        }
+        acc.updateOpacity(dx0_, dy0_, xe, dy1_);
         clearDirty();
     }
 
 private:
+    void markDirty(int x0, int x1, int y0, int y1) {
+        dx0_ = std::min(dx0_, x0);
+        dx1_ = std::max(dx1_, x1);
+        dy0_ = std::min(dy0_, y0);
+        dy1_ = std::max(dy1_, y1);
+    }
     void clearDirty() {
         dx0_ = dy0_ = 1 << 30;
         dx1_ = dy1_ = -1;
     }
-    int ox_, oy_, w_, h_;
+    int ox_, oy_, w_, h_, stride_;
+    std::size_t plane_;
     int dx0_, dy0_, dx1_, dy1_;
-    std::vector<float> v_;  // NCh planes of w x h
+    std::vector<float> v_;  // NCh planes of stride x h
 };
+
+#if defined(__AVX2__) && defined(__FMA__)
+template <int NCh>
+int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float sy,
+                                     const footprint::EllipticalFootprint& e,
+                                     const PixelRect& rect,
+                                     const footprint::FootprintTable& table,
+                                     const FootprintPoly* poly) {
+    const int x0 = rect.x0 - ox_, x1 = rect.x1 - ox_, y0 = rect.y0 - oy_, y1 = rect.y1 - oy_;
+    markDirty(x0, x1, y0, y1);
+    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
+    const __m256 vInv = _mm256_set1_ps(table.invStep()), vMax = _mm256_set1_ps(table.r2Max());
+    const __m256 vLast = _mm256_set1_ps(float(table.resolution())), zero = _mm256_setzero_ps();
+    const float* data = table.data();
+    const float r2max = table.r2Max();
+    __m256 coef[FootprintPoly::kMaxCoefficients];
+    const __m256 vSeg = _mm256_set1_ps(poly ? poly->segmentScale() : 0.0f);
+    const __m256 lastSeg = _mm256_set1_ps(float(FootprintPoly::kSegments - 1));
+    const __m256 one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
+    if (poly)
+        for (int k = 0; k < FootprintPoly::kMaxCoefficients; ++k)
+            coef[k] = _mm256_loadu_ps(poly->coefficients()[k].data());
+    __m256 vv[NCh];
+    for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+    int visited = 0;
+    for (int y = y0; y <= y1; ++y) {
+        const float dy = float(y + oy_) + 0.5f - sy;
+        // The row's span inside the ellipse a dx^2 + 2 b dy dx + c dy^2 < R^2: vector groups
+        // start at its first pixel instead of the bounding box's.
+        const float disc = e.b * e.b * dy * dy - e.a * (e.c * dy * dy - r2max);
+        if (!(disc > 0.0f)) continue;
+        const float left = (-e.b * dy - std::sqrt(disc)) / e.a + sx - 0.5f - float(ox_);
+        int xs = std::max(x0, int(std::ceil(left)) - 1);
+        const __m256 cyy = _mm256_set1_ps(e.c * dy * dy), byy = _mm256_set1_ps(2.0f * e.b * dy);
+        const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
+        float* row = &v_[std::size_t(y) * stride_];
+        for (int x = xs; x <= x1; x += 8) {
+            const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
+            const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox_) + 0.5f - sx));
+            const __m256 r2 = _mm256_fmadd_ps(_mm256_fmadd_ps(va, dx, byy), dx, cyy);
+            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
+                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
+            if (_mm256_movemask_ps(inside) == 0) break;
+            __m256 fp;
+            if (poly) {
+                // Segment index and local coordinate u in [-1, 1], then Horner with the
+                // coefficients of each lane's segment picked by a permute.
+                const __m256 s = _mm256_min_ps(_mm256_mul_ps(_mm256_max_ps(r2, zero), vSeg), lastSeg);
+                const __m256 sf = _mm256_floor_ps(s);
+                const __m256i seg = _mm256_cvttps_epi32(sf);
+                const __m256 u = _mm256_fmsub_ps(two, _mm256_sub_ps(s, sf), one);
+                fp = _mm256_permutevar8x32_ps(coef[0], seg);
+                for (int k = 1; k < FootprintPoly::kMaxCoefficients; ++k)
+                    fp = _mm256_fmadd_ps(fp, u, _mm256_permutevar8x32_ps(coef[k], seg));
+            } else {
+                const __m256 t = _mm256_min_ps(_mm256_mul_ps(_mm256_max_ps(r2, zero), vInv), vLast);
+                const __m256i i = _mm256_cvttps_epi32(t);
+                const __m256 f = _mm256_sub_ps(t, _mm256_cvtepi32_ps(i));
+                const __m256 v0 = _mm256_i32gather_ps(data, i, 4);
+                const __m256 v1 = _mm256_i32gather_ps(data + 1, i, 4);
+                fp = _mm256_fmadd_ps(f, _mm256_sub_ps(v1, v0), v0);
+            }
+            const __m256 w = _mm256_and_ps(inside, _mm256_mul_ps(fp, vScale));
+            for (int c = 0; c < NCh; ++c) {
+                float* p = row + c * plane_ + x;
+                _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
+            }
+            visited += 8;
+        }
+    }
+    return visited;
+}
+#else
+template <int NCh>
+int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float sy,
+                                     const footprint::EllipticalFootprint& e,
+                                     const PixelRect& rect,
+                                     const footprint::FootprintTable& table,
+                                     const FootprintPoly* poly) {
+    const float scale = e.scale;
+    return splat(values, sx, sy, e, rect,
+                 [&](float r2, float, float) { return table.lookup(r2) * scale; });
+}
+#endif
 
 }  // namespace splat

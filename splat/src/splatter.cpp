@@ -1,7 +1,10 @@
 // Shared pieces of the splatters (see splatter.h) and the transfer table.
 #include "splatter.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include <tbb/parallel_for.h>
 
 namespace splat {
 
@@ -12,6 +15,35 @@ std::vector<std::uint32_t> orderByKey(const std::vector<std::uint32_t>& key, std
     std::vector<std::uint32_t> order(key.size());
     for (std::size_t s = 0; s < key.size(); ++s) order[start[key[s]]++] = std::uint32_t(s);
     return order;
+}
+
+SplatList sortedBySlice(const SplatList& s, int axis) {
+    const std::vector<std::uint16_t>& index = axis == 0 ? s.i : (axis == 1 ? s.j : s.k);
+    std::uint32_t slices = 0;
+    for (std::uint16_t v : index) slices = std::max<std::uint32_t>(slices, v + 1u);
+    const std::vector<std::uint32_t> order =
+        orderByKey(std::vector<std::uint32_t>(index.begin(), index.end()), slices);
+    SplatList out;
+    out.voxels = s.voxels;
+    auto gather = [&](const auto& from, auto& to) {
+        to.resize(from.size());
+        tbb::parallel_for(std::size_t(0), order.size(), std::size_t(1) << 16, [&](std::size_t b) {
+            const std::size_t e = std::min(order.size(), b + (std::size_t(1) << 16));
+            for (std::size_t n = b; n < e; ++n) to[n] = from[order[n]];
+        });
+    };
+    gather(s.x, out.x);
+    gather(s.y, out.y);
+    gather(s.z, out.z);
+    gather(s.i, out.i);
+    gather(s.j, out.j);
+    gather(s.k, out.k);
+    gather(s.density, out.density);
+    gather(s.extinction, out.extinction);
+    gather(s.r, out.r);
+    gather(s.g, out.g);
+    gather(s.b, out.b);
+    return out;
 }
 
 std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& axis) {

@@ -19,6 +19,7 @@ struct FrameInputs {
     const Camera& camera;
     const RenderSettings& settings;  ///< transfer already resolved
     const footprint::FootprintTable& table;
+    const FootprintPoly* poly;  ///< fast evaluation of `table`, if accurate enough
     const footprint::SlabTable* slabs;  ///< image-aligned only
     const TransferTable& transfer;
 };
@@ -27,6 +28,10 @@ struct FrameInputs {
 struct TileCounters {
     std::size_t footprintPixels = 0, sheets = 0, culled = 0;
 };
+
+/// A copy of `splats` sorted (stably) by slice index along `axis` (0 = i, 1 = j, 2 = k), so
+/// that a frame visiting slices in order reads the list sequentially.
+SplatList sortedBySlice(const SplatList& splats, int axis);
 
 /// Stable counting sort: splat indices ordered by key[s] in [0, keys).
 std::vector<std::uint32_t> orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys);

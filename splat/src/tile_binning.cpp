@@ -8,24 +8,6 @@
 
 namespace splat {
 
-PixelRect footprintPixels(const ProjectedSplats& p, std::size_t s, const TileGrid& grid) {
-    const auto& e = p.ellipse(s);
-    // Pixel centres px + 0.5 within [sx - halfWidth, sx + halfWidth].
-    const float fx0 = std::ceil(p.sx[s] - e.halfWidth - 0.5f);
-    const float fx1 = std::floor(p.sx[s] + e.halfWidth - 0.5f);
-    const float fy0 = std::ceil(p.sy[s] - e.halfHeight - 0.5f);
-    const float fy1 = std::floor(p.sy[s] + e.halfHeight - 0.5f);
-    PixelRect r;
-    r.x0 = int(std::max(fx0, 0.0f));
-    r.y0 = int(std::max(fy0, 0.0f));
-    r.x1 = int(std::min(fx1, float(grid.width - 1)));
-    r.y1 = int(std::min(fy1, float(grid.height - 1)));
-    if (!(fx1 >= 0.0f) || !(fy1 >= 0.0f) || !(fx0 <= float(grid.width - 1)) ||
-        !(fy0 <= float(grid.height - 1)) || (p.perspective && !(p.depth[s] > 0.0f)))
-        r = {1, 1, 0, 0};
-    return r;
-}
-
 namespace {
 // A fixed number of chunks (not one per thread) keeps the result identical for any
 // thread count.
@@ -53,7 +35,7 @@ TileBins binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& 
         std::uint32_t* cnt = &counts[c * tiles];
         const std::size_t e = std::min(n, (c + 1) * chunk);
         for (std::size_t o = c * chunk; o < e; ++o) {
-            const PixelRect r = footprintPixels(p, order[o], grid);
+            const PixelRect& r = p.rect[order[o]];
             if (!r.empty()) forTilesOf(r, grid, [&](int t) { ++cnt[t]; });
         }
     });
@@ -74,7 +56,7 @@ TileBins binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& 
         std::uint32_t* next = &counts[c * tiles];
         const std::size_t e = std::min(n, (c + 1) * chunk);
         for (std::size_t o = c * chunk; o < e; ++o) {
-            const PixelRect r = footprintPixels(p, order[o], grid);
+            const PixelRect& r = p.rect[order[o]];
             if (!r.empty()) forTilesOf(r, grid, [&](int t) { bins.splats[next[t]++] = order[o]; });
         }
     });

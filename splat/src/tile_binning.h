@@ -3,6 +3,7 @@
 // bounding box touches, in a given visiting order (compressed rows: tile t owns
 // splats[begin[t] .. begin[t + 1])). Tiles then render independently, so threads never
 // share a pixel and the image does not depend on the thread count.
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -19,13 +20,15 @@ struct TileGrid {
     int count() const { return tilesX * tilesY; }
 };
 
-/// Inclusive pixel range covered by a splat's footprint bounding box, clamped to the
-/// image; empty when x0 > x1 or y0 > y1.
-struct PixelRect {
-    int x0, y0, x1, y1;
-    bool empty() const { return x0 > x1 || y0 > y1; }
-};
-PixelRect footprintPixels(const ProjectedSplats& p, std::size_t s, const TileGrid& grid);
+/// The part of a rectangle inside tile `t`.
+inline PixelRect clipToTile(PixelRect r, const TileGrid& g, int t) {
+    const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
+    r.x0 = std::max(r.x0, ox);
+    r.y0 = std::max(r.y0, oy);
+    r.x1 = std::min(r.x1, std::min(ox + g.tileSize, g.width) - 1);
+    r.y1 = std::min(r.y1, std::min(oy + g.tileSize, g.height) - 1);
+    return r;
+}
 
 struct TileBins {
     TileGrid grid;
