@@ -81,11 +81,12 @@ public:
         const float fx0 = float(rect.x0) + 0.5f - sx;
         for (int y = y0; y <= y1; ++y) {
             const float dy = float(y + oy_) + 0.5f - sy;
-            const float cyy = e.c * dy * dy, byy = 2.0f * e.b * dy;
+            const float shift = e.beta * dy, gyy = e.gamma * dy * dy;
             float* row = &v_[std::size_t(y) * stride_];
             for (int x = x0; x <= x1; ++x) {
                 const float dx = fx0 + float(x - x0);
-                const float r2 = (e.a * dx + byy) * dx + cyy;
+                const float q = dx + shift;
+                const float r2 = e.a * q * q + gyy;  // EllipticalFootprint::r2
                 const float wgt = weight(r2, dx, dy);
                 for (int c = 0; c < NCh; ++c) row[c * plane_ + x] += values[c] * wgt;
             }
@@ -181,19 +182,21 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
     int visited = 0;
     for (int y = y0; y <= y1; ++y) {
         const float dy = float(y + oy_) + 0.5f - sy;
-        // The row's span inside the ellipse a dx^2 + 2 b dy dx + c dy^2 < R^2: vector groups
+        // r^2 = a (dx + beta dy)^2 + gamma dy^2 (EllipticalFootprint::r2). The row's span
+        // inside the ellipse is |dx + beta dy| < sqrt((R^2 - gamma dy^2) / a): vector groups
         // start at its first pixel instead of the bounding box's.
-        const float disc = e.b * e.b * dy * dy - e.a * (e.c * dy * dy - r2max);
-        if (!(disc > 0.0f)) continue;
-        const float left = (-e.b * dy - std::sqrt(disc)) / e.a + sx - 0.5f - float(ox_);
-        int xs = std::max(x0, int(std::ceil(left)) - 1);
-        const __m256 cyy = _mm256_set1_ps(e.c * dy * dy), byy = _mm256_set1_ps(2.0f * e.b * dy);
+        const float gyy = e.gamma * dy * dy, shift = e.beta * dy;
+        const float room = (r2max - gyy) / e.a;
+        if (!(room > 0.0f)) continue;
+        const float left = -shift - std::sqrt(room) + sx - 0.5f - float(ox_);
+        const int xs = std::max(x0, int(std::ceil(left)) - 1);
+        const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(shift);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
         float* row = &v_[std::size_t(y) * stride_];
         for (int x = xs; x <= x1; x += 8) {
             const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
-            const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox_) + 0.5f - sx));
-            const __m256 r2 = _mm256_fmadd_ps(_mm256_fmadd_ps(va, dx, byy), dx, cyy);
+            const __m256 q = _mm256_add_ps(_mm256_add_ps(px, _mm256_set1_ps(float(ox_) + 0.5f - sx)), vshift);
+            const __m256 r2 = _mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy);
             const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
                                                 _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
             if (_mm256_movemask_ps(inside) == 0) break;
