@@ -7,6 +7,7 @@
 // intensity scaling and the orientation (sform preferred, then qform, else pixdim).
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 
 #include <nifti1_io.h>
@@ -39,16 +40,56 @@ std::optional<SampleType> niftiType(int datatype) {
     }
 }
 
-// Bytes of sample data actually present after the header (for the truncation message).
-std::size_t availableDataBytes(const fs::path& p, std::size_t offset) {
-    gzFile f = gzopen(p.string().c_str(), "rb");  // reads plain files too
+// Total (decompressed) length of a .nii or .nii.gz file.
+std::size_t contentLength(const fs::path& p, bool gz) {
+    std::error_code ec;
+    if (!gz) return std::size_t(fs::file_size(p, ec));
+    gzFile f = gzopen(p.string().c_str(), "rb");
     if (!f) return 0;
     std::size_t total = 0;
-    std::vector<char> buf(1 << 16);
+    std::vector<char> buf(1 << 18);
     int n;
     while ((n = gzread(f, buf.data(), unsigned(buf.size()))) > 0) total += std::size_t(n);
     gzclose(f);
-    return total > offset ? total - offset : 0;
+    return total;
+}
+
+// Checks the 348-byte header ourselves before handing the file to niftilib, which
+// prints its own complaints to stderr: size field, magic, dims, data length.
+void validateHeader(const fs::path& p, const std::string& name) {
+    const bool gz = lowerExtension(p) == ".nii.gz";
+    nifti_1_header h;
+    gzFile f = gzopen(p.string().c_str(), "rb");
+    if (!f) throw Error(name + ": cannot open for reading");
+    int got = gzread(f, &h, sizeof h);
+    int gzErr = 0;
+    gzerror(f, &gzErr);
+    gzclose(f);
+    if (gzErr != Z_OK && gzErr != Z_STREAM_END) throw Error(name + ": corrupt gzip data");
+    if (got != int(sizeof h)) throw Error(name + ": not a NIfTI-1 file (shorter than its 348-byte header)");
+    bool swapped = h.sizeof_hdr != 348;
+    if (swapped) {
+        swap_nifti_header(&h, 1);
+        if (h.sizeof_hdr != 348) throw Error(name + ": not a readable NIfTI-1 file (bad header size)");
+    }
+    if (std::memcmp(h.magic, "n+1", 4) != 0)
+        throw Error(name + ": not a readable NIfTI-1 single file (magic is not n+1)");
+    if (h.dim[0] < 1 || h.dim[0] > 7)
+        throw Error(name + ": not a readable NIfTI-1 file (bad dim[0] = " + std::to_string(h.dim[0]) + ")");
+    std::uint64_t count = 1;
+    for (int d = 1; d <= h.dim[0]; ++d) {
+        if (h.dim[d] < 1)
+            throw Error(name + ": invalid dimension " + std::to_string(h.dim[d]) + " along axis " +
+                        std::to_string(d));
+        count *= std::uint64_t(h.dim[d]);  // at most 7 factors below 2^15: no overflow
+    }
+    if (!niftiType(h.datatype))
+        throw Error(name + ": unsupported NIfTI data type " + nifti_datatype_string(h.datatype) +
+                    " (supported: uint8, int8, int16, uint16, int32, uint32, float32, float64)");
+    std::size_t offset = std::size_t(std::max(0.0f, h.vox_offset));
+    std::size_t expected = std::size_t(count) * std::size_t(h.bitpix / 8);
+    std::size_t total = contentLength(p, gz);
+    checkDataLength(expected, total > offset ? total - offset : 0, name, false);
 }
 
 glm::dmat3 linearPart(const mat44& m, glm::dvec3& t) {
@@ -65,29 +106,18 @@ Volume loadNifti(const fs::path& p) {
     const std::string name = displayName(p);
     std::error_code ec;
     if (!fs::exists(p, ec)) throw Error(name + ": no such file");
+    validateHeader(p, name);
     nifti_set_debug_level(0);  // niftilib prints to stderr otherwise; we report ourselves
     NimPtr nim(nifti_image_read(p.string().c_str(), 0));
     if (!nim) throw Error(name + ": not a readable NIfTI-1 file (bad header or corrupt gzip data)");
-
     auto type = niftiType(nim->datatype);
-    if (!type)
-        throw Error(name + ": unsupported NIfTI data type " +
-                    nifti_datatype_string(nim->datatype) +
-                    " (supported: uint8, int8, int16, uint16, int32, uint32, float32, float64)");
-    for (int d = 1; d <= 3; ++d)
-        if (nim->dim[d] < 1 && !(d > nim->dim[0]))
-            throw Error(name + ": invalid dimension " + std::to_string(nim->dim[d]) +
-                        " along axis " + std::to_string(d));
+    if (!type) throw Error(name + ": unsupported NIfTI data type");
     glm::ivec3 dims(std::max(nim->nx, 1), std::max(nim->ny, 1), std::max(nim->nz, 1));
     Volume v = makeVolume(dims, glm::dvec3(1.0), name);
     std::size_t extraVolumes = dims.x > 0 ? nim->nvox / v.voxelCount() : 1;
 
-    if (nifti_image_load(nim.get()) < 0 || !nim->data) {
-        std::size_t expected = nim->nvox * std::size_t(nim->nbyper);
-        std::size_t found = availableDataBytes(p, std::size_t(nim->iname_offset));
-        if (found < expected) checkDataLength(expected, found, name, false);
-        throw Error(name + ": cannot read the sample data");
-    }
+    if (nifti_image_load(nim.get()) < 0 || !nim->data)
+        throw Error(name + ": cannot read the sample data (corrupt gzip data?)");
     decodeSamples(static_cast<const unsigned char*>(nim->data), v.voxelCount(), *type, false,
                   v.data.data());
 
