@@ -204,8 +204,8 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
             if (poly) {
                 // Segment index and local coordinate u in [-1, 1], then Horner with the
                 // coefficients of each lane's segment picked by a permute.
-                const __m256 s = _mm256_min_ps(_mm256_mul_ps(_mm256_max_ps(r2, zero), vSeg), lastSeg);
-                const __m256 sf = _mm256_floor_ps(s);
+                const __m256 s = _mm256_mul_ps(_mm256_max_ps(r2, zero), vSeg);
+                const __m256 sf = _mm256_min_ps(_mm256_floor_ps(s), lastSeg);
                 const __m256i seg = _mm256_cvttps_epi32(sf);
                 const __m256 u = _mm256_fmsub_ps(two, _mm256_sub_ps(s, sf), one);
                 fp = _mm256_permutevar8x32_ps(coef[0], seg);
