@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Installs splat's build dependencies from Debian's packages (idempotent: packages that
+# are already installed are skipped, and apt is not touched at all when none is missing).
+set -euo pipefail
+packages=(build-essential cmake pkg-config libglm-dev libopenimageio-dev openimageio-tools
+          libtbb-dev catch2 libcli11-dev nlohmann-json3-dev libnifti2-dev zlib1g-dev
+          mricron-data)
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+    echo "setup: all dependencies present"
+    exit 0
+fi
+echo "setup: installing ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
