@@ -57,6 +57,7 @@ TEST_CASE("splat info: bad input exits non-zero with one line on stderr", "[volu
     writeBytes(dir / "gz.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\n"
                                 "encoding: gzip\n\nnot gzip at all");
     writeBytes(dir / "plain.raw", "xxxxxxxx");
+    writeBytes(dir / "junk.nii", std::string(500, 'j'));
     auto before = std::distance(std::filesystem::directory_iterator(dir),
                                 std::filesystem::directory_iterator());
     struct Case { std::vector<std::string> args; std::string expect; };
@@ -73,6 +74,7 @@ TEST_CASE("splat info: bad input exits non-zero with one line on stderr", "[volu
          "spacings must be finite and > 0"},
         {{"info", "synthetic:phantom", "--nan-policy", "maybe"}, "--nan-policy 'maybe'"},
         {{"info", "synthetic:nothing"}, "unknown synthetic volume"},
+        {{"info", d + "junk.nii"}, "junk.nii: not a readable NIfTI-1 file"},
     };
     for (const Case& c : cases) {
         RunResult r = runSplat(c.args);

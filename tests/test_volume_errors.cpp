@@ -105,6 +105,27 @@ TEST_CASE("truncated NIfTI data reports expected and found bytes", "[volume]") {
     CHECK_THAT(loadError(p), Catch::Contains("truncated data: expected 256 bytes, found 100"));
 }
 
+TEST_CASE("NIfTI header problems: dims, type, gzip", "[volume]") {
+    auto dir = testTmpDir("volume_errors_nifti_hdr");
+    Volume v = makeVolume({2, 2, 2}, {1, 1, 1}, "t");
+    std::string p = (dir / "h.nii").string();
+    saveNifti(p, v);
+    auto patch = [&](std::size_t offset, std::int16_t value) {
+        std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(std::streamoff(offset));
+        f.write(reinterpret_cast<const char*>(&value), 2);
+    };
+    patch(44, 0);  // dim[2] = 0 (dim[] starts at byte 40)
+    CHECK(loadError(p) == p + ": invalid dimension 0 along axis 2");
+    patch(44, 2);
+    patch(70, 32);  // datatype = DT_COMPLEX64
+    CHECK_THAT(loadError(p), Catch::StartsWith(p + ": unsupported NIfTI data type"));
+    std::string gz = (dir / "c.nii.gz").string();
+    writeBytes(gz, std::string("\x1f\x8b\x08\x00\x00\x00\x00\x00\x00\x03garbage", 18) +
+                       std::string(400, 'q'));
+    CHECK_THAT(loadError(gz), Catch::StartsWith(gz + ": "));
+}
+
 TEST_CASE("NaN/Inf policy", "[volume]") {
     auto dir = testTmpDir("volume_nan");
     const float nan = std::numeric_limits<float>::quiet_NaN();
