@@ -4,6 +4,7 @@
 // of its slice, and sheets are composited in visibility order. When the major axis
 // changes (e.g. at 45 degrees) the sheets change orientation: that is the popping
 // artifact the image-aligned splatter removes.
+#include <chrono>
 #include <cmath>
 
 #include "axis_splatter.h"
@@ -20,6 +21,7 @@ namespace {
 
 template <int NCh>
 Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats* stats) {
+    const auto start = std::chrono::steady_clock::now();
     const SplatList& s = in.splats;
     const int m = majorAxis(in.camera.view);
     const bool ascending = (in.camera.view[m] >= 0) == (in.settings.order == CompositeOrder::FrontToBack);
@@ -27,11 +29,13 @@ Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats
 
     // Visiting order: by slice, in visibility order for the compositing direction. The
     // list arrives sorted by slice along m, so the order is the list or its reverse.
-    std::vector<std::uint32_t> order(s.size());
+    std::vector<std::uint32_t>& order = in.work.order;
+    order.resize(s.size());
     for (std::size_t n = 0; n < s.size(); ++n)
         order[n] = std::uint32_t(ascending ? n : s.size() - 1 - n);
-    const TileBins bins = binToTiles(proj, order, TileGrid(in.camera.width(), in.camera.height(),
-                                                           in.settings.tileSize));
+    TileBins& bins = in.work.bins;
+    binToTiles(proj, order, TileGrid(in.camera.width(), in.camera.height(), in.settings.tileSize),
+               bins);
 
     // A ray crosses the slab around one slice over spacing_m / |view_m| world units.
     glm::dvec3 axis(0.0);
@@ -41,7 +45,9 @@ Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats
     const SheetModel model{in.settings.mode, in.settings.classification, &in.transfer};
     const footprint::FootprintTable& table = in.table;
 
-    return renderTiles<NCh>(in, bins, pathScale, stats,
+    if (stats) stats->binMs = msSince(start);
+    const auto tiles = std::chrono::steady_clock::now();
+    Image image = renderTiles<NCh>(in, bins, pathScale, stats,
                             [&](int t, SheetBuffer<NCh>& sheet, TileAccumulator& acc,
                                 const float* tileScale, TileCounters& cnt) {
         const int ox = (t % bins.grid.tilesX) * bins.grid.tileSize;
@@ -75,6 +81,8 @@ Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats
             ++cnt.sheets;
         }
     });
+    if (stats) stats->tilesMs = msSince(tiles);
+    return image;
 }
 
 }  // namespace

@@ -8,7 +8,7 @@
 namespace splat {
 
 namespace {
-constexpr int kBlock = 8;  // early-termination granularity, pixels
+constexpr int kBlock = 4;  // early-termination granularity, pixels (64 blocks per 32x32 tile)
 }
 
 TileAccumulator::TileAccumulator(int width, int height, CompositeOrder order,

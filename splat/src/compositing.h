@@ -52,7 +52,7 @@ public:
     void add(int p, float v) { r_[p] += v; }
 
     /// Early termination (front-to-back dvr only): true when every pixel of the tile, or
-    /// of the 8x8 blocks overlapping the tile-local inclusive rectangle, is opaque.
+    /// of the 4x4 blocks overlapping the tile-local inclusive rectangle, is opaque.
     bool terminates() const { return terminates_; }
     bool allOpaque() const { return terminates_ && opaqueBlocks_ == allBlocks_; }
     bool rectOpaque(int x0, int y0, int x1, int y1) const;

@@ -16,7 +16,7 @@ namespace splat {
 class FootprintPoly {
 public:
     static constexpr int kSegments = 8;
-    static constexpr int kMaxCoefficients = 8;
+    static constexpr int kMaxCoefficients = 8;  // the vector code assumes exactly 8
     static constexpr double kTolerance = 1e-6;  ///< of the peak
 
     explicit FootprintPoly(const footprint::FootprintTable& table);

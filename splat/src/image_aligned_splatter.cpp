@@ -7,6 +7,7 @@
 // Splats are visited through depth buckets: sorted by the first slab they touch (last
 // slab for back-to-front), each tile keeps an active list that splats join when the sweep
 // reaches their first slab and leave after their last one.
+#include <chrono>
 #include <cmath>
 
 #include "image_aligned_splatter.h"
@@ -18,6 +19,7 @@ namespace {
 
 template <int NCh>
 Image renderSlabs(const FrameInputs& in, const ProjectedSplats& proj, RenderStats* stats) {
+    const auto start = std::chrono::steady_clock::now();
     const SplatList& s = in.splats;
     const bool ftb = in.settings.order == CompositeOrder::FrontToBack;
     const float thickness = float(in.settings.slab * in.volume.minSpacing());
@@ -35,20 +37,26 @@ Image renderSlabs(const FrameInputs& in, const ProjectedSplats& proj, RenderStat
     zmin -= ext;
     zmax += ext;
     const std::uint32_t slabs = std::uint32_t(std::floor((zmax - zmin) / thickness)) + 1;
-    std::vector<std::uint32_t> first(s.size()), last(s.size()), key(s.size());
+    std::vector<std::uint32_t>&first = in.work.first, &last = in.work.last, &key = in.work.key;
+    first.resize(s.size());
+    last.resize(s.size());
+    key.resize(s.size());
     for (std::size_t n = 0; n < s.size(); ++n) {
         first[n] = std::min(slabs - 1, std::uint32_t((proj.depth[n] - ext - zmin) / thickness));
         last[n] = std::min(slabs - 1, std::uint32_t((proj.depth[n] + ext - zmin) / thickness));
         key[n] = ftb ? first[n] : slabs - 1 - last[n];
     }
-    const TileBins bins = binToTiles(proj, orderByKey(key, slabs),
-                                     TileGrid(in.camera.width(), in.camera.height(),
-                                              in.settings.tileSize));
+    TileBins& bins = in.work.bins;
+    orderByKey(key, slabs, in.work.order);
+    binToTiles(proj, in.work.order,
+               TileGrid(in.camera.width(), in.camera.height(), in.settings.tileSize), bins);
     const std::vector<float> pathScale = perspectivePathScale(in.camera, in.camera.view);
     const SheetModel model{in.settings.mode, in.settings.classification, &in.transfer};
     const footprint::SlabTable& table = *in.slabs;
 
-    return renderTiles<NCh>(in, bins, pathScale, stats,
+    if (stats) stats->binMs = msSince(start);
+    const auto tiles = std::chrono::steady_clock::now();
+    Image image = renderTiles<NCh>(in, bins, pathScale, stats,
                             [&](int t, SheetBuffer<NCh>& sheet, TileAccumulator& acc,
                                 const float* tileScale, TileCounters& cnt) {
         const int ox = (t % bins.grid.tilesX) * bins.grid.tileSize;
@@ -96,6 +104,8 @@ Image renderSlabs(const FrameInputs& in, const ProjectedSplats& proj, RenderStat
             }
         }
     });
+    if (stats) stats->tilesMs = msSince(tiles);
+    return image;
 }
 
 }  // namespace

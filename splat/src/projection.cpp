@@ -21,9 +21,8 @@ PixelRect coveredPixels(float sx, float sy, const footprint::EllipticalFootprint
 }
 }  // namespace
 
-ProjectedSplats projectSplats(const SplatList& splats, const Camera& camera,
-                              const glm::dvec3& spacing, double radius) {
-    ProjectedSplats p;
+void projectSplats(const SplatList& splats, const Camera& camera, const glm::dvec3& spacing,
+                   double radius, ProjectedSplats& p) {
     const std::size_t n = splats.size();
     p.sx.resize(n);
     p.sy.resize(n);
@@ -33,11 +32,13 @@ ProjectedSplats projectSplats(const SplatList& splats, const Camera& camera,
     // The kernel is the ellipsoid S * (ball of radius R); its extent along a unit
     // direction n is R |S n| (the support function of the ellipsoid).
     p.depthExtent = float(radius * glm::length(spacing * camera.view));
-    if (!p.perspective)
+    if (!p.perspective) {
         p.shared = footprint::ellipticalFootprint(spacing, camera.right * camera.pixelSize,
                                                   -camera.up * camera.pixelSize, camera.view,
                                                   radius);
-    else {
+        p.each.clear();
+        p.depthPerRay.clear();
+    } else {
         p.each.resize(n);
         p.depthPerRay.resize(n);
     }
@@ -62,7 +63,6 @@ ProjectedSplats projectSplats(const SplatList& splats, const Camera& camera,
                                             camera.height());
         }
     });
-    return p;
 }
 
 }  // namespace splat

@@ -32,9 +32,10 @@ struct ProjectedSplats {
     }
 };
 
-/// Projects every splat. Screen units are pixels: x right, y down. Splats behind a
-/// perspective eye get an empty rectangle.
-ProjectedSplats projectSplats(const SplatList& splats, const Camera& camera,
-                              const glm::dvec3& spacing, double radius);
+/// Projects every splat into `out` (its arrays are reused, so frames of a sequence do not
+/// allocate). Screen units are pixels: x right, y down. Splats behind a perspective eye get
+/// an empty rectangle.
+void projectSplats(const SplatList& splats, const Camera& camera, const glm::dvec3& spacing,
+                   double radius, ProjectedSplats& out);
 
 }  // namespace splat

@@ -29,6 +29,10 @@ struct Renderer::Impl {
     // splatters read the list in visiting order.
     mutable std::mutex sortMutex;
     mutable std::array<std::unique_ptr<SplatList>, 2> sorted;
+    // One frame at a time uses the workspace; concurrent render() calls on one Renderer
+    // are serialised.
+    mutable std::mutex frameMutex;
+    mutable FrameWorkspace work;
 
     const SplatList& sortedAlong(int axis) const {
         if (axis == 2) return splats;
@@ -112,10 +116,14 @@ Image Renderer::render(const CameraParams& params, RenderStats* stats) const {
         image = renderReference(m.volume, m.splats, m.kernel, camera, settings, &local);
     } else {
         const SplatList& list = m.sortedAlong(majorAxis(camera.view));
+        std::lock_guard<std::mutex> lock(m.frameMutex);
         const FrameInputs in{m.volume, list, camera, settings, *m.table,
-                             m.poly ? &*m.poly : nullptr, m.slabs ? &*m.slabs : nullptr, m.transfer};
-        const ProjectedSplats proj = projectSplats(list, camera, m.volume.spacing,
-                                                   m.kernel.radius());
+                             m.poly ? &*m.poly : nullptr, m.slabs ? &*m.slabs : nullptr, m.transfer,
+                             m.work};
+        const auto t0 = std::chrono::steady_clock::now();
+        ProjectedSplats& proj = m.work.proj;
+        projectSplats(list, camera, m.volume.spacing, m.kernel.radius(), proj);
+        local.projectMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         image = settings.renderer == RendererKind::Axis ? renderAxisAligned(in, proj, &local)
                                                         : renderImageAligned(in, proj, &local);
     }

@@ -63,7 +63,7 @@ public:
     /// padded to a multiple of 8 floats so that vector loops may run past the tile edge.
     SheetBuffer(int ox, int oy, int w, int h)
         : ox_(ox), oy_(oy), w_(w), h_(h), stride_((w + 7) & ~7),
-          plane_(std::size_t(stride_) * h), v_(std::size_t(NCh) * plane_ + 8, 0.0f) {
+          plane_(std::size_t(stride_) * h + kPlanePad), v_(std::size_t(NCh) * plane_ + 8, 0.0f) {
         clearDirty();
     }
 
@@ -149,6 +149,9 @@ private:
         dx0_ = dy0_ = 1 << 30;
         dx1_ = dy1_ = -1;
     }
+    // Channel planes of a 32 x 32 tile would be exactly 4 KiB apart, and loads of one plane
+    // would then falsely depend on stores to the plane before (4K aliasing): pad them.
+    static constexpr std::size_t kPlanePad = 24;
     int ox_, oy_, w_, h_, stride_;
     std::size_t plane_;
     int dx0_, dy0_, dx1_, dy1_;
@@ -169,7 +172,6 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
     const __m256 vInv = _mm256_set1_ps(table.invStep()), vMax = _mm256_set1_ps(table.r2Max());
     const __m256 vLast = _mm256_set1_ps(float(table.resolution())), zero = _mm256_setzero_ps();
     const float* data = table.data();
-    const float r2max = table.r2Max();
     __m256 coef[FootprintPoly::kMaxCoefficients];
     const __m256 vSeg = _mm256_set1_ps(poly ? poly->segmentScale() : 0.0f);
     const __m256 lastSeg = _mm256_set1_ps(float(FootprintPoly::kSegments - 1));
@@ -182,24 +184,20 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
     int visited = 0;
     for (int y = y0; y <= y1; ++y) {
         const float dy = float(y + oy_) + 0.5f - sy;
-        // r^2 = a (dx + beta dy)^2 + gamma dy^2 (EllipticalFootprint::r2). The row's span
-        // inside the ellipse is |dx + beta dy| < sqrt((R^2 - gamma dy^2) / a): vector groups
-        // start at its first pixel instead of the bounding box's.
+        // r^2 = a (dx + beta dy)^2 + gamma dy^2 (EllipticalFootprint::r2).
         const float gyy = e.gamma * dy * dy, shift = e.beta * dy;
-        const float room = (r2max - gyy) / e.a;
-        if (!(room > 0.0f)) continue;
-        const float left = -shift - std::sqrt(room) + sx - 0.5f - float(ox_);
-        const int xs = std::max(x0, int(std::ceil(left)) - 1);
         const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(shift);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
+        const __m256 firstX = _mm256_set1_ps(float(x0) - 0.5f);
         float* row = &v_[std::size_t(y) * stride_];
-        for (int x = xs; x <= x1; x += 8) {
+        for (int x = x0 & ~7; x <= x1; x += 8) {
             const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
             const __m256 q = _mm256_add_ps(_mm256_add_ps(px, _mm256_set1_ps(float(ox_) + 0.5f - sx)), vshift);
             const __m256 r2 = _mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy);
-            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
-                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
-            if (_mm256_movemask_ps(inside) == 0) break;
+            const __m256 inside = _mm256_and_ps(
+                _mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
+                _mm256_and_ps(_mm256_cmp_ps(px, lastX, _CMP_LT_OQ),
+                              _mm256_cmp_ps(px, firstX, _CMP_GT_OQ)));
             __m256 fp;
             if (poly) {
                 // Segment index and local coordinate u in [-1, 1], then Horner with the
@@ -208,9 +206,13 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
                 const __m256 sf = _mm256_min_ps(_mm256_floor_ps(s), lastSeg);
                 const __m256i seg = _mm256_cvttps_epi32(sf);
                 const __m256 u = _mm256_fmsub_ps(two, _mm256_sub_ps(s, sf), one);
-                fp = _mm256_permutevar8x32_ps(coef[0], seg);
-                for (int k = 1; k < FootprintPoly::kMaxCoefficients; ++k)
-                    fp = _mm256_fmadd_ps(fp, u, _mm256_permutevar8x32_ps(coef[k], seg));
+                // Estrin's scheme (three dependent steps instead of seven for Horner);
+                // a[k] = coefficient of u^k = coef[7 - k].
+                auto a = [&](int k) { return _mm256_permutevar8x32_ps(coef[7 - k], seg); };
+                const __m256 u2 = _mm256_mul_ps(u, u), u4 = _mm256_mul_ps(u2, u2);
+                const __m256 q0 = _mm256_fmadd_ps(a(1), u, a(0)), q1 = _mm256_fmadd_ps(a(3), u, a(2));
+                const __m256 q2 = _mm256_fmadd_ps(a(5), u, a(4)), q3 = _mm256_fmadd_ps(a(7), u, a(6));
+                fp = _mm256_fmadd_ps(_mm256_fmadd_ps(q3, u2, q2), u4, _mm256_fmadd_ps(q1, u2, q0));
             } else {
                 const __m256 t = _mm256_min_ps(_mm256_mul_ps(_mm256_max_ps(r2, zero), vInv), vLast);
                 const __m256i i = _mm256_cvttps_epi32(t);

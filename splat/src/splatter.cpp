@@ -8,21 +8,21 @@
 
 namespace splat {
 
-std::vector<std::uint32_t> orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys) {
+void orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys,
+                std::vector<std::uint32_t>& order) {
     std::vector<std::uint32_t> start(std::size_t(keys) + 1, 0);
     for (std::uint32_t k : key) ++start[std::size_t(k) + 1];
     for (std::size_t k = 0; k < keys; ++k) start[k + 1] += start[k];
-    std::vector<std::uint32_t> order(key.size());
+    order.resize(key.size());
     for (std::size_t s = 0; s < key.size(); ++s) order[start[key[s]]++] = std::uint32_t(s);
-    return order;
 }
 
 SplatList sortedBySlice(const SplatList& s, int axis) {
     const std::vector<std::uint16_t>& index = axis == 0 ? s.i : (axis == 1 ? s.j : s.k);
     std::uint32_t slices = 0;
     for (std::uint16_t v : index) slices = std::max<std::uint32_t>(slices, v + 1u);
-    const std::vector<std::uint32_t> order =
-        orderByKey(std::vector<std::uint32_t>(index.begin(), index.end()), slices);
+    std::vector<std::uint32_t> order;
+    orderByKey(std::vector<std::uint32_t>(index.begin(), index.end()), slices, order);
     SplatList out;
     out.voxels = s.voxels;
     auto gather = [&](const auto& from, auto& to) {

@@ -3,15 +3,26 @@
 // the driver that renders screen tiles in parallel (each tile owns its sheet buffer and
 // its compositing state) and assembles the image. The two splatters differ only in how
 // they cut kernels into sheets: axis_splatter.cpp and image_aligned_splatter.cpp.
+#include <chrono>
 #include <cstdint>
 #include <vector>
 
 #include "footprint/footprint_table.h"
 #include "footprint/slab_table.h"
+#include "projection.h"
 #include "sheet_buffer.h"
+#include "tile_binning.h"
 #include "splat/render.h"
 
 namespace splat {
+
+/// Per-frame arrays, kept by the Renderer and reused so that a sequence of frames does not
+/// allocate (and fault in) fresh memory every frame.
+struct FrameWorkspace {
+    ProjectedSplats proj;
+    TileBins bins;
+    std::vector<std::uint32_t> order, key, first, last;
+};
 
 struct FrameInputs {
     const Volume& volume;
@@ -22,6 +33,7 @@ struct FrameInputs {
     const FootprintPoly* poly;  ///< fast evaluation of `table`, if accurate enough
     const footprint::SlabTable* slabs;  ///< image-aligned only
     const TransferTable& transfer;
+    FrameWorkspace& work;
 };
 
 /// Per-tile counters, summed into RenderStats.
@@ -33,8 +45,14 @@ struct TileCounters {
 /// that a frame visiting slices in order reads the list sequentially.
 SplatList sortedBySlice(const SplatList& splats, int axis);
 
+/// Milliseconds since `start`.
+inline double msSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
 /// Stable counting sort: splat indices ordered by key[s] in [0, keys).
-std::vector<std::uint32_t> orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys);
+void orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys,
+                std::vector<std::uint32_t>& order);
 
 /// Per-pixel ray direction factor for perspective views, 1 / |dir . axis| * |view . axis|
 /// style path-length scales; empty for orthographic views. `axis` is the sheet normal.

@@ -22,14 +22,14 @@ void forTilesOf(const PixelRect& r, const TileGrid& g, F&& f) {
 }
 }  // namespace
 
-TileBins binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& order,
-                    const TileGrid& grid) {
-    TileBins bins;
+void binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& order,
+                const TileGrid& grid, TileBins& bins) {
     bins.grid = grid;
     const std::size_t tiles = std::size_t(grid.count());
     const std::size_t n = order.size();
     const std::size_t chunk = (n + kChunks - 1) / kChunks;
-    std::vector<std::uint32_t> counts(kChunks * tiles, 0);
+    std::vector<std::uint32_t>& counts = bins.counts;
+    counts.assign(kChunks * tiles, 0);
 
     tbb::parallel_for(std::size_t(0), kChunks, [&](std::size_t c) {
         std::uint32_t* cnt = &counts[c * tiles];
@@ -60,7 +60,6 @@ TileBins binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& 
             if (!r.empty()) forTilesOf(r, grid, [&](int t) { bins.splats[next[t]++] = order[o]; });
         }
     });
-    return bins;
 }
 
 }  // namespace splat

@@ -34,10 +34,12 @@ struct TileBins {
     TileGrid grid;
     std::vector<std::uint32_t> begin;   ///< grid.count() + 1 offsets
     std::vector<std::uint32_t> splats;  ///< splat indices, per tile in `order`
+    std::vector<std::uint32_t> counts;  ///< scratch: per chunk and tile
 };
 
-/// Bins the splats listed in `order` (visiting order) to tiles.
-TileBins binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& order,
-                    const TileGrid& grid);
+/// Bins the splats listed in `order` (visiting order) to tiles, into `bins` (its arrays
+/// are reused across frames).
+void binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& order,
+                const TileGrid& grid, TileBins& bins);
 
 }  // namespace splat

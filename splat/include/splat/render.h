@@ -49,6 +49,8 @@ struct RenderStats {
     std::size_t sheets = 0;            ///< sheets composited (summed over tiles)
     std::size_t culledSplats = 0;      ///< splats skipped by occlusion culling
     double referenceStep = 0;          ///< reference: final step (voxels)
+    /// Stage times of the splatters: project, order + bin to tiles, rasterise + composite.
+    double projectMs = 0, binMs = 0, tilesMs = 0;
 };
 
 class Renderer {
