@@ -352,3 +352,38 @@ TEST_CASE("splatters against the reference ray caster", "[splatter][accuracy]") 
         CHECK(axis.rmse < c.axisBound);
     }
 }
+
+TEST_CASE("shading: normals point out of a sphere; ambient 1 reproduces the unshaded image",
+          "[splatter][shading]") {
+    const Volume v = makeSynthetic("blob", 32);
+    TransferFunction tf = flatTf(0.05f);
+    const SplatList s = classify(v, tf, RenderMode::Dvr, Classification::Pre, 2.0, true);
+    REQUIRE(s.nx.size() == s.size());
+    const glm::dvec3 c = v.center();
+    int checked = 0;
+    for (std::size_t n = 0; n < s.size(); n += 7) {
+        const glm::dvec3 out = glm::dvec3(s.x[n], s.y[n], s.z[n]) - c;
+        if (glm::length(out) < 3.0 || glm::length(out) > 10.0) continue;
+        const double cosine = glm::dot(glm::normalize(out), glm::dvec3(s.nx[n], s.ny[n], s.nz[n]));
+        REQUIRE(cosine > 0.99);  // -grad of a Gaussian blob points away from its centre
+        ++checked;
+    }
+    CHECK(checked > 100);
+    for (RendererKind r : kSplatters) {
+        RenderSettings base = baseSettings(r, RenderMode::Dvr, 48);
+        base.transfer = tf;
+        const Image plain = render(v, base);
+        base.shading.enabled = true;
+        base.shading.ambient = 1.0f;
+        base.shading.diffuse = base.shading.specular = 0.0f;
+        const Image flat = render(v, base);
+        CHECK(maxRelDiff(flat, plain, 1e-3) < 1e-6);
+        base.shading.ambient = 0.2f;
+        base.shading.diffuse = 0.8f;
+        const Image lit = render(v, base);
+        // Facing the light at the centre: n.l ~ 1 so the centre keeps its brightness,
+        // while the limb (n.l ~ 0) darkens to about the ambient share.
+        CHECK(lit.at(24, 24).r == Approx(plain.at(24, 24).r).epsilon(0.1));
+        CHECK(lit.at(24, 24).r > plain.at(24, 24).r * 0.8);
+    }
+}

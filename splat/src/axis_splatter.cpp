@@ -73,7 +73,7 @@ Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats
             }
             const footprint::EllipticalFootprint& e = proj.ellipse(id);
             float v[NCh];
-            splatValues<NCh>(s, id, v);
+            splatValues<NCh>(in, id, v);
             cnt.footprintPixels += sheet.splatFootprint(v, proj.sx[id], proj.sy[id], e, r, table, in.poly);
         }
         if (sheet.dirty()) {

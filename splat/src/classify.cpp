@@ -44,14 +44,52 @@ std::vector<char> neededBricks(const Volume& v, const TransferFunction& tf, int 
     return need;
 }
 
+// -grad d / |grad d| by central differences (one-sided at the border), in world units; 0
+// where the gradient vanishes.
+glm::dvec3 normalAt(const Volume& v, int i, int j, int k) {
+    glm::dvec3 g(0.0);
+    const int p[3] = {i, j, k};
+    for (int a = 0; a < 3; ++a) {
+        int lo[3] = {i, j, k}, hi[3] = {i, j, k};
+        lo[a] = std::max(p[a] - 1, 0);
+        hi[a] = std::min(p[a] + 1, v.dims[a] - 1);
+        if (hi[a] == lo[a]) continue;
+        g[a] = (double(v.at(hi[0], hi[1], hi[2])) - v.at(lo[0], lo[1], lo[2])) /
+               ((hi[a] - lo[a]) * v.spacing[a]);
+    }
+    const double len = glm::length(g);
+    return len > 0 ? -g / len : glm::dvec3(0.0);
+}
+
 }  // namespace
+
+void shadeEmission(const SplatList& s, const Shading& sh, const glm::dvec3& view,
+                   std::vector<float>& r, std::vector<float>& g, std::vector<float>& b) {
+    const std::size_t n = s.size();
+    r.resize(n);
+    g.resize(n);
+    b.resize(n);
+    const glm::vec3 l = -glm::vec3(view);
+    const bool hasNormals = s.nx.size() == n;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t q = range.begin(); q != range.end(); ++q) {
+            const float c = hasNormals ? std::abs(s.nx[q] * l.x + s.ny[q] * l.y + s.nz[q] * l.z) : 1.0f;
+            const float diffuse = sh.ambient + sh.diffuse * c;
+            const float spec = c > 0.0f ? sh.specular * std::exp(sh.shininess * std::log(c)) * s.extinction[q] : 0.0f;
+            r[q] = s.r[q] * diffuse + spec;
+            g[q] = s.g[q] * diffuse + spec;
+            b[q] = s.b[q] * diffuse + spec;
+        }
+    });
+}
 
 std::size_t SplatList::bytes() const {
     return size() * (3 * sizeof(float) + 3 * sizeof(std::uint16_t) + 5 * sizeof(float));
 }
 
 SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
-                   Classification classification, double radius) {
+                   Classification classification, double radius, bool normals) {
     const glm::ivec3 d = volume.dims;
     if (d.x > 65535 || d.y > 65535 || d.z > 65535)
         throw Error("volume dimension above 65535 is not supported by the splat list");
@@ -86,6 +124,8 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
     s.voxels = volume.voxelCount();
     for (auto* a : {&s.x, &s.y, &s.z, &s.density, &s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
     for (auto* a : {&s.i, &s.j, &s.k}) a->resize(n);
+    if (normals)
+        for (auto* a : {&s.nx, &s.ny, &s.nz}) a->resize(n);
     tbb::parallel_for(0, d.z, [&](int k) {
         std::size_t o = count[std::size_t(k)];
         for (int j = 0; j < d.y; ++j)
@@ -109,6 +149,12 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                     s.b[o] = c.b * rho;
                 } else {
                     s.extinction[o] = s.r[o] = s.g[o] = s.b[o] = 0.0f;
+                }
+                if (normals) {
+                    const glm::dvec3 n = normalAt(volume, i, j, k);
+                    s.nx[o] = float(n.x);
+                    s.ny[o] = float(n.y);
+                    s.nz[o] = float(n.z);
                 }
                 ++o;
             }

@@ -85,7 +85,7 @@ Image renderSlabs(const FrameInputs& in, const ProjectedSplats& proj, RenderStat
                 const float t0 = (z0 - proj.depth[id]) * perRay, t1 = (z1 - proj.depth[id]) * perRay;
                 const float ds = e.depthScale, tx = e.tx, ty = e.ty, scale = e.scale;
                 float v[NCh];
-                splatValues<NCh>(s, id, v);
+                splatValues<NCh>(in, id, v);
                 cnt.footprintPixels += sheet.splat(v, proj.sx[id], proj.sy[id], e, r,
                                                    [&](float r2, float dx, float dy) {
                     const float tc = tx * dx + ty * dy;

@@ -43,6 +43,12 @@ struct Renderer::Impl {
 
     Impl(const Volume& v, const RenderSettings& s) : volume(v), settings(s), kernel(makeKernel(s)) {}
 
+    /// Shading is modelled only where it applies: pre-classified dvr.
+    bool shaded() const {
+        return settings.shading.enabled && settings.mode == RenderMode::Dvr &&
+               settings.classification == Classification::Pre;
+    }
+
     static footprint::Kernel makeKernel(const RenderSettings& s) {
         try {
             return footprint::Kernel::fromName(s.kernel, s.kernelSigma, s.kernelRadius);
@@ -83,7 +89,7 @@ Renderer::Renderer(const Volume& volume, const RenderSettings& settings) {
     const VolumeStats st = volumeStats(volume, 1);
     impl_->settings.transfer = settings.transfer.resolved(st.minValue, st.maxValue);
     impl_->splats = classify(volume, impl_->settings.transfer, settings.mode,
-                             settings.classification, impl_->kernel.radius());
+                             settings.classification, impl_->kernel.radius(), impl_->shaded());
     impl_->transfer = TransferTable(impl_->settings.transfer);
     if (settings.renderer != RendererKind::Reference) {
         impl_->table.emplace(impl_->kernel);
@@ -113,13 +119,26 @@ Image Renderer::render(const CameraParams& params, RenderStats* stats) const {
     local.voxels = m.splats.voxels;
     Image image;
     if (settings.renderer == RendererKind::Reference) {
-        image = renderReference(m.volume, m.splats, m.kernel, camera, settings, &local);
+        if (m.shaded()) {
+            SplatList lit = m.splats;
+            shadeEmission(m.splats, settings.shading, camera.view, lit.r, lit.g, lit.b);
+            image = renderReference(m.volume, lit, m.kernel, camera, settings, &local);
+        } else {
+            image = renderReference(m.volume, m.splats, m.kernel, camera, settings, &local);
+        }
     } else {
         const SplatList& list = m.sortedAlong(majorAxis(camera.view));
         std::lock_guard<std::mutex> lock(m.frameMutex);
+        const float *er = list.r.data(), *eg = list.g.data(), *eb = list.b.data();
+        if (m.shaded()) {
+            shadeEmission(list, settings.shading, camera.view, m.work.r, m.work.g, m.work.b);
+            er = m.work.r.data();
+            eg = m.work.g.data();
+            eb = m.work.b.data();
+        }
         const FrameInputs in{m.volume, list, camera, settings, *m.table,
                              m.poly ? &*m.poly : nullptr, m.slabs ? &*m.slabs : nullptr, m.transfer,
-                             m.work};
+                             m.work, er, eg, eb};
         const auto t0 = std::chrono::steady_clock::now();
         ProjectedSplats& proj = m.work.proj;
         projectSplats(list, camera, m.volume.spacing, m.kernel.radius(), proj);

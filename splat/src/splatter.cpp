@@ -27,6 +27,7 @@ SplatList sortedBySlice(const SplatList& s, int axis) {
     out.voxels = s.voxels;
     auto gather = [&](const auto& from, auto& to) {
         to.resize(from.size());
+        if (from.empty()) return;
         tbb::parallel_for(std::size_t(0), order.size(), std::size_t(1) << 16, [&](std::size_t b) {
             const std::size_t e = std::min(order.size(), b + (std::size_t(1) << 16));
             for (std::size_t n = b; n < e; ++n) to[n] = from[order[n]];
@@ -43,6 +44,9 @@ SplatList sortedBySlice(const SplatList& s, int axis) {
     gather(s.r, out.r);
     gather(s.g, out.g);
     gather(s.b, out.b);
+    gather(s.nx, out.nx);
+    gather(s.ny, out.ny);
+    gather(s.nz, out.nz);
     return out;
 }
 

@@ -22,6 +22,7 @@ struct FrameWorkspace {
     ProjectedSplats proj;
     TileBins bins;
     std::vector<std::uint32_t> order, key, first, last;
+    std::vector<float> r, g, b;  ///< shaded emission of this view
 };
 
 struct FrameInputs {
@@ -34,6 +35,8 @@ struct FrameInputs {
     const footprint::SlabTable* slabs;  ///< image-aligned only
     const TransferTable& transfer;
     FrameWorkspace& work;
+    /// Emission to splat: the list's own, or the shaded emission of this view.
+    const float *er, *eg, *eb;
 };
 
 /// Per-tile counters, summed into RenderStats.
@@ -60,14 +63,14 @@ std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& 
 
 /// The values a splat contributes to a sheet: (rho, e_r, e_g, e_b) or (density).
 template <int NCh>
-inline void splatValues(const SplatList& s, std::size_t i, float (&v)[NCh]) {
+inline void splatValues(const FrameInputs& in, std::size_t i, float (&v)[NCh]) {
     if constexpr (NCh == 4) {
-        v[0] = s.extinction[i];
-        v[1] = s.r[i];
-        v[2] = s.g[i];
-        v[3] = s.b[i];
+        v[0] = in.splats.extinction[i];
+        v[1] = in.er[i];
+        v[2] = in.eg[i];
+        v[3] = in.eb[i];
     } else {
-        v[0] = s.density[i];
+        v[0] = in.splats.density[i];
     }
 }
 

@@ -39,6 +39,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
     cmd.add_option("--tile-size", a.tileSize, "screen tile edge in pixels (8..64)")->capture_default_str();
     cmd.add_option("--ref-step", a.refStep, "reference: initial step, voxels")->capture_default_str();
     cmd.add_option("--ref-tolerance", a.refTolerance, "reference: step refinement tolerance")->capture_default_str();
+    cmd.add_flag("--shade", a.shade, "headlight Phong shading from the density gradient (pre-classified dvr)");
     cmd.add_option("--scene", a.scene, "scene FILE.json holding any of these options (flags override it)");
 }
 
@@ -125,6 +126,7 @@ RenderArgs withScene(const RenderArgs& given) {
             else if (key == "ref-tolerance") a.refTolerance = value.get<double>();
             else if (key == "threads") a.threads = value.get<int>();
             else if (key == "tile-size") a.tileSize = value.get<int>();
+            else if (key == "shade") a.shade = value.get<bool>();
             else throw Error(given.scene + ": unknown scene key '" + key + "'");
         }
     } catch (const nlohmann::json::exception& e) {
@@ -169,6 +171,7 @@ RenderSettings settingsFromArgs(const RenderArgs& given) {
     s.tileSize = a.tileSize;
     s.referenceStep = a.refStep;
     s.referenceTolerance = a.refTolerance;
+    s.shading.enabled = a.shade;
     return s;
 }
 

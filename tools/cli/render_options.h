@@ -18,6 +18,7 @@ struct RenderArgs {
     double azimuth = 0, elevation = 0, pixelSize = 0, fov = 30, slab = 1, sigma = 0, radius = 0;
     double earlyTermination = 1.0 / 256.0, isoLevel = 0.5, refStep = 0.25, refTolerance = 1e-4;
     int threads = 0, tileSize = 32;
+    bool shade = false;
     CLI::App* cmd = nullptr;
 };
 

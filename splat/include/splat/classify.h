@@ -22,6 +22,9 @@ struct SplatList {
     std::vector<float> density;            ///< d_i
     std::vector<float> extinction;         ///< rho_i = f_rho(d_i), per world unit (pre)
     std::vector<float> r, g, b;            ///< premultiplied emission e_i = colour * rho_i (pre)
+    /// Unit normals -grad d / |grad d| (central differences in world units), only when
+    /// classify() was asked for them (shading); empty otherwise.
+    std::vector<float> nx, ny, nz;
     std::size_t voxels = 0;                ///< voxels considered
     std::size_t size() const { return x.size(); }
     std::size_t bytes() const;
@@ -32,6 +35,18 @@ struct SplatList {
 /// is the kernel radius in voxels (for the brick dilation of post-classification).
 /// Throws splat::Error if a dimension exceeds 65535.
 SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
-                   Classification classification, double radius);
+                   Classification classification, double radius, bool normals = false);
+
+/// Headlight Phong shading of pre-classified emission (DESIGN.md: shading is modelled only
+/// when asked for): e' = e (ambient + diffuse |n.l|) + specular |n.l|^shininess rho, with
+/// the light at the eye (l = -view), two-sided.
+struct Shading {
+    bool enabled = false;
+    float ambient = 0.35f, diffuse = 0.65f, specular = 0.25f, shininess = 24.0f;
+};
+
+/// Shaded emission of every splat for a view direction (needs normals).
+void shadeEmission(const SplatList& splats, const Shading& shading, const glm::dvec3& view,
+                   std::vector<float>& r, std::vector<float>& g, std::vector<float>& b);
 
 }  // namespace splat

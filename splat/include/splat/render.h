@@ -33,6 +33,7 @@ struct RenderSettings {
     double earlyTermination = 1.0 / 256.0;
     glm::vec4 background{0.0f};       ///< premultiplied RGBA behind the volume
     double isoLevel = 0.5;            ///< iso mode: level of f (absolute density)
+    Shading shading;                  ///< headlight shading (pre-classified dvr)
     int threads = 0;                  ///< 0: all cores
     int tileSize = 32;                ///< screen tile edge, pixels
     /// Reference ray caster: step in voxels of the first pass and the image tolerance at
