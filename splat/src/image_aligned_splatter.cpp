@@ -83,14 +83,10 @@ Image renderSlabs(const FrameInputs& in, const ProjectedSplats& proj, RenderStat
                 // z = depthScale (t - (tx dx + ty dy)), t = (plane depth - centre) / cos.
                 const float perRay = proj.perspective ? proj.depthPerRay[id] : 1.0f;
                 const float t0 = (z0 - proj.depth[id]) * perRay, t1 = (z1 - proj.depth[id]) * perRay;
-                const float ds = e.depthScale, tx = e.tx, ty = e.ty, scale = e.scale;
                 float v[NCh];
                 splatValues<NCh>(in, id, v);
-                cnt.footprintPixels += sheet.splat(v, proj.sx[id], proj.sy[id], e, r,
-                                                   [&](float r2, float dx, float dy) {
-                    const float tc = tx * dx + ty * dy;
-                    return table.section(r2, ds * (t0 - tc), ds * (t1 - tc)) * scale;
-                });
+                cnt.footprintPixels += sheet.splatSection(v, proj.sx[id], proj.sy[id], e, r, table,
+                                                          in.poly, t0, t1);
             }
             active.swap(keep);
             if (sheet.dirty()) {

@@ -33,7 +33,10 @@ std::string temporaryName(const std::string& path) {
     const fs::path p(path);
     std::random_device rd;
     const std::string tag = std::to_string(rd() % 1000000u);
-    return (p.parent_path() / ("." + p.stem().string() + ".tmp" + tag + p.extension().string())).string();
+    std::string name = p.stem().string();
+    name.insert(0, 1, '.');
+    name.append(".tmp").append(tag).append(p.extension().string());
+    return (p.parent_path() / name).string();
 }
 
 std::vector<float> displayValues(const Image& image, const WriteOptions& o) {

@@ -106,7 +106,7 @@ void writeHeatmap(const std::string& path, const Image& test, const Image& refer
     Image heat(w, h, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
     std::vector<float> rgb(std::size_t(w) * h * 3);
     if (!mapped.get_pixels(OIIO::ROI(0, w, 0, h, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT, rgb.data()))
-        throw Error("heat map: colour map failed: " + mapped.geterror());
+        throw Error(std::string("heat map: colour map failed: ").append(mapped.geterror()));
     for (std::size_t n = 0; n < heat.pixels.size(); ++n)
         heat.pixels[n] = glm::vec4(rgb[3 * n], rgb[3 * n + 1], rgb[3 * n + 2], 1.0f);
     writeImage(path, heat);
