@@ -6,5 +6,5 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/build.sh
 build/bin/splat info synthetic:phantom:128
-build/bin/splat rotate synthetic:phantom:128 --renderer sheet --tf ct-soft --size 384x384 \
+build/bin/splat rotate synthetic:phantom:128 --renderer sheet --tf tools/gallery/phantom-tf.json --size 384x384 \
     --elevation 20 --frames 36 -o out/phantom --gif out/phantom.gif

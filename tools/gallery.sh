@@ -19,7 +19,8 @@ $S render $CH2 --tf mri-head --shade --azimuth 135 --elevation 10 --size 320x320
 $S render $CH2 --mode mip --azimuth 90 --size 320x320 -o $G/head_mip.png
 $S render $CH2 --mode xray --azimuth 90 --size 320x320 -o $G/head_xray.png
 # The built-in 3D Shepp-Logan phantom, image-aligned, post-classified.
-$S render synthetic:phantom:128 --tf ct-soft --renderer sheet --classify post --elevation 25 --azimuth 30 --size 320x320 -o $G/phantom_sheet_post.png
+$S render synthetic:phantom:128 --tf tools/gallery/phantom-tf.json --renderer sheet --elevation 25 --azimuth 30 --size 320x320 -o $G/phantom_sheet.png
+$S render synthetic:phantom:128 --tf tools/gallery/phantom-tf.json --renderer sheet --classify post --elevation 25 --azimuth 30 --size 320x320 -o $G/phantom_sheet_post.png
 # One kernel's footprint (X-ray of a single voxel), isotropic and with spacing 1 x 1 x 3.
 python3 -c "import struct,sys; sys.stdout.buffer.write(struct.pack('<f', 1.0))" > $tmp/one_1x1x1_float32.raw
 $S render $tmp/one_1x1x1_float32.raw --mode xray --pixel-size 0.04 --size 160x160 -o $G/footprint.png
@@ -32,4 +33,4 @@ $S compare $tmp/axis.exr $tmp/reference.exr --heatmap $G/error_axis_45.png --sca
 $S compare $tmp/sheet.exr $tmp/reference.exr --heatmap $G/error_sheet_45.png --scale 0.05
 $S render synthetic:phantom:64 --tf ct-soft --azimuth 45 --size 256x256 --renderer reference -o $G/phantom_reference_45.png
 # A small rotation of the phantom as an animated GIF.
-$S rotate synthetic:phantom:96 --tf ct-soft --renderer sheet --elevation 20 --size 192x192 --frames 24 -o $tmp/frames --gif $G/phantom_rotate.gif
+$S rotate synthetic:phantom:96 --tf tools/gallery/phantom-tf.json --renderer sheet --elevation 20 --size 192x192 --frames 24 -o $tmp/frames --gif $G/phantom_rotate.gif

@@ -46,12 +46,12 @@ Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats
     const footprint::FootprintTable& table = in.table;
 
     if (stats) stats->binMs = msSince(start);
-    const auto tiles = std::chrono::steady_clock::now();
-    Image image = renderTiles<NCh>(in, bins, pathScale, stats,
-                            [&](int t, SheetBuffer<NCh>& sheet, TileAccumulator& acc,
-                                const float* tileScale, TileCounters& cnt) {
+    return renderTiles<NCh>(in, bins, pathScale, stats,
+                            [&](int t, TileAccumulator& acc, const float* tileScale,
+                                TileCounters& cnt) {
         const int ox = (t % bins.grid.tilesX) * bins.grid.tileSize;
         const int oy = (t / bins.grid.tilesX) * bins.grid.tileSize;
+        SheetBuffer<NCh> sheet(ox, oy, acc.width(), acc.height());
         int current = -1;
         for (std::uint32_t n = bins.begin[t]; n < bins.begin[t + 1]; ++n) {
             const std::uint32_t id = bins.splats[n];
@@ -81,16 +81,12 @@ Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats
             ++cnt.sheets;
         }
     });
-    if (stats) stats->tilesMs = msSince(tiles);
-    return image;
 }
 
 }  // namespace
 
 Image renderAxisAligned(const FrameInputs& in, const ProjectedSplats& proj, RenderStats* stats) {
-    return SheetModel{in.settings.mode, in.settings.classification, nullptr}.channels() == 4
-               ? renderAxis<4>(in, proj, stats)
-               : renderAxis<1>(in, proj, stats);
+    return withChannels(in.settings, [&]<int NCh>() { return renderAxis<NCh>(in, proj, stats); });
 }
 
 }  // namespace splat

@@ -74,8 +74,16 @@ inline void splatValues(const FrameInputs& in, std::size_t i, float (&v)[NCh]) {
     }
 }
 
-/// Runs `tileFn(bins, tileIndex, sheet, accumulator, pathScaleOfTile, counters)` for
-/// every tile in parallel (settings.threads), then writes the tiles into the image.
+/// Calls f.operator()<4>() for pre-classified dvr (extinction and emission per sheet
+/// pixel) and f.operator()<1>() otherwise (density).
+template <class F>
+Image withChannels(const RenderSettings& s, F&& f) {
+    return SheetModel{s.mode, s.classification, nullptr}.channels() == 4 ? f.template operator()<4>()
+                                                                         : f.template operator()<1>();
+}
+
+/// Runs `tileFn(tileIndex, accumulator, pathScaleOfTile, counters)` for every tile that
+/// has splats, in parallel (settings.threads), then writes the tiles into the image.
 template <int NCh, class TileFn>
 Image renderTiles(const FrameInputs& in, const TileBins& bins, const std::vector<float>& pathScale,
                   RenderStats* stats, TileFn&& tileFn);

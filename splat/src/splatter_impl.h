@@ -26,6 +26,7 @@ template <int NCh, class TileFn>
 Image renderTiles(const FrameInputs& in, const TileBins& bins, const std::vector<float>& pathScale,
                   RenderStats* stats, TileFn&& tileFn) {
     const TileGrid& g = bins.grid;
+    const auto start = std::chrono::steady_clock::now();
     Image image(g.width, g.height);
     std::vector<TileCounters> counters(std::size_t(g.count()));
     auto work = [&] {
@@ -36,7 +37,6 @@ Image renderTiles(const FrameInputs& in, const TileBins& bins, const std::vector
             TileAccumulator acc(w, h, in.settings.order,
                                 in.settings.mode == RenderMode::Dvr ? in.settings.earlyTermination : 0.0);
             if (bins.begin[t] != bins.begin[t + 1]) {
-                SheetBuffer<NCh> sheet(ox, oy, w, h);
                 std::vector<float> tileScale;
                 if (!pathScale.empty()) {
                     tileScale.resize(std::size_t(w) * h);
@@ -44,7 +44,7 @@ Image renderTiles(const FrameInputs& in, const TileBins& bins, const std::vector
                         for (int x = 0; x < w; ++x)
                             tileScale[y * w + x] = pathScale[std::size_t(oy + y) * g.width + ox + x];
                 }
-                tileFn(t, sheet, acc, tileScale.empty() ? nullptr : tileScale.data(), counters[t]);
+                tileFn(t, acc, tileScale.empty() ? nullptr : tileScale.data(), counters[t]);
             }
             acc.resolve(image, ox, oy, in.settings.mode, in.settings.background);
         });
@@ -56,6 +56,7 @@ Image renderTiles(const FrameInputs& in, const TileBins& bins, const std::vector
         work();
     }
     if (stats) {
+        stats->tilesMs = msSince(start);
         for (const auto& c : counters) {
             stats->footprintPixels += c.footprintPixels;
             stats->sheets += c.sheets;

@@ -98,7 +98,8 @@ RenderArgs withScene(const RenderArgs& given) {
     }
     if (!j.is_object()) throw Error(given.scene + ": a scene file must be a JSON object");
     auto flagGiven = [&](const std::string& key) {
-        return given.cmd && given.cmd->count("--" + key) > 0;
+        const CLI::Option* o = given.cmd ? given.cmd->get_option_no_throw("--" + key) : nullptr;
+        return o && o->count() > 0;
     };
     try {
         for (auto& [key, value] : j.items()) {
