@@ -102,6 +102,7 @@ TEST_CASE("render refuses bad options and outputs with one line and no file", "[
         {{"--slab", "0", "--renderer", "sheet"}, "slab thickness"},
         {{"--size", "0x10"}, "--size"},
         {{"--size", "banana"}, "--size"},
+        {{"--size", "30000x30000"}, "Mpixels"},
         {{"--tf", "no-such-preset"}, "unknown transfer function preset"},
         {{"--tf", (dir / "missing.json").string()}, "cannot open transfer function file"},
         {{"--background", "1,2"}, "--background"},

@@ -2,6 +2,7 @@
 #include "splat/camera.h"
 
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "splat/error.h"
@@ -11,6 +12,7 @@ namespace splat {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxImageSide = 32768;
+constexpr std::int64_t kMaxImagePixels = std::int64_t(1) << 27;  // 2 GiB of RGBA floats
 }  // namespace
 
 Camera::Camera(const CameraParams& params, const Volume& volume) : params_(params) {
@@ -19,6 +21,10 @@ Camera::Camera(const CameraParams& params, const Volume& volume) : params_(param
         throw Error("image size " + std::to_string(params.width) + "x" +
                     std::to_string(params.height) + " is outside 1.." +
                     std::to_string(kMaxImageSide) + " per side");
+    if (std::int64_t(params.width) * params.height > kMaxImagePixels)
+        throw Error("image size " + std::to_string(params.width) + "x" +
+                    std::to_string(params.height) + " exceeds " +
+                    std::to_string(kMaxImagePixels >> 20) + " Mpixels");
     if (!std::isfinite(params.azimuthDeg) || !std::isfinite(params.elevationDeg))
         throw Error("azimuth and elevation must be finite numbers");
     if (!(params.pixelSize >= 0) || !std::isfinite(params.pixelSize))

@@ -49,6 +49,10 @@ void registerRotate(CLI::App& app) {
             throw Error("--format must be png, exr or tif");
         if (!a->gif.empty()) checkImagePath(a->gif);
         const RenderSettings settings = settingsFromArgs(a->render);
+        // The GIF is assembled in memory: keep it under 4 GiB of float frames.
+        if (!a->gif.empty() && double(a->frames) * settings.camera.width * settings.camera.height > double(1 << 28))
+            throw Error("--gif with " + std::to_string(a->frames) + " frames of " + a->render.size +
+                        " would not fit in memory; use fewer frames or a smaller --size");
         const Volume volume = loadVolumeFromArgs(a->volume);
         std::error_code ec;
         std::filesystem::create_directories(a->outDir, ec);
