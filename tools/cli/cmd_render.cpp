@@ -33,9 +33,12 @@ void registerRender(CLI::App& app) {
         RenderStats stats;
         const Image image = renderer.render(&stats);
         writeImage(args->output, image, displayOptions(args->render, settings, image));
-        std::printf("wrote %s: %dx%d, %s %s, %zu splats of %zu voxels, %.1f ms\n",
+        const double skipped = stats.voxels ? 100.0 * (1.0 - double(stats.splats) / stats.voxels) : 0.0;
+        std::printf("wrote %s: %dx%d, %s %s, %zu splats of %zu voxels (%.1f%% skipped, splat list "
+                    "%.1f MiB), %.1f ms\n",
                     args->output.c_str(), image.width, image.height, toString(settings.renderer),
-                    toString(settings.mode), stats.splats, stats.voxels, stats.milliseconds);
+                    toString(settings.mode), stats.splats, stats.voxels, skipped,
+                    renderer.splats().bytes() / 1048576.0, stats.milliseconds);
     });
 }
 
