@@ -67,12 +67,12 @@ TEST_CASE("rotate writes every frame and an animated GIF", "[cli]") {
     const fs::path dir = testTmpDir("cli_rotate");
     const RunResult r = runSplat({"rotate", "synthetic:phantom:24", "--tf", "ct-soft", "--size", "24x24",
                                   "--frames", "5", "-o", (dir / "frames").string(), "--gif",
-                                  (dir / "r.gif").string()});
+                                  (dir / "new" / "r.gif").string()});
     INFO(r.err);
     REQUIRE(r.status == 0);
     for (int f = 0; f < 5; ++f) CHECK(fs::exists(dir / "frames" / ("frame_000" + std::to_string(f) + ".png")));
-    REQUIRE(fs::exists(dir / "r.gif"));
-    CHECK(fs::file_size(dir / "r.gif") > 200);
+    REQUIRE(fs::exists(dir / "new" / "r.gif"));  // the GIF's folder is created like the frames'
+    CHECK(fs::file_size(dir / "new" / "r.gif") > 200);
     requireOneLineError(runSplat({"rotate", "synthetic:blob:8", "--frames", "0", "-o", (dir / "z").string()}),
                         "--frames");
 }

@@ -47,7 +47,14 @@ void registerRotate(CLI::App& app) {
         if (!std::isfinite(a->from) || !std::isfinite(a->to)) throw Error("--from/--to must be finite");
         if (a->format != "png" && a->format != "exr" && a->format != "tif")
             throw Error("--format must be png, exr or tif");
-        if (!a->gif.empty()) checkImagePath(a->gif);
+        if (!a->gif.empty()) {
+            // Like the frames folder, the GIF's folder is created if needed.
+            const std::filesystem::path parent = std::filesystem::path(a->gif).parent_path();
+            std::error_code ec;
+            if (!parent.empty() && std::filesystem::path(a->gif).extension() == ".gif")
+                std::filesystem::create_directories(parent, ec);
+            checkImagePath(a->gif);
+        }
         const RenderSettings settings = settingsFromArgs(a->render);
         // The GIF is assembled in memory: keep it under 4 GiB of float frames.
         if (!a->gif.empty() && double(a->frames) * settings.camera.width * settings.camera.height > double(1 << 28))
