@@ -19,9 +19,9 @@ extern char** environ;
 namespace splat::test {
 
 struct RunResult {
-    int status = -1;   ///< exit code; 128 + signal number if killed by a signal
-    std::string out;   ///< everything written to stdout
-    std::string err;   ///< everything written to stderr
+    int status = -1;  ///< exit code; 128 + signal number if killed by a signal
+    std::string out;  ///< everything written to stdout
+    std::string err;  ///< everything written to stderr
     /// Non-empty lines of stderr.
     std::vector<std::string> errLines() const {
         std::vector<std::string> lines;
@@ -69,8 +69,10 @@ inline RunResult runSplat(const std::vector<std::string>& args) {
 
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 1, outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
     RunResult r;
     pid_t pid = 0;
     int rc = posix_spawn(&pid, SPLAT_EXE, &actions, nullptr, argv.data(), environ);
@@ -82,8 +84,10 @@ inline RunResult runSplat(const std::vector<std::string>& args) {
     int wstatus = 0;
     while (::waitpid(pid, &wstatus, 0) < 0) {
     }
-    if (WIFEXITED(wstatus)) r.status = WEXITSTATUS(wstatus);
-    else if (WIFSIGNALED(wstatus)) r.status = 128 + WTERMSIG(wstatus);
+    if (WIFEXITED(wstatus))
+        r.status = WEXITSTATUS(wstatus);
+    else if (WIFSIGNALED(wstatus))
+        r.status = 128 + WTERMSIG(wstatus);
     r.out = readTextFile(outPath);
     r.err = readTextFile(errPath);
     std::error_code ec;

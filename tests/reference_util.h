@@ -2,7 +2,6 @@
 // Test helpers around the reference ray caster: render the exact model for a volume and
 // settings, build splat lists by hand, and the closed forms of one kernel.
 #include <cmath>
-
 #include <glm/glm.hpp>
 
 #include "footprint/footprint_table.h"
@@ -39,8 +38,8 @@ inline Image referenceImage(const Volume& volume, RenderSettings settings,
                             RenderStats* stats = nullptr, Image* depth = nullptr) {
     if (settings.transfer.normalized) settings.transfer = resolvedFor(settings.transfer, volume);
     const footprint::Kernel kernel = kernelOf(settings);
-    const SplatList splats =
-        classify(volume, settings.transfer, settings.mode, settings.classification, kernel.radius());
+    const SplatList splats = classify(volume, settings.transfer, settings.mode,
+                                      settings.classification, kernel.radius());
     const Camera camera(settings.camera, volume);
     if (depth) *depth = renderReferenceDepth(volume, splats, kernel, camera, settings);
     return renderReference(volume, splats, kernel, camera, settings, stats);

@@ -54,13 +54,17 @@ TEST_CASE("splat info: bad input exits non-zero with one line on stderr", "[volu
     writeBytes(dir / "t_4x4x4_uint8.raw", std::string(10, 'x'));
     writeBytes(dir / "n_2x1x1_float32.raw", samples<float>({1.0, std::nan("")}));
     writeBytes(dir / "odd.xyz", "what");
-    writeBytes(dir / "gz.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\n"
-                                "encoding: gzip\n\nnot gzip at all");
+    writeBytes(dir / "gz.nrrd",
+               "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\n"
+               "encoding: gzip\n\nnot gzip at all");
     writeBytes(dir / "plain.raw", "xxxxxxxx");
     writeBytes(dir / "junk.nii", std::string(500, 'j'));
     auto before = std::distance(std::filesystem::directory_iterator(dir),
                                 std::filesystem::directory_iterator());
-    struct Case { std::vector<std::string> args; std::string expect; };
+    struct Case {
+        std::vector<std::string> args;
+        std::string expect;
+    };
     const std::string d = dir.string() + "/";
     std::vector<Case> cases = {
         {{"info", d + "missing.nii"}, "no such file or folder"},

@@ -2,7 +2,6 @@
 // hold the numbers the library computes; bad input gives one line, a non-zero status and
 // no output file.
 #include <catch2/catch.hpp>
-
 #include <filesystem>
 #include <fstream>
 
@@ -40,7 +39,8 @@ TEST_CASE("render writes an EXR equal to the library's image", "[cli]") {
     s.camera.azimuthDeg = 20;
     const Image lib = render(makeSynthetic("sphere", 24), s);
     REQUIRE(file.width == 32);
-    for (std::size_t n = 0; n < lib.pixels.size(); ++n) REQUIRE(file.pixels[n].r == lib.pixels[n].r);
+    for (std::size_t n = 0; n < lib.pixels.size(); ++n)
+        REQUIRE(file.pixels[n].r == lib.pixels[n].r);
 }
 
 TEST_CASE("a scene file sets options and flags override it", "[cli]") {
@@ -48,8 +48,8 @@ TEST_CASE("a scene file sets options and flags override it", "[cli]") {
     std::ofstream(dir / "scene.json") << R"({"renderer": "sheet", "slab": 0.5, "size": "24x16",
                                               "mode": "mip", "azimuth": 10})";
     const std::string out = (dir / "m.exr").string();
-    const RunResult r = runSplat({"render", "synthetic:blob:16", "--scene", (dir / "scene.json").string(),
-                                  "--size", "20x12", "-o", out});
+    const RunResult r = runSplat({"render", "synthetic:blob:16", "--scene",
+                                  (dir / "scene.json").string(), "--size", "20x12", "-o", out});
     INFO(r.err);
     REQUIRE(r.status == 0);
     CHECK(r.out.find("sheet mip") != std::string::npos);
@@ -57,24 +57,26 @@ TEST_CASE("a scene file sets options and flags override it", "[cli]") {
     CHECK(img.width == 20);
     CHECK(img.height == 12);
     std::ofstream(dir / "bad.json") << R"({"renderer": "sheet", "slabb": 1})";
-    requireOneLineError(runSplat({"render", "synthetic:blob:8", "--scene", (dir / "bad.json").string(),
-                                  "-o", (dir / "b.png").string()}),
+    requireOneLineError(runSplat({"render", "synthetic:blob:8", "--scene",
+                                  (dir / "bad.json").string(), "-o", (dir / "b.png").string()}),
                         "unknown scene key 'slabb'");
     CHECK(!fs::exists(dir / "b.png"));
 }
 
 TEST_CASE("rotate writes every frame and an animated GIF", "[cli]") {
     const fs::path dir = testTmpDir("cli_rotate");
-    const RunResult r = runSplat({"rotate", "synthetic:phantom:24", "--tf", "ct-soft", "--size", "24x24",
-                                  "--frames", "5", "-o", (dir / "frames").string(), "--gif",
-                                  (dir / "new" / "r.gif").string()});
+    const RunResult r = runSplat({"rotate", "synthetic:phantom:24", "--tf", "ct-soft", "--size",
+                                  "24x24", "--frames", "5", "-o", (dir / "frames").string(),
+                                  "--gif", (dir / "new" / "r.gif").string()});
     INFO(r.err);
     REQUIRE(r.status == 0);
-    for (int f = 0; f < 5; ++f) CHECK(fs::exists(dir / "frames" / ("frame_000" + std::to_string(f) + ".png")));
+    for (int f = 0; f < 5; ++f)
+        CHECK(fs::exists(dir / "frames" / ("frame_000" + std::to_string(f) + ".png")));
     REQUIRE(fs::exists(dir / "new" / "r.gif"));  // the GIF's folder is created like the frames'
     CHECK(fs::file_size(dir / "new" / "r.gif") > 200);
-    requireOneLineError(runSplat({"rotate", "synthetic:blob:8", "--frames", "0", "-o", (dir / "z").string()}),
-                        "--frames");
+    requireOneLineError(
+        runSplat({"rotate", "synthetic:blob:8", "--frames", "0", "-o", (dir / "z").string()}),
+        "--frames");
 }
 
 TEST_CASE("bench writes JSON with a run per thread count", "[cli]") {
@@ -119,10 +121,12 @@ TEST_CASE("render refuses bad options and outputs with one line and no file", "[
     }
     requireOneLineError(runSplat({"render", "synthetic:blob:8", "-o", (dir / "x.bmpx").string()}),
                         "unsupported image type");
-    requireOneLineError(runSplat({"render", "synthetic:blob:8", "-o", (dir / "nope" / "x.png").string()}),
-                        "does not exist");
+    requireOneLineError(
+        runSplat({"render", "synthetic:blob:8", "-o", (dir / "nope" / "x.png").string()}),
+        "does not exist");
     // Nothing but the scratch files of earlier cases is left in the folder.
-    for (const auto& e : fs::directory_iterator(dir)) CHECK(e.path().filename().string().find(".tmp") == std::string::npos);
+    for (const auto& e : fs::directory_iterator(dir))
+        CHECK(e.path().filename().string().find(".tmp") == std::string::npos);
 }
 
 TEST_CASE("compare reports zero error for identical images and a heat map", "[cli]") {

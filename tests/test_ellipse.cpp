@@ -1,8 +1,7 @@
 // Elliptical footprints (orthographic and EWA perspective) against brute-force line
 // integrals of the world-space kernel h(|S^-1 (x - x_i)|).
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -24,8 +23,8 @@ constexpr double kPi = 3.14159265358979323846;
 
 // Integral over t in [tA, tB] of h(|S^-1 (o + t w)|), o relative to the kernel centre
 // (world), w unit: composite Simpson over the part of the ray inside the support.
-double bruteLine(const Kernel& k, dvec3 sp, dvec3 o, dvec3 w, double tA = -1e300,
-                 double tB = 1e300, int n = 2000) {
+double bruteLine(const Kernel& k, dvec3 sp, dvec3 o, dvec3 w, double tA = -1e300, double tB = 1e300,
+                 int n = 2000) {
     const dvec3 u0 = o / sp, v = w / sp;
     const double vv = glm::dot(v, v), tc = -glm::dot(u0, v) / vv;
     const dvec3 uc = u0 + tc * v;
@@ -68,7 +67,8 @@ dvec3 randomSpacing(std::mt19937& rng, double ratio) {
 
 }  // namespace
 
-TEST_CASE("ellipse: orthographic footprint matches brute-force line integrals", "[footprint][ellipse]") {
+TEST_CASE("ellipse: orthographic footprint matches brute-force line integrals",
+          "[footprint][ellipse]") {
     const Kernel k = Kernel::defaultKernel();
     const FootprintTable fp(k);
     std::mt19937 rng(1234);
@@ -89,7 +89,8 @@ TEST_CASE("ellipse: orthographic footprint matches brute-force line integrals", 
             const EllipticalFootprint e = footprint::ellipticalFootprint(sp, ax, ay, w, k.radius());
             const double peak = e.scale * fp.peak();
             for (int i = 0; i < 25; ++i) {
-                const double dx = (2 * U(rng) - 1) * e.halfWidth, dy = (2 * U(rng) - 1) * e.halfHeight;
+                const double dx = (2 * U(rng) - 1) * e.halfWidth,
+                             dy = (2 * U(rng) - 1) * e.halfHeight;
                 const double table = e.scale * fp.lookup(e.r2(float(dx), float(dy)));
                 const double brute = bruteLine(k, sp, dx * ax + dy * ay, w);
                 worst = std::max(worst, std::abs(table - brute) / peak);
@@ -112,7 +113,8 @@ TEST_CASE("ellipse: bounding box is tight", "[footprint][ellipse]") {
         const dvec3 w = randomUnit(rng);
         dvec3 right, up;
         basis(w, right, up);
-        const EllipticalFootprint e = footprint::ellipticalFootprint(sp, right * 0.7, -up * 0.7, w, R);
+        const EllipticalFootprint e =
+            footprint::ellipticalFootprint(sp, right * 0.7, -up * 0.7, w, R);
         double mx = 0, my = 0;
         for (int i = 0; i < 20000; ++i) {
             const double th = 2 * kPi * i / 20000, c = std::cos(th), s = std::sin(th);
@@ -121,9 +123,9 @@ TEST_CASE("ellipse: bounding box is tight", "[footprint][ellipse]") {
             my = std::max(my, std::abs(rho * s));
         }
         INFO("trial " << trial);
-        CHECK(mx <= e.halfWidth * (1 + 1e-5));   // contains the whole ellipse
+        CHECK(mx <= e.halfWidth * (1 + 1e-5));  // contains the whole ellipse
         CHECK(my <= e.halfHeight * (1 + 1e-5));
-        CHECK(mx >= e.halfWidth * (1 - 1e-4));   // and touches it
+        CHECK(mx >= e.halfWidth * (1 - 1e-4));  // and touches it
         CHECK(my >= e.halfHeight * (1 - 1e-4));
         // The touching points: (halfWidth, -b/c halfWidth) and (-b/a halfHeight, halfHeight).
         const double dx = e.halfWidth, dy = -double(e.b) / e.c * dx;
@@ -133,7 +135,8 @@ TEST_CASE("ellipse: bounding box is tight", "[footprint][ellipse]") {
     }
 }
 
-TEST_CASE("ellipse: slab sections from tx, ty, depthScale match brute force", "[footprint][ellipse][slab]") {
+TEST_CASE("ellipse: slab sections from tx, ty, depthScale match brute force",
+          "[footprint][ellipse][slab]") {
     const Kernel k = Kernel::defaultKernel();
     const SlabTable slab(k);
     std::mt19937 rng(5);
@@ -157,8 +160,9 @@ TEST_CASE("ellipse: slab sections from tx, ty, depthScale match brute force", "[
             double t0 = (2 * U(rng) - 1) * tExtent, t1 = (2 * U(rng) - 1) * tExtent;
             if (t0 > t1) std::swap(t0, t1);
             const float r2 = e.r2(float(dx), float(dy));
-            const double table = e.scale * slab.section(r2, e.depth(float(t0), float(dx), float(dy)),
-                                                        e.depth(float(t1), float(dx), float(dy)));
+            const double table =
+                e.scale * slab.section(r2, e.depth(float(t0), float(dx), float(dy)),
+                                       e.depth(float(t1), float(dx), float(dy)));
             const double brute = bruteLine(k, sp, dx * ax + dy * ay, w, t0, t1);
             worst = std::max(worst, std::abs(table - brute) / peak);
         }
@@ -197,13 +201,16 @@ double perspectiveError(const Kernel& k, const FootprintTable& fp, double dist, 
     const EllipticalFootprint e = footprint::perspectiveFootprint(
         s.spacing, s.eye, s.right, s.up, s.forward, s.focal, s.pixelSize, s.centre, k.radius());
     const double peak = e.scale * fp.peak();
-    centreErr = std::abs(e.scale * fp.lookup(e.r2(0, 0)) - bruteLine(k, s.spacing, s.eye - s.centre, s.ray(0, 0))) / peak;
+    centreErr = std::abs(e.scale * fp.lookup(e.r2(0, 0)) -
+                         bruteLine(k, s.spacing, s.eye - s.centre, s.ray(0, 0))) /
+                peak;
     double worst = 0;
     for (int i = -10; i <= 10; ++i)
         for (int j = -10; j <= 10; ++j) {
             const double dx = e.halfWidth * i / 10, dy = e.halfHeight * j / 10;
             const double ewa = e.scale * fp.lookup(e.r2(float(dx), float(dy)));
-            const double exact = bruteLine(k, s.spacing, s.eye - s.centre, s.ray(dx, dy), -1e300, 1e300, 400);
+            const double exact =
+                bruteLine(k, s.spacing, s.eye - s.centre, s.ray(dx, dy), -1e300, 1e300, 400);
             worst = std::max(worst, std::abs(ewa - exact) / peak);
         }
     return worst;
@@ -235,17 +242,20 @@ TEST_CASE("ellipse: perspective footprint (EWA Jacobian)", "[footprint][ellipse]
 }
 
 TEST_CASE("ellipse: perspective culls splats behind the eye", "[footprint][ellipse]") {
-    const auto e = footprint::perspectiveFootprint(dvec3(1), dvec3(0), dvec3(1, 0, 0), dvec3(0, 0, 1),
-                                                   dvec3(0, 1, 0), 1, 0.01, dvec3(0, -5, 0), 2);
+    const auto e =
+        footprint::perspectiveFootprint(dvec3(1), dvec3(0), dvec3(1, 0, 0), dvec3(0, 0, 1),
+                                        dvec3(0, 1, 0), 1, 0.01, dvec3(0, -5, 0), 2);
     CHECK(e.scale == 0);
     CHECK(e.halfWidth == 0);
     CHECK(e.halfHeight == 0);
-    const auto f = footprint::perspectiveFootprint(dvec3(1), dvec3(0), dvec3(1, 0, 0), dvec3(0, 0, 1),
-                                                   dvec3(0, 1, 0), 1, 0.01, dvec3(0, 0, 3), 2);
+    const auto f =
+        footprint::perspectiveFootprint(dvec3(1), dvec3(0), dvec3(1, 0, 0), dvec3(0, 0, 1),
+                                        dvec3(0, 1, 0), 1, 0.01, dvec3(0, 0, 3), 2);
     CHECK(f.scale == 0);
-    CHECK_THROWS_AS(footprint::perspectiveFootprint(dvec3(1), dvec3(0), dvec3(1, 0, 0), dvec3(0, 0, 1),
-                                                    dvec3(0, 1, 0), 0, 0.01, dvec3(0, 5, 0), 2),
-                    std::invalid_argument);
+    CHECK_THROWS_AS(
+        footprint::perspectiveFootprint(dvec3(1), dvec3(0), dvec3(1, 0, 0), dvec3(0, 0, 1),
+                                        dvec3(0, 1, 0), 0, 0.01, dvec3(0, 5, 0), 2),
+        std::invalid_argument);
 }
 
 TEST_CASE("ellipse: view along an axis and at 45 degrees", "[footprint][ellipse]") {
@@ -253,7 +263,8 @@ TEST_CASE("ellipse: view along an axis and at 45 degrees", "[footprint][ellipse]
     const FootprintTable fp(k);
     const dvec3 sp(1, 2, 3);
     // Along +z with screen x = +x, screen y = -y: exact, axis-aligned ellipse.
-    const auto e = footprint::ellipticalFootprint(sp, dvec3(1, 0, 0), dvec3(0, -1, 0), dvec3(0, 0, 1), 2);
+    const auto e =
+        footprint::ellipticalFootprint(sp, dvec3(1, 0, 0), dvec3(0, -1, 0), dvec3(0, 0, 1), 2);
     CHECK(e.a == 1.0f);
     CHECK(e.b == 0.0f);
     CHECK(e.c == 0.25f);
@@ -277,7 +288,8 @@ TEST_CASE("ellipse: view along an axis and at 45 degrees", "[footprint][ellipse]
         for (double dx : {0.0, 0.3, -0.9, 1.4})
             for (double dy : {0.0, 0.5, -1.7}) {
                 const double brute = bruteLine(k, sp, dx * right - dy * up, w);
-                CHECK(std::abs(f.scale * fp.lookup(f.r2(float(dx), float(dy))) - brute) <= 1e-5 * peak);
+                CHECK(std::abs(f.scale * fp.lookup(f.r2(float(dx), float(dy))) - brute) <=
+                      1e-5 * peak);
             }
     }
 }
@@ -328,15 +340,16 @@ TEST_CASE("ellipse: spacing ratios up to 1:1000", "[footprint][ellipse]") {
             basis(w, right, up);
             const double px = 0.5 * std::min({sp.x, sp.y, sp.z});
             const auto e = footprint::ellipticalFootprint(sp, right * px, -up * px, w, 2);
-            for (float v : {e.a, e.b, e.c, e.beta, e.gamma, e.scale, e.halfWidth, e.halfHeight, e.depthScale,
-                            e.tx, e.ty})
+            for (float v : {e.a, e.b, e.c, e.beta, e.gamma, e.scale, e.halfWidth, e.halfHeight,
+                            e.depthScale, e.tx, e.ty})
                 CHECK(std::isfinite(v));
             CHECK(e.gamma > 0);
             const double peak = e.scale * fp.peak();
             for (int i = 0; i < 30; ++i) {
                 // Points along the ellipse's long axis are where a naive form would cancel.
                 const double s = 2 * U(rng) - 1;
-                const double dy = s * e.halfHeight, dx = -double(e.beta) * dy + (U(rng) - 0.5) * 0.2 * e.halfWidth;
+                const double dy = s * e.halfHeight,
+                             dx = -double(e.beta) * dy + (U(rng) - 0.5) * 0.2 * e.halfWidth;
                 const float r2 = e.r2(float(dx), float(dy));
                 CHECK(r2 >= 0.0f);
                 const double table = e.scale * fp.lookup(r2);
@@ -352,12 +365,18 @@ TEST_CASE("ellipse: spacing ratios up to 1:1000", "[footprint][ellipse]") {
 TEST_CASE("ellipse: invalid input", "[footprint][ellipse]") {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     const dvec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
-    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1, 0, 1), x, y, z, 2), std::invalid_argument);
-    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1, -1, 1), x, y, z, 2), std::invalid_argument);
-    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1, nan, 1), x, y, z, 2), std::invalid_argument);
-    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1), x, y, dvec3(0), 2), std::invalid_argument);
-    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1), x, z, z, 2), std::invalid_argument);  // axisY along the ray
-    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1), x, x, z, 2), std::invalid_argument);  // degenerate axes
+    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1, 0, 1), x, y, z, 2),
+                    std::invalid_argument);
+    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1, -1, 1), x, y, z, 2),
+                    std::invalid_argument);
+    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1, nan, 1), x, y, z, 2),
+                    std::invalid_argument);
+    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1), x, y, dvec3(0), 2),
+                    std::invalid_argument);
+    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1), x, z, z, 2),
+                    std::invalid_argument);  // axisY along the ray
+    CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1), x, x, z, 2),
+                    std::invalid_argument);  // degenerate axes
     CHECK_THROWS_AS(footprint::ellipticalFootprint(dvec3(1), x, y, z, 0), std::invalid_argument);
     // A non-unit ray direction is normalised.
     const auto a = footprint::ellipticalFootprint(dvec3(1, 2, 3), x, y, z, 2);

@@ -1,7 +1,6 @@
 // Footprint and slab tables against closed forms and direct quadrature.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -25,9 +24,9 @@ double gaussianFootprint(const Kernel& k, double r) {
     if (r >= R) return 0;
     const double L = std::sqrt(R * R - r * r);
     const double eR = std::exp(-R * R / (2 * s * s));
-    return k.normalisation() *
-           (s * std::sqrt(2 * kPi) * std::exp(-r * r / (2 * s * s)) * std::erf(L / (s * std::sqrt(2.0))) -
-            2 * L * eR - eR / (2 * s * s) * 4 * L * L * L / 3);
+    return k.normalisation() * (s * std::sqrt(2 * kPi) * std::exp(-r * r / (2 * s * s)) *
+                                    std::erf(L / (s * std::sqrt(2.0))) -
+                                2 * L * eR - eR / (2 * s * s) * 4 * L * L * L / 3);
 }
 
 // Closed-form C(r, z) of the C1-tapered Gaussian.
@@ -38,7 +37,8 @@ double gaussianCumulative(const Kernel& k, double r, double z) {
     z = std::clamp(z, -L, L);
     const double eR = std::exp(-R * R / (2 * s * s));
     const double q = 1 / (s * std::sqrt(2.0));
-    const double g = s * std::sqrt(kPi / 2) * std::exp(-r * r / (2 * s * s)) * (std::erf(z * q) + std::erf(L * q));
+    const double g = s * std::sqrt(kPi / 2) * std::exp(-r * r / (2 * s * s)) *
+                     (std::erf(z * q) + std::erf(L * q));
     const double lin = eR * (z + L);
     const double quad = eR / (2 * s * s) * (L * L * (z + L) - (z * z * z + L * L * L) / 3);
     return k.normalisation() * (g - lin - quad);
@@ -50,7 +50,8 @@ double maxTableError(const FootprintTable& t, int samples = 100000) {
     for (int i = 0; i <= samples; ++i) {
         // Sample uniformly in r^2 (where the table is linear) and include the knots.
         const double r2 = R * R * i / samples;
-        const double e = std::abs(t.lookup(float(r2)) - gaussianFootprint(t.kernel(), std::sqrt(r2)));
+        const double e =
+            std::abs(t.lookup(float(r2)) - gaussianFootprint(t.kernel(), std::sqrt(r2)));
         worst = std::max(worst, e);
     }
     return worst / t.peak();
@@ -59,8 +60,8 @@ double maxTableError(const FootprintTable& t, int samples = 100000) {
 }  // namespace
 
 TEST_CASE("footprint table: quadrature matches the closed form", "[footprint][table]") {
-    for (const Kernel& k : {Kernel::defaultKernel(), Kernel::gaussian(0.8, 2), Kernel::gaussian(0.6, 1.5),
-                            Kernel::gaussian(2, 2)}) {
+    for (const Kernel& k : {Kernel::defaultKernel(), Kernel::gaussian(0.8, 2),
+                            Kernel::gaussian(0.6, 1.5), Kernel::gaussian(2, 2)}) {
         const FootprintTable t(k, 16);
         for (double r : {0.0, 0.1, 0.5, 1.0, 1.3, 1.49, 1.9, 1.999, 2.0, 3.0}) {
             INFO(k.name() << " r=" << r);
@@ -71,8 +72,8 @@ TEST_CASE("footprint table: quadrature matches the closed form", "[footprint][ta
 
 TEST_CASE("footprint table: default resolution within 1e-6 of the peak", "[footprint][table]") {
     // Measured: default Gaussian 1.3e-7 of the peak at 4096 entries.
-    for (const Kernel& k : {Kernel::defaultKernel(), Kernel::gaussian(0.6, 2), Kernel::gaussian(0.8, 2),
-                            Kernel::gaussian(0.7, 1.5)}) {
+    for (const Kernel& k : {Kernel::defaultKernel(), Kernel::gaussian(0.6, 2),
+                            Kernel::gaussian(0.8, 2), Kernel::gaussian(0.7, 1.5)}) {
         const FootprintTable t(k);
         CHECK(t.resolution() == 4096);
         const double err = maxTableError(t);
@@ -81,7 +82,8 @@ TEST_CASE("footprint table: default resolution within 1e-6 of the peak", "[footp
     }
     // The error is second order in the resolution.
     const Kernel k = Kernel::defaultKernel();
-    const double e256 = maxTableError(FootprintTable(k, 256)), e1024 = maxTableError(FootprintTable(k, 1024));
+    const double e256 = maxTableError(FootprintTable(k, 256)),
+                 e1024 = maxTableError(FootprintTable(k, 1024));
     CHECK(e256 / e1024 > 12);
     CHECK(e256 / e1024 < 20);
 }
@@ -159,9 +161,11 @@ TEST_CASE("slab table: sections of any partition sum to the footprint", "[footpr
             cuts.push_back(float(R));
             std::sort(cuts.begin(), cuts.end());
             double sum = 0;
-            for (int i = 0; i + 1 < int(cuts.size()); ++i) sum += s.section(r2, cuts[i], cuts[i + 1]);
+            for (int i = 0; i + 1 < int(cuts.size()); ++i)
+                sum += s.section(r2, cuts[i], cuts[i + 1]);
             worst = std::max(worst, std::abs(sum - fp.lookup(r2)) / peak);
-            worstExact = std::max(worstExact, std::abs(sum - fp.exact(std::sqrt(double(r2)))) / peak);
+            worstExact =
+                std::max(worstExact, std::abs(sum - fp.exact(std::sqrt(double(r2)))) / peak);
         }
         INFO(k.name() << ": partition sum vs table " << worst << ", vs exact " << worstExact);
         CHECK(worst <= 1e-6);
@@ -176,7 +180,8 @@ TEST_CASE("slab table: C(r, R) equals the footprint table", "[footprint][slab]")
     for (int i = 0; i <= 20000; ++i) {
         const float r2 = float(4.0 * i / 20000);
         worst = std::max(worst, double(std::abs(s.cumulative(r2, 2.0f) - fp.lookup(r2))));
-        worst = std::max(worst, std::abs(s.cumulative(r2, 2.0f) - gaussianFootprint(s.kernel(), std::sqrt(double(r2)))));
+        worst = std::max(worst, std::abs(s.cumulative(r2, 2.0f) -
+                                         gaussianFootprint(s.kernel(), std::sqrt(double(r2)))));
     }
     INFO("C(r, R) vs footprint: " << worst / fp.peak());
     CHECK(worst / fp.peak() <= 1e-6);
@@ -211,7 +216,8 @@ TEST_CASE("slab table: single sections match direct quadrature", "[footprint][sl
 TEST_CASE("slab table: edges and bad input", "[footprint][slab]") {
     const SlabTable s(Kernel::defaultKernel());
     const float fp0 = s.footprint().peak();
-    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity(),
+                nan = std::numeric_limits<float>::quiet_NaN();
     CHECK(s.cumulative(0, -2.0f) == 0.0f);
     CHECK(s.cumulative(0, -7.0f) == 0.0f);
     CHECK(s.cumulative(0, -inf) == 0.0f);

@@ -1,6 +1,5 @@
 // Kernels: normalisation, shape, partition-of-unity ripple, parameter validation.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -29,11 +28,11 @@ double radialIntegral(const Kernel& k, int n = 20000) {
 // Closed-form normalisation of the C1-tapered Gaussian (see kernel.h).
 double gaussianNorm(double sigma, double R) {
     const double eR = std::exp(-R * R / (2 * sigma * sigma));
-    const double m = sigma * sigma * sigma *
-                         (std::sqrt(kPi / 2) * std::erf(R / (sigma * std::sqrt(2.0))) -
-                          R / sigma * eR) -
-                     eR * R * R * R / 3 -
-                     eR / (2 * sigma * sigma) * (R * R * R * R * R / 3 - R * R * R * R * R / 5);
+    const double m =
+        sigma * sigma * sigma *
+            (std::sqrt(kPi / 2) * std::erf(R / (sigma * std::sqrt(2.0))) - R / sigma * eR) -
+        eR * R * R * R / 3 -
+        eR / (2 * sigma * sigma) * (R * R * R * R * R / 3 - R * R * R * R * R / 5);
     return 1 / (4 * kPi * m);
 }
 
@@ -52,10 +51,10 @@ TEST_CASE("kernel defaults", "[footprint][kernel]") {
 }
 
 TEST_CASE("kernels integrate to one over R^3", "[footprint][kernel]") {
-    for (const Kernel& k : {Kernel::defaultKernel(), Kernel::gaussian(0.8, 2), Kernel::gaussian(0.6, 1.5),
-                            Kernel::gaussian(1.5, 3), Kernel::gaussian(0.05, 2),
-                            Kernel::gaussian(1e4, 2), Kernel::cubicBSpline(1.0),
-                            Kernel::cubicBSpline(0.7)}) {
+    for (const Kernel& k :
+         {Kernel::defaultKernel(), Kernel::gaussian(0.8, 2), Kernel::gaussian(0.6, 1.5),
+          Kernel::gaussian(1.5, 3), Kernel::gaussian(0.05, 2), Kernel::gaussian(1e4, 2),
+          Kernel::cubicBSpline(1.0), Kernel::cubicBSpline(0.7)}) {
         INFO(k.name());
         CHECK(radialIntegral(k) == Approx(1.0).epsilon(1e-9));
     }
@@ -64,14 +63,16 @@ TEST_CASE("kernels integrate to one over R^3", "[footprint][kernel]") {
             const Kernel k = Kernel::gaussian(sigma, R);
             INFO(k.name());
             // (the closed form cancels badly when sigma > R)
-            CHECK(k.normalisation() == Approx(gaussianNorm(sigma, R)).epsilon(sigma < R ? 1e-12 : 1e-9));
+            CHECK(k.normalisation() ==
+                  Approx(gaussianNorm(sigma, R)).epsilon(sigma < R ? 1e-12 : 1e-9));
         }
     }
     CHECK(Kernel::cubicBSpline(2.0).normalisation() == Approx(3 / (2 * kPi * 8)).epsilon(1e-15));
 }
 
 TEST_CASE("kernel shape: positive, decreasing, zero at and beyond R", "[footprint][kernel]") {
-    for (const Kernel& k : {Kernel::defaultKernel(), Kernel::cubicBSpline(), Kernel::gaussian(3, 2)}) {
+    for (const Kernel& k :
+         {Kernel::defaultKernel(), Kernel::cubicBSpline(), Kernel::gaussian(3, 2)}) {
         INFO(k.name());
         const double R = k.radius();
         double prev = k(0);
@@ -99,8 +100,9 @@ TEST_CASE("kernel shape: positive, decreasing, zero at and beyond R", "[footprin
     const double eR = std::exp(-4 / (2 * 0.65 * 0.65));
     for (double u : {0.0, 0.5, 1.0, 1.5}) {
         const double x = (4 - u * u) / (2 * 0.65 * 0.65);
-        CHECK(k(u) == Approx(k.normalisation() * (std::exp(-u * u / (2 * 0.65 * 0.65)) - eR * (1 + x)))
-                          .epsilon(1e-13));
+        CHECK(k(u) ==
+              Approx(k.normalisation() * (std::exp(-u * u / (2 * 0.65 * 0.65)) - eR * (1 + x)))
+                  .epsilon(1e-13));
     }
 }
 

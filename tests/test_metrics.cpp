@@ -1,13 +1,12 @@
 // Image metrics, heat maps and `splat compare`.
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <string>
-
-#include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "splat/error.h"
 #include "splat/image_io.h"
@@ -136,7 +135,8 @@ TEST_CASE("splat compare: metrics, JSON, heat map and bad input", "[metrics][cli
     CHECK(j["foreground_pixels"].get<int>() == 1);
     CHECK(fs::exists(heat));
     std::ifstream text(out);
-    const std::string printed((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
+    const std::string printed((std::istreambuf_iterator<char>(text)),
+                              std::istreambuf_iterator<char>());
     CHECK(printed.find("rmse") != std::string::npos);
     CHECK(printed.find("psnr") != std::string::npos);
 
@@ -152,7 +152,7 @@ TEST_CASE("splat compare: metrics, JSON, heat map and bad input", "[metrics][cli
     std::string line;
     std::getline(err, line);
     CHECK(line.find("sizes differ") != std::string::npos);
-    const std::string badScale = "\"" + exe + "\" compare \"" + a + "\" \"" + b +
-                                 "\" --scale -1 > \"" + out + "\" 2>&1";
+    const std::string badScale =
+        "\"" + exe + "\" compare \"" + a + "\" \"" + b + "\" --scale -1 > \"" + out + "\" 2>&1";
     CHECK(std::system(badScale.c_str()) != 0);
 }

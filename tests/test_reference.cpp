@@ -1,9 +1,8 @@
 // The reference ray caster against closed forms of the model (DESIGN.md, "The model").
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <vector>
-
-#include <catch2/catch.hpp>
 
 #include "footprint/footprint_table.h"
 #include "reference_util.h"
@@ -125,7 +124,8 @@ TEST_CASE("reference: dvr of a homogeneous cube, exact and against exp(-rho L)",
         const Image im = renderReference(v, splats, kernel, cam, s);
         for (int y = 2; y < im.height; y += 3)
             for (int x = 1; x < im.width; x += 3) {
-                const double T = std::exp(-exactOpticalDepth(v, splats, fp, cam.ray(x + 0.5, y + 0.5)));
+                const double T =
+                    std::exp(-exactOpticalDepth(v, splats, fp, cam.ray(x + 0.5, y + 0.5)));
                 REQUIRE(std::abs(im.at(x, y).a - (1.0 - T)) <= 1e-4 * (1.0 - T) + 1e-6);
                 REQUIRE(std::abs(im.at(x, y).g - colour.g * (1.0 - T)) <= 1e-4 * (1.0 - T) + 1e-6);
             }

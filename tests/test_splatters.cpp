@@ -1,7 +1,6 @@
 // The axis-aligned and image-aligned splatters against closed forms, invariants and the
 // reference ray caster (issues: render core, image-aligned splatter, reference).
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstring>
 
@@ -22,7 +21,8 @@ TransferFunction flatTf(float alpha, glm::vec3 colour = glm::vec3(1.0f), float l
                         float hi = 1.0f) {
     TransferFunction tf;
     tf.name = "flat";
-    tf.points = {{lo, glm::vec4(colour, 0.0f)}, {lo + 1e-3f * (hi - lo), glm::vec4(colour, alpha)},
+    tf.points = {{lo, glm::vec4(colour, 0.0f)},
+                 {lo + 1e-3f * (hi - lo), glm::vec4(colour, alpha)},
                  {hi, glm::vec4(colour, alpha)}};
     return tf;
 }
@@ -88,7 +88,8 @@ TEST_CASE("xray of the synthetic sphere is its chord length", "[splatter]") {
                     worst = std::max(worst, rel);
                     ++count;
                 }
-            INFO(toString(r) << " azimuth " << az << ": mean rel " << sumRel / count << " worst " << worst);
+            INFO(toString(r) << " azimuth " << az << ": mean rel " << sumRel / count << " worst "
+                             << worst);
             REQUIRE(count > 500);
             CHECK(sumRel / count < 0.01);
             CHECK(worst < 0.03);  // the voxelised ball's staircase
@@ -196,7 +197,8 @@ TEST_CASE("front-to-back equals back-to-front, and any thread count gives the sa
             double worst = 0;
             for (std::size_t n = 0; n < btf.pixels.size(); ++n)
                 for (int ch = 0; ch < 4; ++ch)
-                    worst = std::max(worst, double(std::abs(btf.pixels[n][ch] - ftb1.pixels[n][ch])));
+                    worst =
+                        std::max(worst, double(std::abs(btf.pixels[n][ch] - ftb1.pixels[n][ch])));
             INFO(toString(r) << (c == Classification::Pre ? " pre" : " post"));
             CHECK(worst < 1e-5);
         }
@@ -234,7 +236,8 @@ TEST_CASE("opacity 0 gives the background exactly; opacity 1 stays finite", "[sp
             const Image opaque = render(v, s);
             bool finite = true;
             for (const auto& p : opaque.pixels)
-                for (int ch = 0; ch < 4; ++ch) finite = finite && std::isfinite(p[ch]) && p[ch] <= 1.0f + 1e-6f;
+                for (int ch = 0; ch < 4; ++ch)
+                    finite = finite && std::isfinite(p[ch]) && p[ch] <= 1.0f + 1e-6f;
             CHECK(finite);
             CHECK(opaque.at(16, 16).a > 0.999f);
         }
@@ -343,7 +346,8 @@ TEST_CASE("splatters against the reference ray caster", "[splatter][accuracy]") 
         for (double slab : {2.0, 1.0, 0.5, 0.25}) {
             s.slab = slab;
             const ImageMetrics sheet = compareImages(render(v, s), ref);
-            INFO(c.volume << " sheet slab " << slab << " rmse " << sheet.rmse << " (axis " << axis.rmse << ")");
+            INFO(c.volume << " sheet slab " << slab << " rmse " << sheet.rmse << " (axis "
+                          << axis.rmse << ")");
             CHECK(sheet.rmse < c.sheetBound);
             if (c.converges) CHECK(sheet.rmse < previous);  // converges as the slab thins
             previous = sheet.rmse;

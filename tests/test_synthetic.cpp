@@ -1,7 +1,6 @@
 // Synthetic volumes: deterministic, right sizes, the phantom's densities where Kak &
 // Slaney put them, the sphere's volume.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "splat/synthetic.h"

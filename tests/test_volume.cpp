@@ -34,20 +34,34 @@ TEST_CASE("makeVolume validates dimensions and spacing", "[volume]") {
     CHECK(v.data[23] == 0.0f);
     CHECK(v.index(1, 2, 3) == 23);
 
-    CHECK_THAT(errorOf([] { makeVolume({0, 3, 4}, {1, 1, 1}, "vol.raw"); }),
+    CHECK_THAT(errorOf([] {
+                   makeVolume({0, 3, 4}, {1, 1, 1}, "vol.raw");
+               }),
                Catch::StartsWith("vol.raw: invalid dimensions 0 x 3 x 4"));
-    CHECK_THAT(errorOf([] { makeVolume({2, -3, 4}, {1, 1, 1}, "v"); }),
+    CHECK_THAT(errorOf([] {
+                   makeVolume({2, -3, 4}, {1, 1, 1}, "v");
+               }),
                Catch::Contains("y must be at least 1"));
     // More than 2^32 voxels is refused, and the product is computed without overflow.
-    CHECK_THAT(errorOf([] { makeVolume({65536, 65536, 65536}, {1, 1, 1}, "big"); }),
+    CHECK_THAT(errorOf([] {
+                   makeVolume({65536, 65536, 65536}, {1, 1, 1}, "big");
+               }),
                Catch::Contains("too large"));
-    CHECK_THAT(errorOf([] { makeVolume({2147483647, 2147483647, 2147483647}, {1, 1, 1}, "big"); }),
+    CHECK_THAT(errorOf([] {
+                   makeVolume({2147483647, 2147483647, 2147483647}, {1, 1, 1}, "big");
+               }),
                Catch::Contains("too large"));
-    CHECK_THAT(errorOf([] { makeVolume({2, 2, 2}, {1, 0, 1}, "s"); }),
+    CHECK_THAT(errorOf([] {
+                   makeVolume({2, 2, 2}, {1, 0, 1}, "s");
+               }),
                Catch::Contains("invalid spacing"));
-    CHECK_THAT(errorOf([] { makeVolume({2, 2, 2}, {1, 1, -2}, "s"); }),
+    CHECK_THAT(errorOf([] {
+                   makeVolume({2, 2, 2}, {1, 1, -2}, "s");
+               }),
                Catch::Contains("invalid spacing"));
-    CHECK_THAT(errorOf([] { makeVolume({2, 2, 2}, {std::nan(""), 1, 1}, "s"); }),
+    CHECK_THAT(errorOf([] {
+                   makeVolume({2, 2, 2}, {std::nan(""), 1, 1}, "s");
+               }),
                Catch::Contains("invalid spacing"));
 }
 
@@ -85,9 +99,12 @@ TEST_CASE("writers round-trip through the loaders", "[volume]") {
         DYNAMIC_SECTION(name) {
             std::string path = (dir / name).string();
             std::string ext = std::string(name).substr(1);
-            if (ext.rfind(".nii", 0) == 0) saveNifti(path, v);
-            else if (ext == ".nrrd") saveNrrd(path, v);
-            else saveMetaImage(path, v);
+            if (ext.rfind(".nii", 0) == 0)
+                saveNifti(path, v);
+            else if (ext == ".nrrd")
+                saveNrrd(path, v);
+            else
+                saveMetaImage(path, v);
             Volume w = loadVolume(path);
             requireSame(v, w);
             CHECK(w.note.empty());

@@ -1,7 +1,6 @@
 // Bad input: every failure is a splat::Error with one line naming the file and the
 // problem, and NaN/Inf samples follow the chosen policy.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <limits>
 
@@ -42,20 +41,22 @@ TEST_CASE("load errors name the file and the problem", "[volume]") {
                "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n" +
                    std::string(10, '\0'));
     CHECK_THAT(loadError(path("short.nrrd")), Catch::Contains("expected 32 bytes, found 10"));
-    writeBytes(path("short.mha"), "NDims = 3\nDimSize = 2 2 2\nElementType = MET_SHORT\n"
-                                  "ElementDataFile = LOCAL\n" + std::string(6, '\0'));
+    writeBytes(path("short.mha"),
+               "NDims = 3\nDimSize = 2 2 2\nElementType = MET_SHORT\n"
+               "ElementDataFile = LOCAL\n" +
+                   std::string(6, '\0'));
     CHECK_THAT(loadError(path("short.mha")), Catch::Contains("expected 16 bytes, found 6"));
 
     // Dimensions: zero, negative, overflowing.
     writeBytes(path("zero.nrrd"),
                "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 0 2 2\nencoding: raw\n\n");
     CHECK_THAT(loadError(path("zero.nrrd")), Catch::Contains("invalid NRRD sizes"));
-    writeBytes(path("neg.mha"), "NDims = 3\nDimSize = 2 -2 2\nElementType = MET_UCHAR\n"
-                                "ElementDataFile = LOCAL\n");
+    writeBytes(path("neg.mha"),
+               "NDims = 3\nDimSize = 2 -2 2\nElementType = MET_UCHAR\n"
+               "ElementDataFile = LOCAL\n");
     CHECK_THAT(loadError(path("neg.mha")), Catch::Contains("invalid MetaImage DimSize"));
     writeBytes(path("big_100000x100000x100000_uint8.raw"), "x");
-    CHECK_THAT(loadError(path("big_100000x100000x100000_uint8.raw")),
-               Catch::Contains("too large"));
+    CHECK_THAT(loadError(path("big_100000x100000x100000_uint8.raw")), Catch::Contains("too large"));
     LoadOptions zero;
     zero.raw.dims = glm::ivec3(0, 4, 4);
     zero.raw.type = "uint8";
@@ -66,8 +67,9 @@ TEST_CASE("load errors name the file and the problem", "[volume]") {
     // Unsupported types.
     writeBytes(path("block.nrrd"), "NRRD0004\ntype: block\ndimension: 3\nsizes: 2 2 2\n\n");
     CHECK(loadError(path("block.nrrd")) == path("block.nrrd") + ": unsupported NRRD type 'block'");
-    writeBytes(path("vec.mha"), "NDims = 3\nDimSize = 2 2 2\nElementType = MET_LONG_LONG\n"
-                                "ElementDataFile = LOCAL\n");
+    writeBytes(path("vec.mha"),
+               "NDims = 3\nDimSize = 2 2 2\nElementType = MET_LONG_LONG\n"
+               "ElementDataFile = LOCAL\n");
     CHECK_THAT(loadError(path("vec.mha")), Catch::Contains("unsupported MetaImage ElementType"));
     LoadOptions badType;
     badType.raw.dims = glm::ivec3(2, 2, 2);
@@ -76,19 +78,24 @@ TEST_CASE("load errors name the file and the problem", "[volume]") {
                Catch::Contains("unsupported sample type 'complex64'"));
 
     // Corrupt gzip data.
-    writeBytes(path("gz.nrrd"), "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\n"
-                                "encoding: gzip\n\n\x1f\x8b\x08\x00garbage-not-deflate");
-    CHECK_THAT(loadError(path("gz.nrrd")), Catch::StartsWith(path("gz.nrrd") + ": corrupt gzip data"));
-    writeBytes(path("gz.mha"), "NDims = 3\nDimSize = 2 2 2\nElementType = MET_FLOAT\n"
-                               "CompressedData = True\nElementDataFile = LOCAL\nxxxxxxxx");
+    writeBytes(path("gz.nrrd"),
+               "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\n"
+               "encoding: gzip\n\n\x1f\x8b\x08\x00garbage-not-deflate");
+    CHECK_THAT(loadError(path("gz.nrrd")),
+               Catch::StartsWith(path("gz.nrrd") + ": corrupt gzip data"));
+    writeBytes(path("gz.mha"),
+               "NDims = 3\nDimSize = 2 2 2\nElementType = MET_FLOAT\n"
+               "CompressedData = True\nElementDataFile = LOCAL\nxxxxxxxx");
     CHECK_THAT(loadError(path("gz.mha")), Catch::Contains("corrupt gzip data"));
 
     // Missing detached data file, unreadable NIfTI.
-    writeBytes(path("det.nhdr"), "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\n"
-                                 "encoding: raw\ndata file: missing.raw\n");
+    writeBytes(path("det.nhdr"),
+               "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\n"
+               "encoding: raw\ndata file: missing.raw\n");
     CHECK_THAT(loadError(path("det.nhdr")), Catch::Contains("missing.raw does not exist"));
     writeBytes(path("bad.nii"), std::string(400, 'z'));
-    CHECK_THAT(loadError(path("bad.nii")), Catch::StartsWith(path("bad.nii") + ": not a readable NIfTI-1"));
+    CHECK_THAT(loadError(path("bad.nii")),
+               Catch::StartsWith(path("bad.nii") + ": not a readable NIfTI-1"));
     writeBytes(path("magic.nrrd"), "NOTNRRD\n");
     CHECK_THAT(loadError(path("magic.nrrd")), Catch::Contains("not a NRRD file"));
     // An empty folder is not a volume.

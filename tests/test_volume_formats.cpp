@@ -2,13 +2,12 @@
 // or oblique sform, NRRD (attached, detached .nhdr, gzip, big-endian, text, space
 // directions), MetaImage (.mhd/.mha, compressed, MSB), raw by name and by options,
 // PNG slice folders in natural order and a DICOM series.
-#include <catch2/catch.hpp>
-
-#include <cmath>
-
 #include <OpenImageIO/imageio.h>
 #include <nifti/nifti1.h>
 #include <zlib.h>
+
+#include <catch2/catch.hpp>
+#include <cmath>
 
 #include "splat/volume_io.h"
 #include "test_volume_util.h"
@@ -35,8 +34,8 @@ std::string deflateBytes(const std::string& in, bool gzip) {
 }
 
 // A NIfTI-1 single-file image with int16 samples, scaling and the given sform rows.
-std::string niftiFile(glm::ivec3 dims, const std::vector<double>& values, float slope,
-                      float inter, const float srow[3][4], int sformCode = 1) {
+std::string niftiFile(glm::ivec3 dims, const std::vector<double>& values, float slope, float inter,
+                      const float srow[3][4], int sformCode = 1) {
     nifti_1_header h;
     std::memset(&h, 0, sizeof h);
     h.sizeof_hdr = 348;
@@ -49,8 +48,8 @@ std::string niftiFile(glm::ivec3 dims, const std::vector<double>& values, float 
     h.bitpix = 16;
     h.pixdim[0] = 1;
     for (int a = 0; a < 3; ++a)
-        h.pixdim[a + 1] = std::sqrt(srow[0][a] * srow[0][a] + srow[1][a] * srow[1][a] +
-                                    srow[2][a] * srow[2][a]);
+        h.pixdim[a + 1] =
+            std::sqrt(srow[0][a] * srow[0][a] + srow[1][a] * srow[1][a] + srow[2][a] * srow[2][a]);
     h.vox_offset = 352;
     h.scl_slope = slope;
     h.scl_inter = inter;
@@ -154,7 +153,8 @@ TEST_CASE("NRRD: detached .nhdr with gzip data, spacings, type aliases", "[volum
     CHECK(t.data == std::vector<float>{1.5f, 2.5f, -3.0f, 40.0f});
     writeBytes(dir / "us.nrrd",
                "NRRD0004\ntype: unsigned short int\ndimension: 3\nsizes: 2 2 1\nendian: little\n"
-               "encoding: raw\n\n" + samples<std::uint16_t>({1, 60000, 3, 4}));
+               "encoding: raw\n\n" +
+                   samples<std::uint16_t>({1, 60000, 3, 4}));
     CHECK(loadVolume((dir / "us.nrrd").string()).data[1] == 60000.0f);
 }
 
@@ -173,23 +173,25 @@ TEST_CASE("MetaImage: .mhd with separate data, compressed .mha, MSB", "[volume]"
     for (std::size_t i = 0; i < values.size(); ++i) REQUIRE(v.data[i] == float(values[i]));
 
     std::string packed = deflateBytes(samples<double>(values), false);
-    writeBytes(dir / "c.mha", "ObjectType = Image\nNDims = 3\nDimSize = 5 3 2\n"
-                              "ElementType = MET_DOUBLE\nCompressedData = True\n"
-                              "CompressedDataSize = " + std::to_string(packed.size()) +
-                                  "\nElementDataFile = LOCAL\n" + packed);
+    writeBytes(dir / "c.mha",
+               "ObjectType = Image\nNDims = 3\nDimSize = 5 3 2\n"
+               "ElementType = MET_DOUBLE\nCompressedData = True\n"
+               "CompressedDataSize = " +
+                   std::to_string(packed.size()) + "\nElementDataFile = LOCAL\n" + packed);
     Volume c = loadVolume((dir / "c.mha").string());
     REQUIRE(c.dims == glm::ivec3(5, 3, 2));
     CHECK(c.data[29] == 29.0f);
     CHECK_THAT(c.source, Catch::Contains("compressed"));
 
-    for (const char* t : {"MET_UCHAR", "MET_CHAR", "MET_USHORT", "MET_INT", "MET_UINT", "MET_FLOAT"}) {
+    for (const char* t :
+         {"MET_UCHAR", "MET_CHAR", "MET_USHORT", "MET_INT", "MET_UINT", "MET_FLOAT"}) {
         std::string type = t;
-        std::string data = type == "MET_UCHAR" ? samples<std::uint8_t>(ramp(8))
-                         : type == "MET_CHAR" ? samples<std::int8_t>(ramp(8))
-                         : type == "MET_USHORT" ? samples<std::uint16_t>(ramp(8))
-                         : type == "MET_INT" ? samples<std::int32_t>(ramp(8))
-                         : type == "MET_UINT" ? samples<std::uint32_t>(ramp(8))
-                                              : samples<float>(ramp(8));
+        std::string data = type == "MET_UCHAR"    ? samples<std::uint8_t>(ramp(8))
+                           : type == "MET_CHAR"   ? samples<std::int8_t>(ramp(8))
+                           : type == "MET_USHORT" ? samples<std::uint16_t>(ramp(8))
+                           : type == "MET_INT"    ? samples<std::int32_t>(ramp(8))
+                           : type == "MET_UINT"   ? samples<std::uint32_t>(ramp(8))
+                                                  : samples<float>(ramp(8));
         writeBytes(dir / "t.mha", "NDims = 3\nDimSize = 2 2 2\nElementType = " + type +
                                       "\nElementDataFile = LOCAL\n" + data);
         CHECK(loadVolume((dir / "t.mha").string()).data[7] == 7.0f);
@@ -230,7 +232,8 @@ TEST_CASE("slice folder: PNG slices in natural sort order", "[volume]") {
     for (int s = 1; s <= n; ++s) {
         std::vector<unsigned char> px(std::size_t(w * h));
         for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) px[std::size_t(y * w + x)] = static_cast<unsigned char>(s * 10 + x);
+            for (int x = 0; x < w; ++x)
+                px[std::size_t(y * w + x)] = static_cast<unsigned char>(s * 10 + x);
         auto out = OIIO::ImageOutput::create("png");
         REQUIRE(out);
         std::string name = (dir / ("slice" + std::to_string(s) + ".png")).string();
@@ -261,8 +264,10 @@ std::string dicomElement(std::uint16_t g, std::uint16_t e, const char* vr, std::
     if (value.size() % 2) value += std::string(vr) == "UI" ? '\0' : ' ';
     std::string s = bytesOf(g) + bytesOf(e) + vr;
     std::string v(vr);
-    if (v == "OB" || v == "OW") s += bytesOf(std::uint16_t(0)) + bytesOf(std::uint32_t(value.size()));
-    else s += bytesOf(std::uint16_t(value.size()));
+    if (v == "OB" || v == "OW")
+        s += bytesOf(std::uint16_t(0)) + bytesOf(std::uint32_t(value.size()));
+    else
+        s += bytesOf(std::uint16_t(value.size()));
     return s + value;
 }
 

@@ -56,9 +56,8 @@ EllipticalFootprint ellipticalFootprint(const glm::dvec3& spacing, const glm::dv
 
 EllipticalFootprint perspectiveFootprint(const glm::dvec3& spacing, const glm::dvec3& eye,
                                          const glm::dvec3& right, const glm::dvec3& up,
-                                         const glm::dvec3& forward, double focal,
-                                         double pixelSize, const glm::dvec3& centre,
-                                         double radius) {
+                                         const glm::dvec3& forward, double focal, double pixelSize,
+                                         const glm::dvec3& centre, double radius) {
     if (!std::isfinite(focal) || !(focal > 0) || !std::isfinite(pixelSize) || !(pixelSize > 0))
         throw std::invalid_argument("perspectiveFootprint: focal and pixelSize must be > 0");
     const glm::dvec3 d = centre - eye;

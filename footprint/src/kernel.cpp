@@ -61,8 +61,10 @@ Kernel Kernel::defaultKernel() { return gaussian(kDefaultSigma, kDefaultRadius);
 
 Kernel Kernel::gaussian(double sigma, double radius) {
     if (!std::isfinite(sigma) || !(sigma > 0))
-        throw std::invalid_argument("gaussian kernel: sigma must be a positive finite number "
-                                    "of voxels, got " + num(sigma));
+        throw std::invalid_argument(
+            "gaussian kernel: sigma must be a positive finite number "
+            "of voxels, got " +
+            num(sigma));
     if (!std::isfinite(radius) || !(radius >= 0.5) || !(radius <= kMaxRadius))
         throw std::invalid_argument("gaussian kernel: radius must be in [0.5, 64] voxels, got " +
                                     num(radius));
@@ -90,8 +92,10 @@ Kernel Kernel::gaussian(double sigma, double radius) {
 
 Kernel Kernel::cubicBSpline(double scale) {
     if (!std::isfinite(scale) || !(scale >= 0.25) || !(scale <= 32.0))
-        throw std::invalid_argument("bspline kernel: scale must be in [0.25, 32] voxels "
-                                    "(radius = 2 scale), got " + num(scale));
+        throw std::invalid_argument(
+            "bspline kernel: scale must be in [0.25, 32] voxels "
+            "(radius = 2 scale), got " +
+            num(scale));
     Kernel k;
     k.type_ = KernelType::CubicBSpline;
     k.sigma_ = scale;

@@ -69,7 +69,8 @@ double SlabTable::exact(double r, double z) const {
     const double L = std::sqrt((R - r) * (R + r));
     const Kernel& k = kernel_;
     const double s = k.sigma();
-    const double zk = (k.type() == KernelType::CubicBSpline && r < s) ? std::sqrt(s * s - r2) : -2 * R;
+    const double zk =
+        (k.type() == KernelType::CubicBSpline && r < s) ? std::sqrt(s * s - r2) : -2 * R;
     auto f = [&](double t) { return k(std::sqrt(r2 + t * t)); };
     return detail::integrateSplit(f, -L, std::min(z, L), {-zk, 0.0, zk}, 1e-14 * k(0.0) * R);
 }

@@ -4,10 +4,11 @@
 // of its slice, and sheets are composited in visibility order. When the major axis
 // changes (e.g. at 45 degrees) the sheets change orientation: that is the popping
 // artifact the image-aligned splatter removes.
+#include "axis_splatter.h"
+
 #include <chrono>
 #include <cmath>
 
-#include "axis_splatter.h"
 #include "tile_binning.h"
 
 namespace splat {
@@ -24,7 +25,8 @@ Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats
     const auto start = std::chrono::steady_clock::now();
     const SplatList& s = in.splats;
     const int m = majorAxis(in.camera.view);
-    const bool ascending = (in.camera.view[m] >= 0) == (in.settings.order == CompositeOrder::FrontToBack);
+    const bool ascending =
+        (in.camera.view[m] >= 0) == (in.settings.order == CompositeOrder::FrontToBack);
     const std::vector<std::uint16_t>& index = m == 0 ? s.i : (m == 1 ? s.j : s.k);
 
     // Visiting order: by slice, in visibility order for the compositing direction. The
@@ -46,41 +48,42 @@ Image renderAxis(const FrameInputs& in, const ProjectedSplats& proj, RenderStats
     const footprint::FootprintTable& table = in.table;
 
     if (stats) stats->binMs = msSince(start);
-    return renderTiles<NCh>(in, bins, pathScale, stats,
-                            [&](int t, TileAccumulator& acc, const float* tileScale,
-                                TileCounters& cnt) {
-        const int ox = (t % bins.grid.tilesX) * bins.grid.tileSize;
-        const int oy = (t / bins.grid.tilesX) * bins.grid.tileSize;
-        SheetBuffer<NCh> sheet(ox, oy, acc.width(), acc.height());
-        int current = -1;
-        for (std::uint32_t n = bins.begin[t]; n < bins.begin[t + 1]; ++n) {
-            const std::uint32_t id = bins.splats[n];
-            if (index[id] != current) {
-                if (sheet.dirty()) {
-                    sheet.flush(acc, model, pathLength, tileScale);
-                    ++cnt.sheets;
+    return renderTiles<NCh>(
+        in, bins, pathScale, stats,
+        [&](int t, TileAccumulator& acc, const float* tileScale, TileCounters& cnt) {
+            const int ox = (t % bins.grid.tilesX) * bins.grid.tileSize;
+            const int oy = (t / bins.grid.tilesX) * bins.grid.tileSize;
+            SheetBuffer<NCh> sheet(ox, oy, acc.width(), acc.height());
+            int current = -1;
+            for (std::uint32_t n = bins.begin[t]; n < bins.begin[t + 1]; ++n) {
+                const std::uint32_t id = bins.splats[n];
+                if (index[id] != current) {
+                    if (sheet.dirty()) {
+                        sheet.flush(acc, model, pathLength, tileScale);
+                        ++cnt.sheets;
+                    }
+                    current = index[id];
+                    if (acc.allOpaque()) {
+                        cnt.culled += bins.begin[t + 1] - n;
+                        break;
+                    }
                 }
-                current = index[id];
-                if (acc.allOpaque()) {
-                    cnt.culled += bins.begin[t + 1] - n;
-                    break;
+                const PixelRect r = clipToTile(proj.rect[id], bins.grid, t);
+                if (acc.rectOpaque(r.x0 - ox, r.y0 - oy, r.x1 - ox, r.y1 - oy)) {
+                    ++cnt.culled;
+                    continue;
                 }
+                const footprint::EllipticalFootprint& e = proj.ellipse(id);
+                float v[NCh];
+                splatValues<NCh>(in, id, v);
+                cnt.footprintPixels +=
+                    sheet.splatFootprint(v, proj.sx[id], proj.sy[id], e, r, table, in.poly);
             }
-            const PixelRect r = clipToTile(proj.rect[id], bins.grid, t);
-            if (acc.rectOpaque(r.x0 - ox, r.y0 - oy, r.x1 - ox, r.y1 - oy)) {
-                ++cnt.culled;
-                continue;
+            if (sheet.dirty()) {
+                sheet.flush(acc, model, pathLength, tileScale);
+                ++cnt.sheets;
             }
-            const footprint::EllipticalFootprint& e = proj.ellipse(id);
-            float v[NCh];
-            splatValues<NCh>(in, id, v);
-            cnt.footprintPixels += sheet.splatFootprint(v, proj.sx[id], proj.sy[id], e, r, table, in.poly);
-        }
-        if (sheet.dirty()) {
-            sheet.flush(acc, model, pathLength, tileScale);
-            ++cnt.sheets;
-        }
-    });
+        });
 }
 
 }  // namespace

@@ -1,12 +1,12 @@
 // Classification: voxels -> splat list, keeping only the voxels the scene needs.
 #include "splat/classify.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "splat/error.h"
 
@@ -71,17 +71,21 @@ void shadeEmission(const SplatList& s, const Shading& sh, const glm::dvec3& view
     b.resize(n);
     const glm::vec3 l = -glm::vec3(view);
     const bool hasNormals = s.nx.size() == n;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t q = range.begin(); q != range.end(); ++q) {
-            const float c = hasNormals ? std::abs(s.nx[q] * l.x + s.ny[q] * l.y + s.nz[q] * l.z) : 1.0f;
-            const float diffuse = sh.ambient + sh.diffuse * c;
-            const float spec = c > 0.0f ? sh.specular * std::exp(sh.shininess * std::log(c)) * s.extinction[q] : 0.0f;
-            r[q] = s.r[q] * diffuse + spec;
-            g[q] = s.g[q] * diffuse + spec;
-            b[q] = s.b[q] * diffuse + spec;
-        }
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, 8192),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t q = range.begin(); q != range.end(); ++q) {
+                const float c =
+                    hasNormals ? std::abs(s.nx[q] * l.x + s.ny[q] * l.y + s.nz[q] * l.z) : 1.0f;
+                const float diffuse = sh.ambient + sh.diffuse * c;
+                const float spec =
+                    c > 0.0f ? sh.specular * std::exp(sh.shininess * std::log(c)) * s.extinction[q]
+                             : 0.0f;
+                r[q] = s.r[q] * diffuse + spec;
+                g[q] = s.g[q] * diffuse + spec;
+                b[q] = s.b[q] * diffuse + spec;
+            }
+        });
 }
 
 std::size_t SplatList::bytes() const {
@@ -93,7 +97,8 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
     const glm::ivec3 d = volume.dims;
     if (d.x > 65535 || d.y > 65535 || d.z > 65535)
         throw Error("volume dimension above 65535 is not supported by the splat list");
-    if (tf.normalized) throw Error("internal: transfer function must be resolved before classification");
+    if (tf.normalized)
+        throw Error("internal: transfer function must be resolved before classification");
 
     const bool usesTf = mode == RenderMode::Dvr;
     const bool pre = usesTf && classification == Classification::Pre;

@@ -13,9 +13,12 @@ constexpr int kBlock = 4;  // early-termination granularity, pixels (64 blocks p
 
 TileAccumulator::TileAccumulator(int width, int height, CompositeOrder order,
                                  double earlyTermination)
-    : w_(width), h_(height), order_(order),
+    : w_(width),
+      h_(height),
+      order_(order),
       terminates_(order == CompositeOrder::FrontToBack && earlyTermination > 0),
-      threshold_(float(1.0 - earlyTermination)), blocksX_((width + kBlock - 1) / kBlock),
+      threshold_(float(1.0 - earlyTermination)),
+      blocksX_((width + kBlock - 1) / kBlock),
       blocksY_((height + kBlock - 1) / kBlock) {
     if (blocksX_ * blocksY_ > 64) throw Error("tile size above 64 pixels is not supported");
     allBlocks_ = blocksX_ * blocksY_ == 64 ? ~std::uint64_t(0)

@@ -26,7 +26,7 @@ inline Sample sampleFromOpticalDepth(float tau, float er, float eg, float eb) {
 /// Compositing state of one tile: premultiplied colour and opacity (b in DESIGN.md) for
 /// dvr; for mip the running maximum and for xray the running sum, both in r.
 class TileAccumulator {
-public:
+  public:
     TileAccumulator(int width, int height, CompositeOrder order, double earlyTermination);
 
     int width() const { return w_; }
@@ -63,7 +63,7 @@ public:
     /// xray write the value to r, g, b with alpha 1.
     void resolve(Image& image, int ox, int oy, RenderMode mode, const glm::vec4& background) const;
 
-private:
+  private:
     int w_, h_;
     CompositeOrder order_;
     bool terminates_;

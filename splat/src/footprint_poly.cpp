@@ -39,7 +39,9 @@ FootprintPoly::FootprintPoly(const footprint::FootprintTable& table) {
     for (degree_ = 3; degree_ < kMaxCoefficients; ++degree_) {
         c_ = {};
         for (int s = 0; s < kSegments; ++s) {
-            auto f = [&](double u) { return double(table.lookup(float(width * (s + 0.5 * (u + 1))))); };
+            auto f = [&](double u) {
+                return double(table.lookup(float(width * (s + 0.5 * (u + 1)))));
+            };
             const auto p = chebyshevInterpolant(f, degree_);
             // Stored highest degree first, padded so Horner always runs kMaxCoefficients steps.
             for (int k = 0; k <= degree_; ++k) c_[kMaxCoefficients - 1 - k][s] = float(p[k]);
@@ -47,7 +49,8 @@ FootprintPoly::FootprintPoly(const footprint::FootprintTable& table) {
         maxError_ = 0;
         for (int n = 0; n <= 8192; ++n) {
             const float r2 = float(r2Max_ * n / 8192.0) * 0.999999f;
-            maxError_ = std::max(maxError_, std::abs(double((*this)(r2)) - table.lookup(r2)) / peak);
+            maxError_ =
+                std::max(maxError_, std::abs(double((*this)(r2)) - table.lookup(r2)) / peak);
         }
         if (maxError_ <= kTolerance) break;
     }

@@ -14,7 +14,7 @@
 namespace splat {
 
 class FootprintPoly {
-public:
+  public:
     static constexpr int kSegments = 8;
     static constexpr int kMaxCoefficients = 8;  // the vector code assumes exactly 8
     static constexpr double kTolerance = 1e-6;  ///< of the peak
@@ -33,7 +33,7 @@ public:
     /// Scalar evaluation (tests and tails).
     float operator()(float r2) const;
 
-private:
+  private:
     std::array<std::array<float, kSegments>, kMaxCoefficients> c_{};
     int degree_ = 0;
     float segScale_ = 0, r2Max_ = 0;

@@ -10,10 +10,11 @@
 // splat's sections to every slab it crosses at once (sharing r^2, the footprint and the
 // section boundaries between them), and the sheet at the sweep position, complete now,
 // is composited. Empty sheet space between splats is skipped.
+#include "image_aligned_splatter.h"
+
 #include <chrono>
 #include <cmath>
 
-#include "image_aligned_splatter.h"
 #include "tile_binning.h"
 
 namespace splat {
@@ -61,62 +62,67 @@ Image renderSlabs(const FrameInputs& in, const ProjectedSplats& proj, RenderStat
     // A kernel spans at most this many slabs; a tile keeps that many sheets in a ring, so a
     // splat is cut into all its slab sections at once when the sweep reaches it.
     const std::uint32_t ring = std::uint32_t(std::ceil(2.0f * ext / thickness)) + 2;
-    return renderTiles<NCh>(in, bins, pathScale, stats,
-                            [&](int t, TileAccumulator& acc, const float* tileScale,
-                                TileCounters& cnt) {
-        const int ox = (t % bins.grid.tilesX) * bins.grid.tileSize;
-        const int oy = (t / bins.grid.tilesX) * bins.grid.tileSize;
-        std::vector<SheetBuffer<NCh>> sheets;
-        sheets.reserve(ring);
-        for (std::uint32_t k = 0; k < ring; ++k) sheets.emplace_back(ox, oy, acc.width(), acc.height());
-        std::vector<SheetBuffer<NCh>*> target(ring);
-        std::vector<float> tb(ring + 1);
-        std::uint32_t next = bins.begin[t];
-        const std::uint32_t end = bins.begin[t + 1];
-        // Sweep position (slab index in visiting order) and the last position that has
-        // sections pending in the ring.
-        std::uint32_t step = key[bins.splats[next]], pendingEnd = step;
-        bool pending = false;
-        while (next < end || pending) {
-            if (!pending) step = std::max(step, key[bins.splats[next]]);  // skip empty sheet space
-            for (; next < end && key[bins.splats[next]] == step; ++next) {
-                const std::uint32_t id = bins.splats[next];
-                const PixelRect r = clipToTile(proj.rect[id], bins.grid, t);
-                if (acc.rectOpaque(r.x0 - ox, r.y0 - oy, r.x1 - ox, r.y1 - oy)) {
-                    ++cnt.culled;
-                    continue;
+    return renderTiles<NCh>(
+        in, bins, pathScale, stats,
+        [&](int t, TileAccumulator& acc, const float* tileScale, TileCounters& cnt) {
+            const int ox = (t % bins.grid.tilesX) * bins.grid.tileSize;
+            const int oy = (t / bins.grid.tilesX) * bins.grid.tileSize;
+            std::vector<SheetBuffer<NCh>> sheets;
+            sheets.reserve(ring);
+            for (std::uint32_t k = 0; k < ring; ++k)
+                sheets.emplace_back(ox, oy, acc.width(), acc.height());
+            std::vector<SheetBuffer<NCh>*> target(ring);
+            std::vector<float> tb(ring + 1);
+            std::uint32_t next = bins.begin[t];
+            const std::uint32_t end = bins.begin[t + 1];
+            // Sweep position (slab index in visiting order) and the last position that has
+            // sections pending in the ring.
+            std::uint32_t step = key[bins.splats[next]], pendingEnd = step;
+            bool pending = false;
+            while (next < end || pending) {
+                if (!pending)
+                    step = std::max(step, key[bins.splats[next]]);  // skip empty sheet space
+                for (; next < end && key[bins.splats[next]] == step; ++next) {
+                    const std::uint32_t id = bins.splats[next];
+                    const PixelRect r = clipToTile(proj.rect[id], bins.grid, t);
+                    if (acc.rectOpaque(r.x0 - ox, r.y0 - oy, r.x1 - ox, r.y1 - oy)) {
+                        ++cnt.culled;
+                        continue;
+                    }
+                    // Slabs first..last in depth order; in the sweep they are step..step+n-1.
+                    const int n = int(last[id] - first[id]) + 1;
+                    const footprint::EllipticalFootprint& e = proj.ellipse(id);
+                    // Depths along this splat's rays relative to its centre: t = (plane depth -
+                    // centre) / cos; the slab sections use z = depthScale (t - (tx dx + ty dy)).
+                    const float perRay = proj.perspective ? proj.depthPerRay[id] : 1.0f;
+                    for (int b = 0; b <= n; ++b) {
+                        const std::uint32_t plane =
+                            ftb ? first[id] + std::uint32_t(b) : last[id] + 1 - std::uint32_t(b);
+                        tb[b] = (zmin + float(plane) * thickness - proj.depth[id]) * perRay;
+                    }
+                    for (int j = 0; j < n; ++j)
+                        target[j] = &sheets[(step + std::uint32_t(j)) % ring];
+                    float v[NCh];
+                    splatValues<NCh>(in, id, v);
+                    cnt.footprintPixels +=
+                        splatSections(target.data(), n, v, proj.sx[id], proj.sy[id], e, r, table,
+                                      in.poly, tb.data());
+                    pendingEnd = std::max(pendingEnd, step + std::uint32_t(n) - 1);
+                    pending = true;
                 }
-                // Slabs first..last in depth order; in the sweep they are step..step+n-1.
-                const int n = int(last[id] - first[id]) + 1;
-                const footprint::EllipticalFootprint& e = proj.ellipse(id);
-                // Depths along this splat's rays relative to its centre: t = (plane depth -
-                // centre) / cos; the slab sections use z = depthScale (t - (tx dx + ty dy)).
-                const float perRay = proj.perspective ? proj.depthPerRay[id] : 1.0f;
-                for (int b = 0; b <= n; ++b) {
-                    const std::uint32_t plane = ftb ? first[id] + std::uint32_t(b) : last[id] + 1 - std::uint32_t(b);
-                    tb[b] = (zmin + float(plane) * thickness - proj.depth[id]) * perRay;
+                SheetBuffer<NCh>& sheet = sheets[step % ring];
+                if (sheet.dirty()) {
+                    sheet.flush(acc, model, thickness, tileScale);
+                    ++cnt.sheets;
                 }
-                for (int j = 0; j < n; ++j) target[j] = &sheets[(step + std::uint32_t(j)) % ring];
-                float v[NCh];
-                splatValues<NCh>(in, id, v);
-                cnt.footprintPixels += splatSections(target.data(), n, v, proj.sx[id], proj.sy[id],
-                                                     e, r, table, in.poly, tb.data());
-                pendingEnd = std::max(pendingEnd, step + std::uint32_t(n) - 1);
-                pending = true;
+                pending = step < pendingEnd;
+                ++step;
+                if (acc.allOpaque()) {
+                    cnt.culled += end - next;
+                    break;
+                }
             }
-            SheetBuffer<NCh>& sheet = sheets[step % ring];
-            if (sheet.dirty()) {
-                sheet.flush(acc, model, thickness, tileScale);
-                ++cnt.sheets;
-            }
-            pending = step < pendingEnd;
-            ++step;
-            if (acc.allOpaque()) {
-                cnt.culled += end - next;
-                break;
-            }
-        }
-    });
+        });
 }
 
 }  // namespace

@@ -1,13 +1,13 @@
 // Image files through OpenImageIO, written atomically (temporary file, then rename).
 #include "splat/image_io.h"
 
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imageio.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
-
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imageio.h>
 
 #include "splat/error.h"
 
@@ -24,7 +24,8 @@ namespace {
 
 std::string lowerExtension(const std::string& path) {
     std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
     return ext;
 }
 
@@ -101,8 +102,7 @@ void writeImage(const std::string& path, const Image& image, const WriteOptions&
         OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
         spec.channelnames = {"R", "G", "B", "A"};
         spec.alpha_channel = 3;
-        ok = out->open(tmp, spec) &&
-             out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
+        ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
     } else {
         const std::vector<float> v = displayValues(image, options);
         OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);

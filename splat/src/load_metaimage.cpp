@@ -21,11 +21,11 @@ namespace {
 
 std::optional<SampleType> metaType(const std::string& s) {
     static const std::map<std::string, SampleType> types = {
-        {"MET_UCHAR", SampleType::U8},  {"MET_CHAR", SampleType::I8},
+        {"MET_UCHAR", SampleType::U8},   {"MET_CHAR", SampleType::I8},
         {"MET_USHORT", SampleType::U16}, {"MET_SHORT", SampleType::I16},
-        {"MET_UINT", SampleType::U32},  {"MET_INT", SampleType::I32},
-        {"MET_ULONG", SampleType::U32}, {"MET_LONG", SampleType::I32},
-        {"MET_FLOAT", SampleType::F32}, {"MET_DOUBLE", SampleType::F64}};
+        {"MET_UINT", SampleType::U32},   {"MET_INT", SampleType::I32},
+        {"MET_ULONG", SampleType::U32},  {"MET_LONG", SampleType::I32},
+        {"MET_FLOAT", SampleType::F32},  {"MET_DOUBLE", SampleType::F64}};
     auto it = types.find(s);
     if (it == types.end()) return std::nullopt;
     return it->second;
@@ -79,11 +79,13 @@ Volume loadMetaImage(const fs::path& p) {
     int ndims = std::atoi(get("ndims").c_str());
     if (ndims != 2 && ndims != 3)
         throw Error(name + ": MetaImage NDims " + get("ndims") + " not supported (need 2 or 3)");
-    if (!get("elementnumberofchannels").empty() && std::atoi(get("elementnumberofchannels").c_str()) != 1)
+    if (!get("elementnumberofchannels").empty() &&
+        std::atoi(get("elementnumberofchannels").c_str()) != 1)
         throw Error(name + ": MetaImage with " + get("elementnumberofchannels") +
                     " channels per voxel not supported (need scalar data)");
     auto type = metaType(get("elementtype"));
-    if (!type) throw Error(name + ": unsupported MetaImage ElementType '" + get("elementtype") + "'");
+    if (!type)
+        throw Error(name + ": unsupported MetaImage ElementType '" + get("elementtype") + "'");
     std::vector<double> size = numbers(get("dimsize"), name, "DimSize");
     if (int(size.size()) != ndims)
         throw Error(name + ": DimSize has " + std::to_string(size.size()) + " entries, NDims is " +
@@ -141,14 +143,16 @@ Volume loadMetaImage(const fs::path& p) {
     } else {
         if (toLower(dataFile).rfind("list", 0) == 0 || dataFile.find('%') != std::string::npos)
             throw Error(name + ": multi-file MetaImage data ('" + dataFile + "') is not supported");
-        fs::path dp = fs::path(dataFile).is_absolute() ? fs::path(dataFile) : p.parent_path() / dataFile;
+        fs::path dp =
+            fs::path(dataFile).is_absolute() ? fs::path(dataFile) : p.parent_path() / dataFile;
         dataName = displayName(dp);
         std::error_code ec;
         if (!fs::exists(dp, ec)) throw Error(name + ": data file " + dataName + " does not exist");
         separate = readFileBytes(dp);
         data = separate.data();
         dataSize = separate.size();
-        long long headerSize = get("headersize").empty() ? 0 : std::atoll(get("headersize").c_str());
+        long long headerSize =
+            get("headersize").empty() ? 0 : std::atoll(get("headersize").c_str());
         if (headerSize > 0 && !compressed) {
             checkDataLength(std::size_t(headerSize), dataSize, dataName, false);
             data += headerSize;

@@ -5,13 +5,13 @@
 // RAS+ millimetres) followed by the samples, x fastest. niftilib parses the header,
 // swaps bytes to the host order and handles gzip; we convert to float, apply the
 // intensity scaling and the orientation (sform preferred, then qform, else pixdim).
+#include <nifti1_io.h>
+#include <zlib.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
-
-#include <nifti1_io.h>
-#include <zlib.h>
 
 #include "splat/error.h"
 #include "volume_detail.h"
@@ -28,15 +28,24 @@ using NimPtr = std::unique_ptr<nifti_image, NimDeleter>;
 
 std::optional<SampleType> niftiType(int datatype) {
     switch (datatype) {
-        case DT_UINT8: return SampleType::U8;
-        case DT_INT8: return SampleType::I8;
-        case DT_INT16: return SampleType::I16;
-        case DT_UINT16: return SampleType::U16;
-        case DT_INT32: return SampleType::I32;
-        case DT_UINT32: return SampleType::U32;
-        case DT_FLOAT32: return SampleType::F32;
-        case DT_FLOAT64: return SampleType::F64;
-        default: return std::nullopt;
+        case DT_UINT8:
+            return SampleType::U8;
+        case DT_INT8:
+            return SampleType::I8;
+        case DT_INT16:
+            return SampleType::I16;
+        case DT_UINT16:
+            return SampleType::U16;
+        case DT_INT32:
+            return SampleType::I32;
+        case DT_UINT32:
+            return SampleType::U32;
+        case DT_FLOAT32:
+            return SampleType::F32;
+        case DT_FLOAT64:
+            return SampleType::F64;
+        default:
+            return std::nullopt;
     }
 }
 
@@ -66,16 +75,19 @@ void validateHeader(const fs::path& p, const std::string& name) {
     gzerror(f, &gzErr);
     gzclose(f);
     if (gzErr != Z_OK && gzErr != Z_STREAM_END) throw Error(name + ": corrupt gzip data");
-    if (got != int(sizeof h)) throw Error(name + ": not a NIfTI-1 file (shorter than its 348-byte header)");
+    if (got != int(sizeof h))
+        throw Error(name + ": not a NIfTI-1 file (shorter than its 348-byte header)");
     bool swapped = h.sizeof_hdr != 348;
     if (swapped) {
         swap_nifti_header(&h, 1);
-        if (h.sizeof_hdr != 348) throw Error(name + ": not a readable NIfTI-1 file (bad header size)");
+        if (h.sizeof_hdr != 348)
+            throw Error(name + ": not a readable NIfTI-1 file (bad header size)");
     }
     if (std::memcmp(h.magic, "n+1", 4) != 0)
         throw Error(name + ": not a readable NIfTI-1 single file (magic is not n+1)");
     if (h.dim[0] < 1 || h.dim[0] > 7)
-        throw Error(name + ": not a readable NIfTI-1 file (bad dim[0] = " + std::to_string(h.dim[0]) + ")");
+        throw Error(
+            name + ": not a readable NIfTI-1 file (bad dim[0] = " + std::to_string(h.dim[0]) + ")");
     std::uint64_t count = 1;
     for (int d = 1; d <= h.dim[0]; ++d) {
         if (h.dim[d] < 1)
@@ -127,11 +139,10 @@ Volume loadNifti(const fs::path& p) {
         (slope != 1.0 || inter != 0.0))
         for (float& d : v.data) d = float(slope * d + inter);
 
-    v.source = std::string("NIfTI-1 ") + sampleTypeName(*type) + " (" +
-               p.filename().string() + ")";
+    v.source = std::string("NIfTI-1 ") + sampleTypeName(*type) + " (" + p.filename().string() + ")";
     if (extraVolumes > 1)
-        v.note = "4D file: only the first of " + std::to_string(extraVolumes) +
-                 " volumes was loaded";
+        v.note =
+            "4D file: only the first of " + std::to_string(extraVolumes) + " volumes was loaded";
 
     glm::dvec3 t(0.0);
     glm::dmat3 M(1.0);

@@ -19,18 +19,26 @@ namespace splat::detail {
 namespace {
 
 // Parses "(a,b,c)" vectors separated by spaces; "none" entries become nullopt.
-std::vector<std::optional<glm::dvec3>> parseVectors(const std::string& s,
-                                                    const std::string& what) {
+std::vector<std::optional<glm::dvec3>> parseVectors(const std::string& s, const std::string& what) {
     std::vector<std::optional<glm::dvec3>> out;
     std::size_t i = 0;
     while (i < s.size()) {
-        if (std::isspace(static_cast<unsigned char>(s[i]))) { ++i; continue; }
-        if (s.compare(i, 4, "none") == 0) { out.push_back(std::nullopt); i += 4; continue; }
+        if (std::isspace(static_cast<unsigned char>(s[i]))) {
+            ++i;
+            continue;
+        }
+        if (s.compare(i, 4, "none") == 0) {
+            out.push_back(std::nullopt);
+            i += 4;
+            continue;
+        }
         if (s[i] != '(') throw Error(what + ": cannot parse vector list '" + s + "'");
         std::size_t close = s.find(')', i);
-        if (close == std::string::npos) throw Error(what + ": cannot parse vector list '" + s + "'");
+        if (close == std::string::npos)
+            throw Error(what + ": cannot parse vector list '" + s + "'");
         std::string inner = s.substr(i + 1, close - i - 1);
-        for (char& c : inner) if (c == ',') c = ' ';
+        for (char& c : inner)
+            if (c == ',') c = ' ';
         std::istringstream in(inner);
         glm::dvec3 v;
         if (!(in >> v.x >> v.y >> v.z)) throw Error(what + ": cannot parse vector '" + inner + "'");
@@ -47,7 +55,10 @@ std::vector<double> parseNumbers(const std::string& s, const std::string& what,
     std::string word;
     while (in >> word) {
         std::string w = toLower(word);
-        if (w == "nan") { out.push_back(std::nan("")); continue; }
+        if (w == "nan") {
+            out.push_back(std::nan(""));
+            continue;
+        }
         char* end = nullptr;
         double d = std::strtod(word.c_str(), &end);
         if (end == word.c_str() || *end) throw Error(what + ": bad " + field + " '" + s + "'");
@@ -75,8 +86,14 @@ Volume loadNrrd(const fs::path& p) {
         std::string line(file.begin() + std::ptrdiff_t(pos), file.begin() + std::ptrdiff_t(eol));
         if (!line.empty() && line.back() == '\r') line.pop_back();
         pos = std::min(eol + 1, file.size());
-        if (first) { first = false; continue; }
-        if (line.empty()) { blankSeen = true; break; }
+        if (first) {
+            first = false;
+            continue;
+        }
+        if (line.empty()) {
+            blankSeen = true;
+            break;
+        }
         if (line[0] == '#') continue;
         if (line.find(":=") != std::string::npos) continue;  // key/value pair
         std::size_t colon = line.find(": ");
@@ -147,12 +164,11 @@ Volume loadNrrd(const fs::path& p) {
         if (dataFile.rfind("LIST", 0) == 0 || dataFile.find('%') != std::string::npos)
             throw Error(name + ": multi-file NRRD data ('data file: " + dataFile +
                         "') is not supported");
-        fs::path dp = fs::path(dataFile).is_absolute() ? fs::path(dataFile)
-                                                       : p.parent_path() / dataFile;
+        fs::path dp =
+            fs::path(dataFile).is_absolute() ? fs::path(dataFile) : p.parent_path() / dataFile;
         dataName = displayName(dp);
         std::error_code ec;
-        if (!fs::exists(dp, ec))
-            throw Error(name + ": data file " + dataName + " does not exist");
+        if (!fs::exists(dp, ec)) throw Error(name + ": data file " + dataName + " does not exist");
         detached = readFileBytes(dp);
         data = detached.data();
         dataSize = detached.size();
@@ -166,7 +182,8 @@ Volume loadNrrd(const fs::path& p) {
         data += skipPos;
         dataSize -= skipPos;
     } else {
-        if (!blankSeen) throw Error(name + ": NRRD header has no data (no blank line, no 'data file')");
+        if (!blankSeen)
+            throw Error(name + ": NRRD header has no data (no blank line, no 'data file')");
         data = file.data() + pos;
         dataSize = file.size() - pos;
     }
@@ -183,7 +200,8 @@ Volume loadNrrd(const fs::path& p) {
     std::vector<unsigned char> inflated;
     if (encoding == "gzip" || encoding == "gz") {
         if (byteSkip > 0) {
-            if (std::size_t(byteSkip) > dataSize) checkDataLength(std::size_t(byteSkip), dataSize, dataName, false);
+            if (std::size_t(byteSkip) > dataSize)
+                checkDataLength(std::size_t(byteSkip), dataSize, dataName, false);
             data += byteSkip;
             dataSize -= std::size_t(byteSkip);
         }

@@ -26,7 +26,8 @@ Volume loadRaw(const fs::path& p, const RawOptions& options) {
             glm::ivec3 d;
             for (int a = 0; a < 3; ++a) {
                 long long n = std::atoll(m[std::size_t(a + 1)].str().c_str());
-                if (n > 2147483647LL) throw Error(name + ": dimension " + m[std::size_t(a + 1)].str() + " too large");
+                if (n > 2147483647LL)
+                    throw Error(name + ": dimension " + m[std::size_t(a + 1)].str() + " too large");
                 d[a] = int(n);
             }
             dims = d;
@@ -34,8 +35,9 @@ Volume loadRaw(const fs::path& p, const RawOptions& options) {
         if (typeName.empty() && m[4].matched) typeName = m[4].str();
     }
     if (!dims || typeName.empty())
-        throw Error(name + ": raw data needs --dims and --type (or a name like "
-                           "skull_256x256x256_uint8.raw)");
+        throw Error(name +
+                    ": raw data needs --dims and --type (or a name like "
+                    "skull_256x256x256_uint8.raw)");
     auto type = parseSampleType(typeName);
     if (!type)
         throw Error(name + ": unsupported sample type '" + typeName +
@@ -47,9 +49,10 @@ Volume loadRaw(const fs::path& p, const RawOptions& options) {
     checkDataLength(expected, bytes.size(), name, true);
     decodeSamples(bytes.data() + options.headerBytes, v.voxelCount(), *type, options.bigEndian,
                   v.data.data());
-    v.source = std::string("raw ") + sampleTypeName(*type) +
-               (sampleSize(*type) > 1 ? (options.bigEndian ? " big-endian" : " little-endian") : "") +
-               " (" + file + ")";
+    v.source =
+        std::string("raw ") + sampleTypeName(*type) +
+        (sampleSize(*type) > 1 ? (options.bigEndian ? " big-endian" : " little-endian") : "") +
+        " (" + file + ")";
     return v;
 }
 

@@ -4,10 +4,10 @@
 // Slice pixel (column c, row r) of the n-th slice becomes voxel (c, r, n); values keep
 // their native range (0..255 for 8-bit, 0..65535 for 16-bit images); colour images
 // are reduced to Rec. 709 luminance. Spacing is 1 unless the files say otherwise.
+#include <OpenImageIO/imageio.h>
+
 #include <algorithm>
 #include <cstring>
-
-#include <OpenImageIO/imageio.h>
 
 #include "splat/error.h"
 #include "volume_detail.h"
@@ -66,8 +66,8 @@ void placeSlice(Volume& v, int k, const std::vector<float>& slice, glm::ivec2 si
                 const fs::path& file) {
     if (size.x != v.dims.x || size.y != v.dims.y)
         throw Error(displayName(file) + ": slice is " + std::to_string(size.x) + " x " +
-                    std::to_string(size.y) + ", the first slice is " +
-                    std::to_string(v.dims.x) + " x " + std::to_string(v.dims.y));
+                    std::to_string(size.y) + ", the first slice is " + std::to_string(v.dims.x) +
+                    " x " + std::to_string(v.dims.y));
     std::copy(slice.begin(), slice.end(), v.data.begin() + std::ptrdiff_t(v.index(0, 0, k)));
 }
 
@@ -110,8 +110,10 @@ Volume loadSliceFolder(const fs::path& dir) {
         if (!entry.is_regular_file()) continue;
         const fs::path& p = entry.path();
         if (p.filename().string().starts_with(".")) continue;
-        if (isSliceImage(p)) images.push_back(p);
-        else if (isDicom(p)) dicoms.push_back(p);
+        if (isSliceImage(p))
+            images.push_back(p);
+        else if (isDicom(p))
+            dicoms.push_back(p);
     }
     if (ec) throw Error(name + ": cannot list folder (" + ec.message() + ")");
     auto byName = [](const fs::path& a, const fs::path& b) {
@@ -121,8 +123,7 @@ Volume loadSliceFolder(const fs::path& dir) {
         std::sort(dicoms.begin(), dicoms.end(), byName);
         return loadDicomFolder(dir, dicoms);
     }
-    if (images.empty())
-        throw Error(name + ": folder holds no PNG/TIFF slices or DICOM files");
+    if (images.empty()) throw Error(name + ": folder holds no PNG/TIFF slices or DICOM files");
     std::sort(images.begin(), images.end(), byName);
 
     std::vector<float> slice;
@@ -135,24 +136,30 @@ Volume loadSliceFolder(const fs::path& dir) {
         placeSlice(v, int(k), slice, size, images[k]);
     }
     v.source = "slice folder, " + std::to_string(images.size()) + " images (" +
-               images.front().filename().string() + " .. " + images.back().filename().string() + ")";
+               images.front().filename().string() + " .. " + images.back().filename().string() +
+               ")";
     return v;
 }
 
 Volume loadDicomFolder(const fs::path& dir, const std::vector<fs::path>& files) {
     const std::string name = displayName(dir);
-    if (!oiioHasFormat("dicom")) throw Error(name + ": DICOM not supported by this OpenImageIO build");
+    if (!oiioHasFormat("dicom"))
+        throw Error(name + ": DICOM not supported by this OpenImageIO build");
 
     // Order by InstanceNumber when every file has one (OpenImageIO exposes it as
     // "dicom:InstanceNumber"; it does not expose ImagePositionPatient or PixelSpacing,
     // so spacing is 1 with the in-plane aspect ratio from PixelAspectRatio).
-    struct Slice { fs::path path; int instance; };
+    struct Slice {
+        fs::path path;
+        int instance;
+    };
     std::vector<Slice> slices;
     bool allNumbered = true;
     float aspect = 1.0f;
     for (const fs::path& p : files) {
         auto in = ImageInput::open(p.string());
-        if (!in) throw Error(displayName(p) + ": cannot read DICOM file (" + OIIO::geterror() + ")");
+        if (!in)
+            throw Error(displayName(p) + ": cannot read DICOM file (" + OIIO::geterror() + ")");
         const ImageSpec& spec = in->spec();
         int instance = spec.get_int_attribute("dicom:InstanceNumber", -1);
         if (instance < 0) allNumbered = false;

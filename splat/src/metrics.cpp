@@ -6,12 +6,12 @@
 // otherwise transparent black.
 #include "splat/metrics.h"
 
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 
 #include "splat/error.h"
 #include "splat/image_io.h"
@@ -75,7 +75,8 @@ ImageMetrics compareImages(const Image& test, const Image& reference) {
     }
     m.rmse = std::sqrt(sumSq / (3.0 * double(test.pixels.size())));
     peak = std::max(peak, 1e-12);
-    m.psnr = m.rmse > 0 ? 20.0 * std::log10(peak / m.rmse) : std::numeric_limits<double>::infinity();
+    m.psnr =
+        m.rmse > 0 ? 20.0 * std::log10(peak / m.rmse) : std::numeric_limits<double>::infinity();
     m.meanAbsForeground = m.foregroundPixels ? sumFg / double(m.foregroundPixels) : 0.0;
     return m;
 }

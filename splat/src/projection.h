@@ -18,8 +18,8 @@ struct PixelRect {
 };
 
 struct ProjectedSplats {
-    std::vector<float> sx, sy;    ///< continuous pixel position of the centre
-    std::vector<float> depth;     ///< world depth along the view direction
+    std::vector<float> sx, sy;  ///< continuous pixel position of the centre
+    std::vector<float> depth;   ///< world depth along the view direction
     bool perspective = false;
     footprint::EllipticalFootprint shared;             ///< orthographic: all splats
     std::vector<footprint::EllipticalFootprint> each;  ///< perspective: per splat

@@ -28,6 +28,10 @@
 //    shaded with the normalised gradient of f (central differences) under a headlight.
 #include "splat/reference.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -36,23 +40,19 @@
 #include <limits>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include "splat/error.h"
 
 namespace splat {
 namespace {
 
-constexpr int kBrick = 8;       // brick edge, voxels
-constexpr int kMaxLevels = 6;   // step halvings after the first pass
+constexpr int kBrick = 8;      // brick edge, voxels
+constexpr int kMaxLevels = 6;  // step halvings after the first pass
 constexpr int kLutSize = 1 << 16;
 constexpr double kAmbient = 0.25, kDiffuse = 0.75;
 
 // h(u) tabulated over u^2 in [0, R^2].
 class KernelLut {
-public:
+  public:
     explicit KernelLut(const footprint::Kernel& kernel) {
         const double r = kernel.radius();
         r2Max_ = r * r;
@@ -73,7 +73,7 @@ public:
         return values_[n] + f * (values_[n + 1] - values_[n]);
     }
 
-private:
+  private:
     double r2Max_ = 0, inv_ = 0;
     std::vector<float> values_;
 };
@@ -99,9 +99,12 @@ struct FieldGrid {
     void eval(const glm::dvec3& p, double out[C]) const {
         for (int c = 0; c < C; ++c) out[c] = 0.0;
         const double r = radius, r2 = lut->r2Max();
-        const int i0 = std::max(0, int(std::ceil(p.x - r))), i1 = std::min(dims.x - 1, int(std::floor(p.x + r)));
-        const int j0 = std::max(0, int(std::ceil(p.y - r))), j1 = std::min(dims.y - 1, int(std::floor(p.y + r)));
-        const int k0 = std::max(0, int(std::ceil(p.z - r))), k1 = std::min(dims.z - 1, int(std::floor(p.z + r)));
+        const int i0 = std::max(0, int(std::ceil(p.x - r))),
+                  i1 = std::min(dims.x - 1, int(std::floor(p.x + r)));
+        const int j0 = std::max(0, int(std::ceil(p.y - r))),
+                  j1 = std::min(dims.y - 1, int(std::floor(p.y + r)));
+        const int k0 = std::max(0, int(std::ceil(p.z - r))),
+                  k1 = std::min(dims.z - 1, int(std::floor(p.z + r)));
         if (i0 > i1 || j0 > j1 || k0 > k1) return;
         double dx2[64];
         const int ni = std::min(i1 - i0 + 1, 64);
@@ -135,7 +138,8 @@ FieldGrid<C> buildGrid(const Volume& volume, const SplatList& splats, const Kern
     g.lut = &lut;
     g.values.assign(volume.voxelCount() * C, 0.0f);
     // Brick b covers index positions [-R + b B, -R + (b + 1) B) on each axis.
-    g.nb = glm::ivec3(glm::ceil((glm::dvec3(volume.dims) - 1.0 + 2.0 * radius) / double(kBrick))) + 1;
+    g.nb =
+        glm::ivec3(glm::ceil((glm::dvec3(volume.dims) - 1.0 + 2.0 * radius) / double(kBrick))) + 1;
     g.bricks.assign(std::size_t(g.nb.x) * g.nb.y * g.nb.z, 0);
     for (const auto* ch : channels)
         if (ch->size() != splats.size())
@@ -232,7 +236,7 @@ void raySegments(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& 
 template <int C>
 struct RayScratch {
     std::vector<Segment> segments;
-    std::vector<int> baseN;                              // subintervals of pass 0
+    std::vector<int> baseN;                                   // subintervals of pass 0
     std::vector<std::vector<std::array<float, C>>> old, cur;  // samples per segment
     std::vector<std::array<float, C>> tmp;
 };
@@ -240,10 +244,13 @@ struct RayScratch {
 using Sample4 = std::array<float, 4>;
 
 class Caster {
-public:
+  public:
     Caster(const Volume& volume, const SplatList& splats, const footprint::Kernel& kernel,
            const Camera& camera, const RenderSettings& settings)
-        : volume_(volume), camera_(camera), settings_(settings), lut_(kernel),
+        : volume_(volume),
+          camera_(camera),
+          settings_(settings),
+          lut_(kernel),
           radius_(kernel.radius()) {
         if (!(settings.referenceStep > 0) || !std::isfinite(settings.referenceStep))
             throw Error("reference: referenceStep must be > 0 voxels");
@@ -254,7 +261,8 @@ public:
             throw Error("reference: kernel radius must be in (0, 30] voxels");
         invSpacing_ = 1.0 / volume.spacing;
         stepWorld_ = settings.referenceStep * volume.minSpacing();
-        preDvr_ = settings.mode == RenderMode::Dvr && settings.classification == Classification::Pre;
+        preDvr_ =
+            settings.mode == RenderMode::Dvr && settings.classification == Classification::Pre;
         if (preDvr_)
             grid4_ = buildGrid<4>(volume, splats, lut_, radius_,
                                   {&splats.extinction, &splats.r, &splats.g, &splats.b});
@@ -278,8 +286,9 @@ public:
                     image.at(x, y) = preDvr_ ? pixel(grid4_, s4, x, y, level, hitDepth)
                                              : pixel(grid1_, s1, x, y, level, hitDepth);
                     if (depth)
-                        depth->at(x, y) = hitDepth >= 0 ? glm::vec4(glm::vec3(float(hitDepth)), 1.0f)
-                                                        : glm::vec4(0.0f);
+                        depth->at(x, y) = hitDepth >= 0
+                                              ? glm::vec4(glm::vec3(float(hitDepth)), 1.0f)
+                                              : glm::vec4(0.0f);
                     localFinest = std::max(localFinest, level);
                 }
             int cur = finest.load();
@@ -293,7 +302,7 @@ public:
         return image;
     }
 
-private:
+  private:
     // Converts a grid sample into the quantities integrated: dvr -> (rho, e rgb), else f.
     template <int C>
     void sampleAt(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& v, double t,
@@ -569,7 +578,8 @@ Image renderReference(const Volume& volume, const SplatList& splats,
         stats->splats = splats.size();
         stats->voxels = splats.voxels;
         stats->milliseconds =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
     }
     return image;
 }

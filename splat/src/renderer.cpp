@@ -2,8 +2,8 @@
 // splat list) and the per-frame pipeline project -> bin -> splatter -> composite.
 #include <array>
 #include <chrono>
-#include <mutex>
 #include <cmath>
+#include <mutex>
 #include <optional>
 
 #include "axis_splatter.h"
@@ -41,7 +41,8 @@ struct Renderer::Impl {
         return *sorted[axis];
     }
 
-    Impl(const Volume& v, const RenderSettings& s) : volume(v), settings(s), kernel(makeKernel(s)) {}
+    Impl(const Volume& v, const RenderSettings& s)
+        : volume(v), settings(s), kernel(makeKernel(s)) {}
 
     /// Shading is modelled only where it applies: pre-classified dvr.
     bool shaded() const {
@@ -72,13 +73,14 @@ void validate(const Volume& v, const RenderSettings& s) {
         throw Error("slab thickness below 0.001 voxels would need millions of sheets");
     if (!(s.earlyTermination >= 0 && s.earlyTermination < 1))
         throw Error("early termination threshold must be in [0, 1)");
-    if (s.tileSize < 8 || s.tileSize > 64)
-        throw Error("tile size must be between 8 and 64 pixels");
-    if (s.threads < 0 || s.threads > 1024) throw Error("thread count must be between 0 (all) and 1024");
+    if (s.tileSize < 8 || s.tileSize > 64) throw Error("tile size must be between 8 and 64 pixels");
+    if (s.threads < 0 || s.threads > 1024)
+        throw Error("thread count must be between 0 (all) and 1024");
     if (!(s.referenceStep > 0) || !(s.referenceTolerance > 0))
         throw Error("reference step and tolerance must be positive");
     for (int c = 0; c < 4; ++c)
-        if (!(s.background[c] >= 0 && s.background[c] <= 1)) throw Error("background must be in [0, 1]");
+        if (!(s.background[c] >= 0 && s.background[c] <= 1))
+            throw Error("background must be in [0, 1]");
 }
 
 }  // namespace
@@ -136,13 +138,24 @@ Image Renderer::render(const CameraParams& params, RenderStats* stats) const {
             eg = m.work.g.data();
             eb = m.work.b.data();
         }
-        const FrameInputs in{m.volume, list, camera, settings, *m.table,
-                             m.poly ? &*m.poly : nullptr, m.slabs ? &*m.slabs : nullptr, m.transfer,
-                             m.work, er, eg, eb};
+        const FrameInputs in{m.volume,
+                             list,
+                             camera,
+                             settings,
+                             *m.table,
+                             m.poly ? &*m.poly : nullptr,
+                             m.slabs ? &*m.slabs : nullptr,
+                             m.transfer,
+                             m.work,
+                             er,
+                             eg,
+                             eb};
         const auto t0 = std::chrono::steady_clock::now();
         ProjectedSplats& proj = m.work.proj;
         projectSplats(list, camera, m.volume.spacing, m.kernel.radius(), proj);
-        local.projectMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        local.projectMs =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count();
         image = settings.renderer == RendererKind::Axis ? renderAxisAligned(in, proj, &local)
                                                         : renderImageAligned(in, proj, &local);
     }
@@ -158,19 +171,26 @@ Image render(const Volume& volume, const RenderSettings& settings, RenderStats* 
 
 const char* toString(RendererKind k) {
     switch (k) {
-        case RendererKind::Axis: return "axis";
-        case RendererKind::Sheet: return "sheet";
-        case RendererKind::Reference: return "reference";
+        case RendererKind::Axis:
+            return "axis";
+        case RendererKind::Sheet:
+            return "sheet";
+        case RendererKind::Reference:
+            return "reference";
     }
     return "?";
 }
 
 const char* toString(RenderMode m) {
     switch (m) {
-        case RenderMode::Dvr: return "dvr";
-        case RenderMode::Mip: return "mip";
-        case RenderMode::Xray: return "xray";
-        case RenderMode::Iso: return "iso";
+        case RenderMode::Dvr:
+            return "dvr";
+        case RenderMode::Mip:
+            return "mip";
+        case RenderMode::Xray:
+            return "xray";
+        case RenderMode::Iso:
+            return "iso";
     }
     return "?";
 }

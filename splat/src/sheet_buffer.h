@@ -25,7 +25,7 @@ namespace splat {
 /// The transfer function tabulated over density for per-pixel post-classification:
 /// extinction and colour at n uniformly spaced densities, linear interpolation between.
 class TransferTable {
-public:
+  public:
     TransferTable() = default;
     TransferTable(const TransferFunction& tf, int n = 4096);
     /// Extinction per world unit and (non-premultiplied) colour at density d.
@@ -41,7 +41,7 @@ public:
         b = a[3] + f * (a[7] - a[3]);
     }
 
-private:
+  private:
     float lo_ = 0, inv_ = 1;
     int n_ = 2;
     std::vector<float> v_;
@@ -59,12 +59,17 @@ struct SheetModel {
 
 template <int NCh>
 class SheetBuffer {
-public:
+  public:
     /// A sheet for the tile whose top-left pixel is (ox, oy) and size w x h. Rows are
     /// padded to a multiple of 8 floats so that vector loops may run past the tile edge.
     SheetBuffer(int ox, int oy, int w, int h)
-        : ox_(ox), oy_(oy), w_(w), h_(h), stride_((w + 7) & ~7),
-          plane_(std::size_t(stride_) * h + kPlanePad), v_(std::size_t(NCh) * plane_ + 8, 0.0f) {
+        : ox_(ox),
+          oy_(oy),
+          w_(w),
+          h_(h),
+          stride_((w + 7) & ~7),
+          plane_(std::size_t(stride_) * h + kPlanePad),
+          v_(std::size_t(NCh) * plane_ + 8, 0.0f) {
         clearDirty();
     }
 
@@ -126,8 +131,8 @@ public:
                 const float* v = &v_[std::size_t(y) * stride_ + x];
                 const float len = pathScale ? pathLength * pathScale[p] : pathLength;
                 if constexpr (NCh == 4) {
-                    acc.composite(p, sampleFromOpticalDepth(v[0], v[plane_], v[2 * plane_],
-                                                            v[3 * plane_]));
+                    acc.composite(
+                        p, sampleFromOpticalDepth(v[0], v[plane_], v[2 * plane_], v[3 * plane_]));
                 } else if (model.mode == RenderMode::Dvr) {
                     float rho, r, g, b;
                     model.transfer->lookup(v[0] / len, rho, r, g, b);
@@ -159,7 +164,8 @@ public:
         dy0_ = std::min(dy0_, y0);
         dy1_ = std::max(dy1_, y1);
     }
-private:
+
+  private:
     void clearDirty() {
         dx0_ = dy0_ = 1 << 30;
         dx1_ = dy1_ = -1;
@@ -178,9 +184,11 @@ private:
 /// piecewise polynomial when one is given (permutes pick each lane's segment, Estrin's
 /// scheme evaluates it), else the table itself with two gathers.
 class FootprintLanes {
-public:
+  public:
     FootprintLanes(const footprint::FootprintTable& table, const FootprintPoly* poly)
-        : poly_(poly), data_(table.data()), inv_(_mm256_set1_ps(table.invStep())),
+        : poly_(poly),
+          data_(table.data()),
+          inv_(_mm256_set1_ps(table.invStep())),
           last_(_mm256_set1_ps(float(table.resolution()))),
           seg_(_mm256_set1_ps(poly ? poly->segmentScale() : 0.0f)),
           lastSeg_(_mm256_set1_ps(float(FootprintPoly::kSegments - 1))) {
@@ -193,7 +201,8 @@ public:
             const __m256 s = _mm256_mul_ps(r2, seg_);
             const __m256 sf = _mm256_min_ps(_mm256_floor_ps(s), lastSeg_);
             const __m256i seg = _mm256_cvttps_epi32(sf);
-            const __m256 u = _mm256_fmsub_ps(_mm256_set1_ps(2.0f), _mm256_sub_ps(s, sf), _mm256_set1_ps(1.0f));
+            const __m256 u =
+                _mm256_fmsub_ps(_mm256_set1_ps(2.0f), _mm256_sub_ps(s, sf), _mm256_set1_ps(1.0f));
             auto a = [&](int k) { return _mm256_permutevar8x32_ps(coef_[7 - k], seg); };  // u^k
             const __m256 u2 = _mm256_mul_ps(u, u), u4 = _mm256_mul_ps(u2, u2);
             const __m256 q0 = _mm256_fmadd_ps(a(1), u, a(0)), q1 = _mm256_fmadd_ps(a(3), u, a(2));
@@ -208,7 +217,7 @@ public:
         return _mm256_fmadd_ps(f, _mm256_sub_ps(v1, v0), v0);
     }
 
-private:
+  private:
     const FootprintPoly* poly_;
     const float* data_;
     __m256 inv_, last_, seg_, lastSeg_;
@@ -217,8 +226,7 @@ private:
 
 template <int NCh>
 int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float sy,
-                                     const footprint::EllipticalFootprint& e,
-                                     const PixelRect& rect,
+                                     const footprint::EllipticalFootprint& e, const PixelRect& rect,
                                      const footprint::FootprintTable& table,
                                      const FootprintPoly* poly) {
     const int x0 = rect.x0 - ox_, x1 = rect.x1 - ox_, y0 = rect.y0 - oy_, y1 = rect.y1 - oy_;
@@ -239,12 +247,13 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
         float* row = &v_[std::size_t(y) * stride_];
         for (int x = x0 & ~7; x <= x1; x += 8) {
             const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
-            const __m256 q = _mm256_add_ps(_mm256_add_ps(px, _mm256_set1_ps(float(ox_) + 0.5f - sx)), vshift);
+            const __m256 q =
+                _mm256_add_ps(_mm256_add_ps(px, _mm256_set1_ps(float(ox_) + 0.5f - sx)), vshift);
             const __m256 r2 = _mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy);
-            const __m256 inside = _mm256_and_ps(
-                _mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
-                _mm256_and_ps(_mm256_cmp_ps(px, lastX, _CMP_LT_OQ),
-                              _mm256_cmp_ps(px, firstX, _CMP_GT_OQ)));
+            const __m256 inside =
+                _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
+                              _mm256_and_ps(_mm256_cmp_ps(px, lastX, _CMP_LT_OQ),
+                                            _mm256_cmp_ps(px, firstX, _CMP_GT_OQ)));
             const __m256 fp = footprintOf(_mm256_max_ps(r2, zero));
             const __m256 w = _mm256_and_ps(inside, _mm256_mul_ps(fp, vScale));
             for (int c = 0; c < NCh; ++c) {
@@ -258,9 +267,9 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
 
 template <int NCh>
 int SheetBuffer<NCh>::splatSection(const float (&values)[NCh], float sx, float sy,
-                                   const footprint::EllipticalFootprint& e,
-                                   const PixelRect& rect, const footprint::SlabTable& table,
-                                   const FootprintPoly* poly, float t0, float t1) {
+                                   const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                                   const footprint::SlabTable& table, const FootprintPoly* poly,
+                                   float t0, float t1) {
     const footprint::FootprintTable& fpTable = table.footprint();
     const footprint::SlabTable::Grid grid = table.grid();
     const int x0 = rect.x0 - ox_, x1 = rect.x1 - ox_, y0 = rect.y0 - oy_, y1 = rect.y1 - oy_;
@@ -385,12 +394,15 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
             const __m256 fr = _mm256_sub_ps(rr, _mm256_cvtepi32_ps(ri));
             const __m256i rowIndex = _mm256_mullo_epi32(ri, gStride);
             const __m256 tc = _mm256_fmadd_ps(vtx, dx, vtyy);
-            auto depth = [&](int b) { return _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)); };
+            auto depth = [&](int b) {
+                return _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc));
+            };
             __m256 below = fraction(rowIndex, fr, depth(0));
             for (int j = 0; j < n; ++j) {
                 const __m256 above = fraction(rowIndex, fr, depth(j + 1));
                 // |F(above) - F(below)|: the boundaries run back to front when compositing is.
-                const __m256 w = _mm256_mul_ps(weight, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
+                const __m256 w =
+                    _mm256_mul_ps(weight, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
                 below = above;
                 for (int c = 0; c < NCh; ++c) {
                     float* p = sheets[j]->row(c, y) + x;
@@ -404,8 +416,7 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
 #else
 template <int NCh>
 int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float sy,
-                                     const footprint::EllipticalFootprint& e,
-                                     const PixelRect& rect,
+                                     const footprint::EllipticalFootprint& e, const PixelRect& rect,
                                      const footprint::FootprintTable& table,
                                      const FootprintPoly* poly) {
     const float scale = e.scale;
@@ -415,9 +426,9 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
 
 template <int NCh>
 int SheetBuffer<NCh>::splatSection(const float (&values)[NCh], float sx, float sy,
-                                   const footprint::EllipticalFootprint& e,
-                                   const PixelRect& rect, const footprint::SlabTable& table,
-                                   const FootprintPoly*, float t0, float t1) {
+                                   const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                                   const footprint::SlabTable& table, const FootprintPoly*,
+                                   float t0, float t1) {
     const float ds = e.depthScale, tx = e.tx, ty = e.ty, scale = e.scale;
     return splat(values, sx, sy, e, rect, [&](float r2, float dx, float dy) {
         const float tc = tx * dx + ty * dy;

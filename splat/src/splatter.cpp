@@ -1,10 +1,10 @@
 // Shared pieces of the splatters (see splatter.h) and the transfer table.
 #include "splatter.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <tbb/parallel_for.h>
 
 namespace splat {
 

@@ -11,8 +11,8 @@
 #include "footprint/slab_table.h"
 #include "projection.h"
 #include "sheet_buffer.h"
-#include "tile_binning.h"
 #include "splat/render.h"
+#include "tile_binning.h"
 
 namespace splat {
 
@@ -31,7 +31,7 @@ struct FrameInputs {
     const Camera& camera;
     const RenderSettings& settings;  ///< transfer already resolved
     const footprint::FootprintTable& table;
-    const FootprintPoly* poly;  ///< fast evaluation of `table`, if accurate enough
+    const FootprintPoly* poly;          ///< fast evaluation of `table`, if accurate enough
     const footprint::SlabTable* slabs;  ///< image-aligned only
     const TransferTable& transfer;
     FrameWorkspace& work;
@@ -50,7 +50,8 @@ SplatList sortedBySlice(const SplatList& splats, int axis);
 
 /// Milliseconds since `start`.
 inline double msSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
 }
 
 /// Stable counting sort: splat indices ordered by key[s] in [0, keys).
@@ -78,8 +79,9 @@ inline void splatValues(const FrameInputs& in, std::size_t i, float (&v)[NCh]) {
 /// pixel) and f.operator()<1>() otherwise (density).
 template <class F>
 Image withChannels(const RenderSettings& s, F&& f) {
-    return SheetModel{s.mode, s.classification, nullptr}.channels() == 4 ? f.template operator()<4>()
-                                                                         : f.template operator()<1>();
+    return SheetModel{s.mode, s.classification, nullptr}.channels() == 4
+               ? f.template operator()<4>()
+               : f.template operator()<1>();
 }
 
 /// Runs `tileFn(tileIndex, accumulator, pathScaleOfTile, counters)` for every tile that

@@ -12,12 +12,12 @@ namespace splat {
 /// Flushes denormal floats to zero in this thread while in scope. Kernel tails multiply
 /// tiny weights; denormal arithmetic is ~100x slower on x86 and changes no visible value.
 class DenormalsAreZero {
-public:
+  public:
 #if defined(__SSE__)
     DenormalsAreZero() : saved_(_mm_getcsr()) { _mm_setcsr(saved_ | 0x8040); }
     ~DenormalsAreZero() { _mm_setcsr(saved_); }
 
-private:
+  private:
     unsigned saved_;
 #endif
 };
@@ -33,16 +33,19 @@ Image renderTiles(const FrameInputs& in, const TileBins& bins, const std::vector
         tbb::parallel_for(0, g.count(), 1, [&](int t) {
             const DenormalsAreZero ftz;  // footprint tails must not hit slow denormal paths
             const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
-            const int w = std::min(g.tileSize, g.width - ox), h = std::min(g.tileSize, g.height - oy);
-            TileAccumulator acc(w, h, in.settings.order,
-                                in.settings.mode == RenderMode::Dvr ? in.settings.earlyTermination : 0.0);
+            const int w = std::min(g.tileSize, g.width - ox),
+                      h = std::min(g.tileSize, g.height - oy);
+            TileAccumulator acc(
+                w, h, in.settings.order,
+                in.settings.mode == RenderMode::Dvr ? in.settings.earlyTermination : 0.0);
             if (bins.begin[t] != bins.begin[t + 1]) {
                 std::vector<float> tileScale;
                 if (!pathScale.empty()) {
                     tileScale.resize(std::size_t(w) * h);
                     for (int y = 0; y < h; ++y)
                         for (int x = 0; x < w; ++x)
-                            tileScale[y * w + x] = pathScale[std::size_t(oy + y) * g.width + ox + x];
+                            tileScale[y * w + x] =
+                                pathScale[std::size_t(oy + y) * g.width + ox + x];
                 }
                 tileFn(t, acc, tileScale.empty() ? nullptr : tileScale.data(), counters[t]);
             }

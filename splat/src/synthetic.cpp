@@ -1,8 +1,9 @@
 // Deterministic synthetic volumes (`synthetic:NAME[:N]`), see synthetic.h.
+#include "splat/synthetic.h"
+
 #include <cmath>
 
 #include "splat/error.h"
-#include "splat/synthetic.h"
 
 namespace splat {
 namespace {
@@ -12,7 +13,9 @@ namespace {
 // centre (x0, y0, z0), semi-axes (a, b, c), rotation phi (degrees, about the phantom z
 // axis) and a density that is added inside it, so the skull shell is 2.0 and the brain
 // 2.0 - 0.98 = 1.02. Phantom coordinates are in [-1, 1]^3.
-struct Ellipsoid { double x0, y0, z0, a, b, c, phi, rho; };
+struct Ellipsoid {
+    double x0, y0, z0, a, b, c, phi, rho;
+};
 constexpr Ellipsoid kSheppLogan[10] = {
     {0.00, 0.000, 0.000, 0.6900, 0.920, 0.900, 0, 2.00},
     {0.00, 0.000, 0.000, 0.6624, 0.874, 0.880, 0, -0.98},

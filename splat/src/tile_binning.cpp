@@ -1,10 +1,10 @@
 // Pipeline stage "bin to tiles" (see tile_binning.h).
 #include "tile_binning.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <tbb/parallel_for.h>
 
 namespace splat {
 

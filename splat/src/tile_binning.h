@@ -15,7 +15,10 @@ struct TileGrid {
     int width = 0, height = 0, tileSize = 32, tilesX = 0, tilesY = 0;
     TileGrid() = default;
     TileGrid(int w, int h, int tile)
-        : width(w), height(h), tileSize(tile), tilesX((w + tile - 1) / tile),
+        : width(w),
+          height(h),
+          tileSize(tile),
+          tilesX((w + tile - 1) / tile),
           tilesY((h + tile - 1) / tile) {}
     int count() const { return tilesX * tilesY; }
 };

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-
 #include <nlohmann/json.hpp>
 
 #include "splat/error.h"
@@ -22,15 +21,17 @@ TransferFunction makePreset(const std::string& name) {
     tf.name = name;
     tf.normalized = true;
     if (name == "gray-ramp") {
-        tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.1f, 0.1f, 0.1f, 0.1f, 0),
-                     pt(1.0f, 1, 1, 1, 0.08f)};
+        tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.1f, 0.1f, 0.1f, 0.1f, 0), pt(1.0f, 1, 1, 1, 0.08f)};
     } else if (name == "ct-bone") {
         tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.55f, 0.8f, 0.6f, 0.45f, 0),
                      pt(0.62f, 0.95f, 0.85f, 0.7f, 0.6f), pt(1.0f, 1, 1, 0.95f, 0.9f)};
     } else if (name == "ct-soft") {
-        tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.12f, 0.8f, 0.4f, 0.3f, 0),
-                     pt(0.3f, 0.9f, 0.5f, 0.4f, 0.02f), pt(0.5f, 0.9f, 0.55f, 0.45f, 0.04f),
-                     pt(0.6f, 1, 0.95f, 0.85f, 0.5f), pt(1.0f, 1, 1, 1, 0.8f)};
+        tf.points = {pt(0.0f, 0, 0, 0, 0),
+                     pt(0.12f, 0.8f, 0.4f, 0.3f, 0),
+                     pt(0.3f, 0.9f, 0.5f, 0.4f, 0.02f),
+                     pt(0.5f, 0.9f, 0.55f, 0.45f, 0.04f),
+                     pt(0.6f, 1, 0.95f, 0.85f, 0.5f),
+                     pt(1.0f, 1, 1, 1, 0.8f)};
     } else if (name == "mri-head") {
         tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.12f, 0.75f, 0.5f, 0.4f, 0),
                      pt(0.3f, 0.9f, 0.65f, 0.55f, 0.08f), pt(0.6f, 1.0f, 0.85f, 0.75f, 0.3f),
@@ -50,12 +51,15 @@ void validate(const TransferFunction& tf, const std::string& what) {
         throw Error(what + ": unit_distance must be a positive number");
     for (std::size_t n = 0; n < tf.points.size(); ++n) {
         const auto& p = tf.points[n];
-        if (!std::isfinite(p.value)) throw Error(what + ": point " + std::to_string(n) + " has a non-finite value");
+        if (!std::isfinite(p.value))
+            throw Error(what + ": point " + std::to_string(n) + " has a non-finite value");
         for (int c = 0; c < 4; ++c)
             if (!(p.rgba[c] >= 0.0f && p.rgba[c] <= 1.0f))
-                throw Error(what + ": point " + std::to_string(n) + " has a colour or opacity outside [0, 1]");
+                throw Error(what + ": point " + std::to_string(n) +
+                            " has a colour or opacity outside [0, 1]");
         if (n > 0 && p.value < tf.points[n - 1].value)
-            throw Error(what + ": point values must be non-decreasing (point " + std::to_string(n) + ")");
+            throw Error(what + ": point values must be non-decreasing (point " + std::to_string(n) +
+                        ")");
     }
 }
 

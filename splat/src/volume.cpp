@@ -1,4 +1,6 @@
 // The Volume type: validated allocation, statistics and the `splat info` description.
+#include "splat/volume.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -6,7 +8,6 @@
 #include <sstream>
 
 #include "splat/error.h"
-#include "splat/volume.h"
 
 namespace splat {
 
@@ -15,8 +16,8 @@ Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::
     for (int a = 0; a < 3; ++a)
         if (dims[a] < 1)
             throw Error(what + ": invalid dimensions " + std::to_string(dims.x) + " x " +
-                        std::to_string(dims.y) + " x " + std::to_string(dims.z) + " (" +
-                        axis[a] + " must be at least 1)");
+                        std::to_string(dims.y) + " x " + std::to_string(dims.z) + " (" + axis[a] +
+                        " must be at least 1)");
     // Overflow-safe product: each factor is < 2^31, check before every multiplication.
     std::uint64_t count = 1;
     for (int a = 0; a < 3; ++a) {
@@ -29,8 +30,8 @@ Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::
     for (int a = 0; a < 3; ++a)
         if (!std::isfinite(spacing[a]) || spacing[a] <= 0) {
             std::ostringstream s;
-            s << what << ": invalid spacing " << spacing.x << ", " << spacing.y << ", "
-              << spacing.z << " (" << axis[a] << " must be finite and > 0)";
+            s << what << ": invalid spacing " << spacing.x << ", " << spacing.y << ", " << spacing.z
+              << " (" << axis[a] << " must be finite and > 0)";
             throw Error(s.str());
         }
     Volume v;
@@ -81,8 +82,7 @@ std::string describeVolume(const Volume& v) {
         out << buf << '\n';
     };
     out << "source:      " << v.source << '\n';
-    line("dimensions:  %d x %d x %d (%zu voxels)", v.dims.x, v.dims.y, v.dims.z,
-         v.voxelCount());
+    line("dimensions:  %d x %d x %d (%zu voxels)", v.dims.x, v.dims.y, v.dims.z, v.voxelCount());
     line("spacing:     %g x %g x %g mm", v.spacing.x, v.spacing.y, v.spacing.z);
     glm::dvec3 extent = glm::dvec3(v.dims) * v.spacing;
     glm::dvec3 last = v.world(glm::dvec3(v.dims) - 1.0);
@@ -101,10 +101,9 @@ std::string describeVolume(const Volume& v) {
         // Bars on a linear scale; any non-empty bin shows at least one mark.
         int n = int(std::lround(double(c) / double(peak) * width));
         if (c > 0 && n == 0) n = 1;
-        std::snprintf(buf, sizeof buf, "  [%10.4g, %10.4g%c %-*s %zu",
-                      s.minValue + b * binWidth, s.minValue + (b + 1) * binWidth,
-                      b + 1 == s.histogram.size() ? ']' : ')', width,
-                      std::string(std::size_t(n), '#').c_str(), c);
+        std::snprintf(buf, sizeof buf, "  [%10.4g, %10.4g%c %-*s %zu", s.minValue + b * binWidth,
+                      s.minValue + (b + 1) * binWidth, b + 1 == s.histogram.size() ? ']' : ')',
+                      width, std::string(std::size_t(n), '#').c_str(), c);
         out << buf << '\n';
     }
     line("memory:      %.1f MiB", double(v.bytes()) / (1024.0 * 1024.0));

@@ -10,24 +10,40 @@ namespace splat::detail {
 
 std::size_t sampleSize(SampleType t) {
     switch (t) {
-        case SampleType::U8: case SampleType::I8: return 1;
-        case SampleType::U16: case SampleType::I16: return 2;
-        case SampleType::U32: case SampleType::I32: case SampleType::F32: return 4;
-        case SampleType::F64: return 8;
+        case SampleType::U8:
+        case SampleType::I8:
+            return 1;
+        case SampleType::U16:
+        case SampleType::I16:
+            return 2;
+        case SampleType::U32:
+        case SampleType::I32:
+        case SampleType::F32:
+            return 4;
+        case SampleType::F64:
+            return 8;
     }
     return 1;
 }
 
 const char* sampleTypeName(SampleType t) {
     switch (t) {
-        case SampleType::U8: return "uint8";
-        case SampleType::I8: return "int8";
-        case SampleType::U16: return "uint16";
-        case SampleType::I16: return "int16";
-        case SampleType::U32: return "uint32";
-        case SampleType::I32: return "int32";
-        case SampleType::F32: return "float32";
-        case SampleType::F64: return "float64";
+        case SampleType::U8:
+            return "uint8";
+        case SampleType::I8:
+            return "int8";
+        case SampleType::U16:
+            return "uint16";
+        case SampleType::I16:
+            return "int16";
+        case SampleType::U32:
+            return "uint32";
+        case SampleType::I32:
+            return "int32";
+        case SampleType::F32:
+            return "float32";
+        case SampleType::F64:
+            return "float64";
     }
     return "?";
 }
@@ -37,26 +53,52 @@ std::optional<SampleType> parseSampleType(const std::string& name) {
     std::istringstream in(toLower(name));
     std::string word, s;
     while (in >> word) s += (s.empty() ? "" : " ") + word;
-    struct Alias { const char* name; SampleType type; };
+    struct Alias {
+        const char* name;
+        SampleType type;
+    };
     static const Alias aliases[] = {
         // canonical, short and C names
-        {"uint8", SampleType::U8}, {"u8", SampleType::U8}, {"uchar", SampleType::U8},
-        {"int8", SampleType::I8}, {"i8", SampleType::I8}, {"char", SampleType::I8},
-        {"uint16", SampleType::U16}, {"u16", SampleType::U16}, {"ushort", SampleType::U16},
-        {"int16", SampleType::I16}, {"i16", SampleType::I16}, {"short", SampleType::I16},
-        {"uint32", SampleType::U32}, {"u32", SampleType::U32}, {"uint", SampleType::U32},
-        {"int32", SampleType::I32}, {"i32", SampleType::I32}, {"int", SampleType::I32},
-        {"float32", SampleType::F32}, {"f32", SampleType::F32}, {"float", SampleType::F32},
-        {"float64", SampleType::F64}, {"f64", SampleType::F64}, {"double", SampleType::F64},
+        {"uint8", SampleType::U8},
+        {"u8", SampleType::U8},
+        {"uchar", SampleType::U8},
+        {"int8", SampleType::I8},
+        {"i8", SampleType::I8},
+        {"char", SampleType::I8},
+        {"uint16", SampleType::U16},
+        {"u16", SampleType::U16},
+        {"ushort", SampleType::U16},
+        {"int16", SampleType::I16},
+        {"i16", SampleType::I16},
+        {"short", SampleType::I16},
+        {"uint32", SampleType::U32},
+        {"u32", SampleType::U32},
+        {"uint", SampleType::U32},
+        {"int32", SampleType::I32},
+        {"i32", SampleType::I32},
+        {"int", SampleType::I32},
+        {"float32", SampleType::F32},
+        {"f32", SampleType::F32},
+        {"float", SampleType::F32},
+        {"float64", SampleType::F64},
+        {"f64", SampleType::F64},
+        {"double", SampleType::F64},
         // NRRD spellings (http://teem.sourceforge.net/nrrd/format.html#type)
-        {"signed char", SampleType::I8}, {"int8_t", SampleType::I8},
-        {"unsigned char", SampleType::U8}, {"uint8_t", SampleType::U8},
-        {"short int", SampleType::I16}, {"signed short", SampleType::I16},
-        {"signed short int", SampleType::I16}, {"int16_t", SampleType::I16},
-        {"unsigned short", SampleType::U16}, {"unsigned short int", SampleType::U16},
+        {"signed char", SampleType::I8},
+        {"int8_t", SampleType::I8},
+        {"unsigned char", SampleType::U8},
+        {"uint8_t", SampleType::U8},
+        {"short int", SampleType::I16},
+        {"signed short", SampleType::I16},
+        {"signed short int", SampleType::I16},
+        {"int16_t", SampleType::I16},
+        {"unsigned short", SampleType::U16},
+        {"unsigned short int", SampleType::U16},
         {"uint16_t", SampleType::U16},
-        {"signed int", SampleType::I32}, {"int32_t", SampleType::I32},
-        {"unsigned int", SampleType::U32}, {"uint32_t", SampleType::U32},
+        {"signed int", SampleType::I32},
+        {"int32_t", SampleType::I32},
+        {"unsigned int", SampleType::U32},
+        {"uint32_t", SampleType::U32},
     };
     for (const Alias& a : aliases)
         if (s == a.name) return a.type;
@@ -89,22 +131,37 @@ void decodeAs(const unsigned char* bytes, std::size_t count, bool bigEndian, flo
 
 }  // namespace
 
-void decodeSamples(const unsigned char* bytes, std::size_t count, SampleType t,
-                   bool bigEndian, float* out) {
+void decodeSamples(const unsigned char* bytes, std::size_t count, SampleType t, bool bigEndian,
+                   float* out) {
     switch (t) {
-        case SampleType::U8: decodeAs<std::uint8_t>(bytes, count, false, out); break;
-        case SampleType::I8: decodeAs<std::int8_t>(bytes, count, false, out); break;
-        case SampleType::U16: decodeAs<std::uint16_t>(bytes, count, bigEndian, out); break;
-        case SampleType::I16: decodeAs<std::int16_t>(bytes, count, bigEndian, out); break;
-        case SampleType::U32: decodeAs<std::uint32_t>(bytes, count, bigEndian, out); break;
-        case SampleType::I32: decodeAs<std::int32_t>(bytes, count, bigEndian, out); break;
-        case SampleType::F32: decodeAs<float>(bytes, count, bigEndian, out); break;
-        case SampleType::F64: decodeAs<double>(bytes, count, bigEndian, out); break;
+        case SampleType::U8:
+            decodeAs<std::uint8_t>(bytes, count, false, out);
+            break;
+        case SampleType::I8:
+            decodeAs<std::int8_t>(bytes, count, false, out);
+            break;
+        case SampleType::U16:
+            decodeAs<std::uint16_t>(bytes, count, bigEndian, out);
+            break;
+        case SampleType::I16:
+            decodeAs<std::int16_t>(bytes, count, bigEndian, out);
+            break;
+        case SampleType::U32:
+            decodeAs<std::uint32_t>(bytes, count, bigEndian, out);
+            break;
+        case SampleType::I32:
+            decodeAs<std::int32_t>(bytes, count, bigEndian, out);
+            break;
+        case SampleType::F32:
+            decodeAs<float>(bytes, count, bigEndian, out);
+            break;
+        case SampleType::F64:
+            decodeAs<double>(bytes, count, bigEndian, out);
+            break;
     }
 }
 
-void decodeText(const std::string& text, std::size_t count, float* out,
-                const std::string& what) {
+void decodeText(const std::string& text, std::size_t count, float* out, const std::string& what) {
     const char* p = text.c_str();
     for (std::size_t i = 0; i < count; ++i) {
         while (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r' || *p == ',') ++p;
@@ -114,16 +171,14 @@ void decodeText(const std::string& text, std::size_t count, float* out,
         char* end = nullptr;
         double value = std::strtod(p, &end);
         if (end == p)
-            throw Error(what + ": text data: cannot parse sample " + std::to_string(i) +
-                        " ('" + std::string(p, std::min<std::size_t>(16, std::strlen(p))) +
-                        "')");
+            throw Error(what + ": text data: cannot parse sample " + std::to_string(i) + " ('" +
+                        std::string(p, std::min<std::size_t>(16, std::strlen(p))) + "')");
         out[i] = static_cast<float>(value);
         p = end;
     }
 }
 
-void checkDataLength(std::size_t expected, std::size_t found, const std::string& what,
-                     bool exact) {
+void checkDataLength(std::size_t expected, std::size_t found, const std::string& what, bool exact) {
     if (found < expected)
         throw Error(what + ": truncated data: expected " + std::to_string(expected) +
                     " bytes, found " + std::to_string(found));

@@ -9,11 +9,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <glm/glm.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "splat/volume.h"
 #include "splat/volume_io.h"
@@ -34,13 +33,12 @@ std::optional<SampleType> parseSampleType(const std::string& name);
 
 /// Decodes `count` samples of type `t` stored with the given byte order from `bytes`
 /// into `out[0..count)`. `bytes` must hold count * sampleSize(t) bytes.
-void decodeSamples(const unsigned char* bytes, std::size_t count, SampleType t,
-                   bool bigEndian, float* out);
+void decodeSamples(const unsigned char* bytes, std::size_t count, SampleType t, bool bigEndian,
+                   float* out);
 
 /// Parses ASCII numbers (whitespace separated) into `out[0..count)`; throws naming
 /// `what` if fewer numbers are present or one does not parse.
-void decodeText(const std::string& text, std::size_t count, float* out,
-                const std::string& what);
+void decodeText(const std::string& text, std::size_t count, float* out, const std::string& what);
 
 // ---- files -----------------------------------------------------------------------
 
@@ -58,8 +56,8 @@ std::string trim(const std::string& s);
 
 /// A hidden temporary name next to `target`: ".STEM.tmpNNN EXT" (STEM defaults to
 /// target's file name), for writing before an atomic rename.
-std::filesystem::path temporarySibling(const std::filesystem::path& target,
-                                       const std::string& stem, const std::string& ext);
+std::filesystem::path temporarySibling(const std::filesystem::path& target, const std::string& stem,
+                                       const std::string& ext);
 /// Writes `bytes` to `path` atomically: a temporary file in the same folder, then
 /// std::filesystem::rename. The temporary is removed on failure.
 void writeFileAtomic(const std::filesystem::path& path, const void* bytes, std::size_t size);
@@ -73,8 +71,7 @@ void writeFileAtomic(const std::filesystem::path& path, const void* bytes, std::
 /// norms in their new places and origin the world position of the new first sample.
 /// A residual rotation larger than ~1e-3 is described in v.note (never dropped
 /// silently). `what` names the matrix's origin ("sform", "space directions").
-void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
-                      const std::string& what);
+void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t, const std::string& what);
 
 // ---- the loaders (one per file) --------------------------------------------------
 
@@ -98,7 +95,6 @@ bool naturalLess(const std::string& a, const std::string& b);
 /// Checks a sample count against the available bytes; throws
 /// "WHAT: truncated data: expected N bytes, found M" (or "... file holds M bytes, more
 /// than the N the header describes" when there is too much data and `exact`).
-void checkDataLength(std::size_t expected, std::size_t found, const std::string& what,
-                     bool exact);
+void checkDataLength(std::size_t expected, std::size_t found, const std::string& what, bool exact);
 
 }  // namespace splat::detail

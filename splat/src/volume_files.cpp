@@ -1,5 +1,7 @@
 // File helpers shared by the loaders and writers: whole-file reads with clear errors,
 // gzip/zlib inflation, atomic writes, extensions and natural sort order.
+#include <zlib.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -7,8 +9,6 @@
 #include <fstream>
 #include <random>
 #include <string>
-
-#include <zlib.h>
 
 #include "splat/error.h"
 #include "volume_detail.h"
@@ -95,8 +95,7 @@ std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t siz
     return out;
 }
 
-fs::path temporarySibling(const fs::path& target, const std::string& stem,
-                          const std::string& ext) {
+fs::path temporarySibling(const fs::path& target, const std::string& stem, const std::string& ext) {
     static std::random_device rd;
     std::string name(".");
     name += stem.empty() ? target.filename().string() : stem;

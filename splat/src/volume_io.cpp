@@ -1,12 +1,13 @@
 // loadVolume: picks the loader for a VOLUME argument (synthetic:, folder, extension,
 // or the file's magic bytes) and applies the NaN/Inf policy to every loaded volume.
+#include "splat/volume_io.h"
+
 #include <cmath>
 #include <cstring>
 #include <fstream>
 
 #include "splat/error.h"
 #include "splat/synthetic.h"
-#include "splat/volume_io.h"
 #include "volume_detail.h"
 
 namespace fs = std::filesystem;
@@ -73,7 +74,8 @@ Volume loadByType(const fs::path& p, const std::string& ext, const LoadOptions& 
     if (ext == ".raw") return detail::loadRaw(p, options.raw);
     if (ext == ".dcm" || ext == ".dicom") return detail::loadDicomFolder(p.parent_path(), {p});
     if (ext == ".png" || ext == ".tif" || ext == ".tiff")
-        throw Error(detail::displayName(p) + ": a single 2D image; give the folder of slices instead");
+        throw Error(detail::displayName(p) +
+                    ": a single 2D image; give the folder of slices instead");
     return Volume{};
 }
 

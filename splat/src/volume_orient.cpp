@@ -57,8 +57,8 @@ void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
         if (sign[a] < 0) origin += M[a] * double(fileDims[a] - 1);
     }
 
-    bool identity = best == std::array<int, 3>{0, 1, 2} && sign[0] > 0 && sign[1] > 0 &&
-                    sign[2] > 0;
+    bool identity =
+        best == std::array<int, 3>{0, 1, 2} && sign[0] > 0 && sign[1] > 0 && sign[2] > 0;
     if (!identity) {
         std::vector<float> out(v.data.size());
         const std::size_t nx = std::size_t(dims.x), ny = std::size_t(dims.y);
@@ -66,8 +66,9 @@ void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
         std::ptrdiff_t step[3];
         std::ptrdiff_t start = 0;
         for (int a = 0; a < 3; ++a) {
-            std::ptrdiff_t s = best[a] == 0 ? 1 : best[a] == 1 ? std::ptrdiff_t(nx)
-                                                               : std::ptrdiff_t(nx * ny);
+            std::ptrdiff_t s = best[a] == 0   ? 1
+                               : best[a] == 1 ? std::ptrdiff_t(nx)
+                                              : std::ptrdiff_t(nx * ny);
             if (sign[a] < 0) {
                 start += s * (fileDims[a] - 1);
                 s = -s;

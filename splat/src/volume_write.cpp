@@ -1,11 +1,11 @@
 // Writers: NIfTI-1 (through niftilib), NRRD and MetaImage, float32 samples with spacing
 // and origin. Each writes a temporary file in the destination folder and renames it,
 // so a failed or interrupted write never leaves a half-written volume behind.
+#include <nifti1_io.h>
+
 #include <cstdio>
 #include <cstring>
 #include <sstream>
-
-#include <nifti1_io.h>
 
 #include "splat/error.h"
 #include "splat/volume_io.h"
@@ -42,7 +42,8 @@ std::string floatBytes(const Volume& v) {
 void saveNifti(const std::string& path, const Volume& v) {
     checkWritable(v, path);
     std::string ext = lowerExtension(path);
-    if (ext != ".nii" && ext != ".nii.gz") throw Error(path + ": NIfTI output needs .nii or .nii.gz");
+    if (ext != ".nii" && ext != ".nii.gz")
+        throw Error(path + ": NIfTI output needs .nii or .nii.gz");
     fs::path target(path);
     const std::string file = target.filename().string();
     // niftilib picks compression from the name, so the temporary keeps the extension.
@@ -94,8 +95,8 @@ void saveNrrd(const std::string& path, const Volume& v) {
     std::ostringstream h;
     h << "NRRD0004\n# written by splat\ntype: float\ndimension: 3\nspace: right-anterior-superior\n"
       << "sizes: " << v.dims.x << ' ' << v.dims.y << ' ' << v.dims.z << '\n'
-      << "space directions: (" << fmt(v.spacing.x) << ",0,0) (0," << fmt(v.spacing.y)
-      << ",0) (0,0," << fmt(v.spacing.z) << ")\n"
+      << "space directions: (" << fmt(v.spacing.x) << ",0,0) (0," << fmt(v.spacing.y) << ",0) (0,0,"
+      << fmt(v.spacing.z) << ")\n"
       << "kinds: domain domain domain\nendian: little\nencoding: raw\n"
       << "space origin: (" << fmt(v.origin.x) << ',' << fmt(v.origin.y) << ',' << fmt(v.origin.z)
       << ")\n\n";
@@ -117,8 +118,8 @@ void saveMetaImage(const std::string& path, const Volume& v) {
       << fmt(v.spacing.z) << '\n'
       << "DimSize = " << v.dims.x << ' ' << v.dims.y << ' ' << v.dims.z << '\n'
       << "ElementType = MET_FLOAT\n"
-      << "ElementDataFile = " << (ext == ".mha" ? std::string("LOCAL") : rawPath.filename().string())
-      << '\n';
+      << "ElementDataFile = "
+      << (ext == ".mha" ? std::string("LOCAL") : rawPath.filename().string()) << '\n';
     if (ext == ".mha") {
         std::string bytes = h.str() + floatBytes(v);
         writeFileAtomic(path, bytes.data(), bytes.size());

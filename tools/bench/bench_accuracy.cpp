@@ -62,11 +62,16 @@ int main(int argc, char** argv) {
                 if (a + 1 >= argc) throw std::runtime_error(arg + " needs a value");
                 return argv[++a];
             };
-            if (arg == "--size") size = std::stoi(value());
-            else if (arg == "--mode") mode = value();
-            else if (arg == "--classify") classify = value();
-            else if (arg == "--azimuths") azimuths = parseList(value());
-            else if (arg == "--early-termination") earlyTermination = std::stod(value());
+            if (arg == "--size")
+                size = std::stoi(value());
+            else if (arg == "--mode")
+                mode = value();
+            else if (arg == "--classify")
+                classify = value();
+            else if (arg == "--azimuths")
+                azimuths = parseList(value());
+            else if (arg == "--early-termination")
+                earlyTermination = std::stod(value());
             else if (arg == "-h" || arg == "--help") {
                 usage();
                 return 0;
@@ -99,11 +104,12 @@ int main(int argc, char** argv) {
                                              {"sheet, slab 1", RendererKind::Sheet, 1.0},
                                              {"sheet, slab 0.5", RendererKind::Sheet, 0.5},
                                              {"sheet, slab 0.25", RendererKind::Sheet, 0.25}};
-        std::printf("Accuracy against the reference ray caster: %s, %dx%d, %s %s, transfer "
-                    "function %s, default kernel and reference settings (step %g voxels, "
-                    "tolerance %g), splatter early termination %g.\n\n",
-                    volumeSpec.c_str(), size, size, mode.c_str(), classify.c_str(), tf.c_str(),
-                    base.referenceStep, base.referenceTolerance, base.earlyTermination);
+        std::printf(
+            "Accuracy against the reference ray caster: %s, %dx%d, %s %s, transfer "
+            "function %s, default kernel and reference settings (step %g voxels, "
+            "tolerance %g), splatter early termination %g.\n\n",
+            volumeSpec.c_str(), size, size, mode.c_str(), classify.c_str(), tf.c_str(),
+            base.referenceStep, base.referenceTolerance, base.earlyTermination);
         std::printf("| azimuth | renderer | RMSE | PSNR (dB) | max abs | ms/frame |\n");
         std::printf("|---:|---|---:|---:|---:|---:|\n");
         for (double az : azimuths) {
@@ -114,8 +120,9 @@ int main(int argc, char** argv) {
             const Renderer reference(volume, rs);
             const auto t0 = std::chrono::steady_clock::now();
             const Image ref = reference.render(&refStats);
-            const double refMs = std::chrono::duration<double, std::milli>(
-                                     std::chrono::steady_clock::now() - t0).count();
+            const double refMs =
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                    .count();
             std::printf("| %g | reference (final step %g) | – | – | – | %.0f |\n", az,
                         refStats.referenceStep, refMs);
             std::fflush(stdout);
@@ -128,8 +135,9 @@ int main(int argc, char** argv) {
                 renderer.render();  // warm-up (first-touch allocations)
                 const auto a = std::chrono::steady_clock::now();
                 const Image im = renderer.render();
-                const double ms = std::chrono::duration<double, std::milli>(
-                                      std::chrono::steady_clock::now() - a).count();
+                const double ms =
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a)
+                        .count();
                 const ImageMetrics m = compareImages(im, ref);
                 std::printf("| %g | %s | %.3g | %.1f | %.3g | %.1f |\n", az, c.label.c_str(),
                             m.rmse, m.psnr, m.maxAbs, ms);

@@ -40,9 +40,9 @@ double closedFootprint(const Kernel& k, double r) {
     const double s = k.sigma(), R = k.radius();
     if (r >= R) return 0;
     const double L = std::sqrt(R * R - r * r), eR = std::exp(-R * R / (2 * s * s));
-    return k.normalisation() *
-           (s * std::sqrt(2 * kPi) * std::exp(-r * r / (2 * s * s)) * std::erf(L / (s * std::sqrt(2.0))) -
-            2 * L * eR - eR / (2 * s * s) * 4 * L * L * L / 3);
+    return k.normalisation() * (s * std::sqrt(2 * kPi) * std::exp(-r * r / (2 * s * s)) *
+                                    std::erf(L / (s * std::sqrt(2.0))) -
+                                2 * L * eR - eR / (2 * s * s) * 4 * L * L * L / 3);
 }
 
 double closedCumulative(const Kernel& k, double r, double z) {
@@ -52,7 +52,8 @@ double closedCumulative(const Kernel& k, double r, double z) {
     z = std::clamp(z, -L, L);
     const double eR = std::exp(-R * R / (2 * s * s)), q = 1 / (s * std::sqrt(2.0));
     return k.normalisation() *
-           (s * std::sqrt(kPi / 2) * std::exp(-r * r / (2 * s * s)) * (std::erf(z * q) + std::erf(L * q)) -
+           (s * std::sqrt(kPi / 2) * std::exp(-r * r / (2 * s * s)) *
+                (std::erf(z * q) + std::erf(L * q)) -
             eR * (z + L) - eR / (2 * s * s) * (L * L * (z + L) - (z * z * z + L * L * L) / 3));
 }
 
@@ -119,9 +120,10 @@ int main(int argc, char** argv) {
 
     std::printf("bench_footprint  kernel %s  (errors relative to the footprint peak, vs %s)\n\n",
                 kernel.name().c_str(), closed ? "the closed form" : "adaptive quadrature");
-    std::printf("Footprint table fp(r), linear in r^2 (default %d)\n", FootprintTable::kDefaultResolution);
-    std::printf("%10s %10s %12s %13s %14s %14s\n", "entries", "build ms", "bytes", "max error", "Mlookups/s",
-                "checksum");
+    std::printf("Footprint table fp(r), linear in r^2 (default %d)\n",
+                FootprintTable::kDefaultResolution);
+    std::printf("%10s %10s %12s %13s %14s %14s\n", "entries", "build ms", "bytes", "max error",
+                "Mlookups/s", "checksum");
     std::vector<FpRow> fpRows;
     for (int res = 256; res <= 65536; res *= 2) {
         auto t0 = Clock::now();
@@ -131,7 +133,8 @@ int main(int argc, char** argv) {
         const int samples = 200000;
         for (int i = 0; i <= samples; ++i) {
             const double r2 = R * R * i / samples;
-            const double ex = closed ? closedFootprint(kernel, std::sqrt(r2)) : reference.exact(std::sqrt(r2));
+            const double ex =
+                closed ? closedFootprint(kernel, std::sqrt(r2)) : reference.exact(std::sqrt(r2));
             err = std::max(err, std::abs(t.lookup(float(r2)) - ex));
             if (!closed) i += 19;  // quadrature is slower
         }
@@ -142,16 +145,19 @@ int main(int argc, char** argv) {
             for (int i = 0; i < n; ++i) out[i] += t.lookup(r2s[i]);  // like a sheet buffer
         auto t3 = Clock::now();
         const double sum = checksum(out);
-        FpRow row{res, 1e3 * seconds(t0, t1), err, double(n) * reps / seconds(t2, t3) / 1e6, t.bytes(), sum};
+        FpRow row{res,       1e3 * seconds(t0, t1),
+                  err,       double(n) * reps / seconds(t2, t3) / 1e6,
+                  t.bytes(), sum};
         fpRows.push_back(row);
-        std::printf("%10d %10.2f %12zu %13.2e %14.0f %14.6g%s\n", res, row.buildMs, row.bytes, row.maxErr,
-                    row.mlps, row.checksum, res == FootprintTable::kDefaultResolution ? "  <- default" : "");
+        std::printf("%10d %10.2f %12zu %13.2e %14.0f %14.6g%s\n", res, row.buildMs, row.bytes,
+                    row.maxErr, row.mlps, row.checksum,
+                    res == FootprintTable::kDefaultResolution ? "  <- default" : "");
     }
 
     std::printf("\nSlab table C(r, z) = fp(r^2) * F(r^2, z), F bilinear (default %d x %d)\n",
                 SlabTable::kDefaultRadial, SlabTable::kDefaultDepth);
-    std::printf("%6s x %-6s %10s %12s %13s %13s %14s %14s\n", "r^2", "z", "build ms", "bytes", "section err",
-                "partition err", "Msections/s", "checksum");
+    std::printf("%6s x %-6s %10s %12s %13s %13s %14s %14s\n", "r^2", "z", "build ms", "bytes",
+                "section err", "partition err", "Msections/s", "checksum");
     std::vector<SlabRow> slabRows;
     const int cfg[][2] = {{32, 256}, {64, 512}, {64, 1024}, {128, 1024}, {256, 2048}, {512, 4096}};
     for (const auto& c : cfg) {
@@ -164,10 +170,12 @@ int main(int argc, char** argv) {
         double err = 0, sumErr = 0;
         for (int i = 0; i < (closed ? 20000 : 2000); ++i) {
             const double r2 = R * R * V(g) * V(g), r = std::sqrt(r2);
-            double a = R * (2.2 * V(g) - 1.1), b = (i % 4 == 0) ? a + 0.2 * V(g) : R * (2.2 * V(g) - 1.1);
+            double a = R * (2.2 * V(g) - 1.1),
+                   b = (i % 4 == 0) ? a + 0.2 * V(g) : R * (2.2 * V(g) - 1.1);
             if (a > b) std::swap(a, b);
-            const double ex = closed ? closedCumulative(kernel, r, b) - closedCumulative(kernel, r, a)
-                                     : s.exact(r, b) - s.exact(r, a);
+            const double ex = closed
+                                  ? closedCumulative(kernel, r, b) - closedCumulative(kernel, r, a)
+                                  : s.exact(r, b) - s.exact(r, a);
             err = std::max(err, std::abs(s.section(float(r2), float(a), float(b)) - ex));
             // A partition of [-R, R] into 16 random slabs sums to the footprint.
             if (i % 10 == 0) {
@@ -175,7 +183,8 @@ int main(int argc, char** argv) {
                 for (int k = 0; k < 15; ++k) cuts.push_back(float(R * (2 * V(g) - 1)));
                 std::sort(cuts.begin(), cuts.end());
                 double sum = 0;
-                for (std::size_t k = 0; k + 1 < cuts.size(); ++k) sum += s.section(float(r2), cuts[k], cuts[k + 1]);
+                for (std::size_t k = 0; k + 1 < cuts.size(); ++k)
+                    sum += s.section(float(r2), cuts[k], cuts[k + 1]);
                 sumErr = std::max(sumErr, std::abs(sum - s.footprint().lookup(float(r2))));
             }
         }
@@ -185,17 +194,26 @@ int main(int argc, char** argv) {
             for (int i = 0; i < n; ++i) out[i] += s.section(r2s[i], z0s[i], z1s[i]);
         auto t3 = Clock::now();
         const double sum = checksum(out);
-        SlabRow row{c[0], c[1], 1e3 * seconds(t0, t1), err / peak, sumErr / peak,
-                    double(n) * (reps / 2) / seconds(t2, t3) / 1e6, s.bytes(), sum};
+        SlabRow row{c[0],
+                    c[1],
+                    1e3 * seconds(t0, t1),
+                    err / peak,
+                    sumErr / peak,
+                    double(n) * (reps / 2) / seconds(t2, t3) / 1e6,
+                    s.bytes(),
+                    sum};
         slabRows.push_back(row);
         const bool def = c[0] == SlabTable::kDefaultRadial && c[1] == SlabTable::kDefaultDepth;
-        std::printf("%6d x %-6d %10.2f %12zu %13.2e %13.2e %14.0f %14.6g%s\n", row.nr, row.nz, row.buildMs,
-                    row.bytes, row.maxErr, row.sumErr, row.msps, row.checksum, def ? "  <- default" : "");
+        std::printf("%6d x %-6d %10.2f %12zu %13.2e %13.2e %14.0f %14.6g%s\n", row.nr, row.nz,
+                    row.buildMs, row.bytes, row.maxErr, row.sumErr, row.msps, row.checksum,
+                    def ? "  <- default" : "");
     }
-    std::printf("\nmax error: over %s; section err: 20000 random sections (a quarter of them thinner "
-                "than 0.2 voxel);\npartition err: 16 random slabs vs the full footprint. One thread, "
-                "%d-entry random stream,\nrepeated (10%% of it beyond R), "
-                "results added into an output array.\n", "200001 r^2 values uniform in [0, R^2]", n);
+    std::printf(
+        "\nmax error: over %s; section err: 20000 random sections (a quarter of them thinner "
+        "than 0.2 voxel);\npartition err: 16 random slabs vs the full footprint. One thread, "
+        "%d-entry random stream,\nrepeated (10%% of it beyond R), "
+        "results added into an output array.\n",
+        "200001 r^2 values uniform in [0, R^2]", n);
 
     if (!json.empty()) {
         std::ostringstream o;
@@ -203,17 +221,20 @@ int main(int argc, char** argv) {
         o << "{\n  \"kernel\": \"" << kernel.name() << "\",\n  \"footprint\": [\n";
         for (std::size_t i = 0; i < fpRows.size(); ++i) {
             const auto& r = fpRows[i];
-            o << "    {\"resolution\": " << r.resolution << ", \"build_ms\": " << r.buildMs << ", \"bytes\": "
-              << r.bytes << ", \"max_error_rel_peak\": " << r.maxErr << ", \"mlookups_per_s\": " << r.mlps
-              << ", \"checksum\": " << r.checksum << "}" << (i + 1 < fpRows.size() ? "," : "") << "\n";
+            o << "    {\"resolution\": " << r.resolution << ", \"build_ms\": " << r.buildMs
+              << ", \"bytes\": " << r.bytes << ", \"max_error_rel_peak\": " << r.maxErr
+              << ", \"mlookups_per_s\": " << r.mlps << ", \"checksum\": " << r.checksum << "}"
+              << (i + 1 < fpRows.size() ? "," : "") << "\n";
         }
         o << "  ],\n  \"slab\": [\n";
         for (std::size_t i = 0; i < slabRows.size(); ++i) {
             const auto& r = slabRows[i];
-            o << "    {\"radial\": " << r.nr << ", \"depth\": " << r.nz << ", \"build_ms\": " << r.buildMs
-              << ", \"bytes\": " << r.bytes << ", \"max_section_error_rel_peak\": " << r.maxErr
-              << ", \"max_partition_error_rel_peak\": " << r.sumErr << ", \"msections_per_s\": " << r.msps
-              << ", \"checksum\": " << r.checksum << "}" << (i + 1 < slabRows.size() ? "," : "") << "\n";
+            o << "    {\"radial\": " << r.nr << ", \"depth\": " << r.nz
+              << ", \"build_ms\": " << r.buildMs << ", \"bytes\": " << r.bytes
+              << ", \"max_section_error_rel_peak\": " << r.maxErr
+              << ", \"max_partition_error_rel_peak\": " << r.sumErr
+              << ", \"msections_per_s\": " << r.msps << ", \"checksum\": " << r.checksum << "}"
+              << (i + 1 < slabRows.size() ? "," : "") << "\n";
         }
         o << "  ]\n}\n";
         const std::string tmp = json + ".tmp";

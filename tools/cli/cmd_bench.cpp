@@ -4,10 +4,9 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
-
-#include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "render_options.h"
@@ -43,14 +42,18 @@ std::vector<int> parseThreads(const std::string& text) {
 
 void registerBench(CLI::App& app) {
     auto a = std::make_shared<BenchCommand>();
-    CLI::App* cmd = app.add_subcommand("bench", "time rendering (median of repeats) per thread count");
+    CLI::App* cmd =
+        app.add_subcommand("bench", "time rendering (median of repeats) per thread count");
     addVolumeOptions(*cmd, a->volume);
     addRenderOptions(*cmd, a->render);
-    cmd->add_option("--repeats", a->repeats, "timed frames per configuration")->capture_default_str();
-    cmd->add_option("--thread-list", a->threadList, "thread counts to time, e.g. 1,2")->capture_default_str();
+    cmd->add_option("--repeats", a->repeats, "timed frames per configuration")
+        ->capture_default_str();
+    cmd->add_option("--thread-list", a->threadList, "thread counts to time, e.g. 1,2")
+        ->capture_default_str();
     cmd->add_option("--json", a->json, "write the results as JSON");
     cmd->callback([a] {
-        if (a->repeats < 1 || a->repeats > 1000) throw Error("--repeats must be between 1 and 1000");
+        if (a->repeats < 1 || a->repeats > 1000)
+            throw Error("--repeats must be between 1 and 1000");
         const std::vector<int> threads = parseThreads(a->threadList);
         RenderSettings settings = settingsFromArgs(a->render);
         const Volume volume = loadVolumeFromArgs(a->volume);
@@ -76,8 +79,9 @@ void registerBench(CLI::App& app) {
             std::sort(ms.begin(), ms.end());
             const double median = ms[ms.size() / 2];
             const double rate = double(stats.footprintPixels) / (median * 1e-3);
-            std::printf("%-8d %-7s %8zu %10.1f %10.1f %12zu %14.3g\n", t, toString(settings.renderer),
-                        stats.splats, median, ms.front(), stats.footprintPixels, rate);
+            std::printf("%-8d %-7s %8zu %10.1f %10.1f %12zu %14.3g\n", t,
+                        toString(settings.renderer), stats.splats, median, ms.front(),
+                        stats.footprintPixels, rate);
             out["runs"].push_back({{"threads", t},
                                    {"median_ms", median},
                                    {"min_ms", ms.front()},

@@ -1,16 +1,16 @@
 // `splat compare A B [--heatmap OUT] [--scale S] [--json FILE]`: accuracy of test image A
 // against reference image B (RGB; alpha ignored): RMSE, PSNR, max abs, mean abs over the
 // foreground.
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <system_error>
-#include <unistd.h>
-
-#include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "splat/error.h"
@@ -28,8 +28,8 @@ struct CompareArgs {
 void writeJsonAtomically(const std::string& path, const nlohmann::json& j) {
     namespace fs = std::filesystem;
     const fs::path target(path);
-    const fs::path tmp =
-        target.parent_path() / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
+    const fs::path tmp = target.parent_path() /
+                         ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
     {
         std::ofstream out(tmp);
         if (!out) throw Error("compare: cannot write " + path);
@@ -89,9 +89,10 @@ void run(const CompareArgs& a) {
 
 void registerCompare(CLI::App& app) {
     auto args = std::make_shared<CompareArgs>();
-    CLI::App* cmd = app.add_subcommand(
-        "compare", "Compare a test image A with a reference image B: RMSE, PSNR, max abs, "
-                   "mean abs over the foreground");
+    CLI::App* cmd =
+        app.add_subcommand("compare",
+                           "Compare a test image A with a reference image B: RMSE, PSNR, max abs, "
+                           "mean abs over the foreground");
     cmd->add_option("A", args->test, "Test image (.exr for linear values)")->required();
     cmd->add_option("B", args->reference, "Reference image")->required();
     cmd->add_option("--heatmap", args->heatmap, "Write |A - B| as an 'inferno' heat map");

@@ -23,7 +23,8 @@ void registerRender(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("render", "render one image of a volume");
     addVolumeOptions(*cmd, args->volume);
     addRenderOptions(*cmd, args->render);
-    cmd->add_option("-o,--output", args->output, "output image: .png (8-bit display), .exr or .tif (float)")
+    cmd->add_option("-o,--output", args->output,
+                    "output image: .png (8-bit display), .exr or .tif (float)")
         ->required();
     cmd->callback([args] {
         checkImagePath(args->output);
@@ -33,12 +34,14 @@ void registerRender(CLI::App& app) {
         RenderStats stats;
         const Image image = renderer.render(&stats);
         writeImage(args->output, image, displayOptions(args->render, settings, image));
-        const double skipped = stats.voxels ? 100.0 * (1.0 - double(stats.splats) / stats.voxels) : 0.0;
-        std::printf("wrote %s: %dx%d, %s %s, %zu splats of %zu voxels (%.1f%% skipped, splat list "
-                    "%.1f MiB), %.1f ms\n",
-                    args->output.c_str(), image.width, image.height, toString(settings.renderer),
-                    toString(settings.mode), stats.splats, stats.voxels, skipped,
-                    renderer.splats().bytes() / 1048576.0, stats.milliseconds);
+        const double skipped =
+            stats.voxels ? 100.0 * (1.0 - double(stats.splats) / stats.voxels) : 0.0;
+        std::printf(
+            "wrote %s: %dx%d, %s %s, %zu splats of %zu voxels (%.1f%% skipped, splat list "
+            "%.1f MiB), %.1f ms\n",
+            args->output.c_str(), image.width, image.height, toString(settings.renderer),
+            toString(settings.mode), stats.splats, stats.voxels, skipped,
+            renderer.splats().bytes() / 1048576.0, stats.milliseconds);
     });
 }
 

@@ -43,8 +43,10 @@ void registerRotate(CLI::App& app) {
     cmd->add_option("--gif", a->gif, "also write an animated GIF");
     cmd->add_option("--fps", a->fps, "GIF frames per second")->capture_default_str();
     cmd->callback([a] {
-        if (a->frames < 1 || a->frames > 100000) throw Error("--frames must be between 1 and 100000");
-        if (!std::isfinite(a->from) || !std::isfinite(a->to)) throw Error("--from/--to must be finite");
+        if (a->frames < 1 || a->frames > 100000)
+            throw Error("--frames must be between 1 and 100000");
+        if (!std::isfinite(a->from) || !std::isfinite(a->to))
+            throw Error("--from/--to must be finite");
         if (a->format != "png" && a->format != "exr" && a->format != "tif")
             throw Error("--format must be png, exr or tif");
         if (!a->gif.empty()) {
@@ -57,7 +59,8 @@ void registerRotate(CLI::App& app) {
         }
         const RenderSettings settings = settingsFromArgs(a->render);
         // The GIF is assembled in memory: keep it under 4 GiB of float frames.
-        if (!a->gif.empty() && double(a->frames) * settings.camera.width * settings.camera.height > double(1 << 28))
+        if (!a->gif.empty() &&
+            double(a->frames) * settings.camera.width * settings.camera.height > double(1 << 28))
             throw Error("--gif with " + std::to_string(a->frames) + " frames of " + a->render.size +
                         " would not fit in memory; use fewer frames or a smaller --size");
         const Volume volume = loadVolumeFromArgs(a->volume);

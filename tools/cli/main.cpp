@@ -1,14 +1,14 @@
 // The `splat` command-line program: see README.md ("Command line") and DESIGN.md.
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
-
-#include <CLI/CLI.hpp>
 
 #include "commands.h"
 
 int main(int argc, char** argv) {
-    CLI::App app{"splat: splatting volume renderer (axis-aligned and image-aligned sheet "
-                 "buffers, reference ray caster)"};
+    CLI::App app{
+        "splat: splatting volume renderer (axis-aligned and image-aligned sheet "
+        "buffers, reference ray caster)"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "splat 0.1.0");
     splat::cli::registerInfo(app);

@@ -3,9 +3,8 @@
 
 #include <cmath>
 #include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "splat/error.h"
 
@@ -15,32 +14,48 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
     a.cmd = &cmd;
     cmd.add_option("--renderer", a.renderer, "axis | sheet | reference")->capture_default_str();
     cmd.add_option("--mode", a.mode, "dvr | mip | xray | iso")->capture_default_str();
-    cmd.add_option("--order", a.order, "ftb (front-to-back) | btf (back-to-front)")->capture_default_str();
-    cmd.add_option("--classify", a.classify, "pre | post (classification before or after reconstruction)")
+    cmd.add_option("--order", a.order, "ftb (front-to-back) | btf (back-to-front)")
         ->capture_default_str();
-    cmd.add_option("--tf", a.tf, "transfer function preset (ct-bone, ct-soft, mri-head, gray-ramp) or FILE.json")
+    cmd.add_option("--classify", a.classify,
+                   "pre | post (classification before or after reconstruction)")
+        ->capture_default_str();
+    cmd.add_option("--tf", a.tf,
+                   "transfer function preset (ct-bone, ct-soft, mri-head, gray-ramp) or FILE.json")
         ->capture_default_str();
     cmd.add_option("--size", a.size, "image size WxH")->capture_default_str();
     cmd.add_option("--azimuth", a.azimuth, "camera azimuth, degrees")->capture_default_str();
     cmd.add_option("--elevation", a.elevation, "camera elevation, degrees")->capture_default_str();
     cmd.add_option("--projection", a.projection, "ortho | perspective")->capture_default_str();
-    cmd.add_option("--pixel-size", a.pixelSize, "world units per pixel (0 = fit the volume)")->capture_default_str();
-    cmd.add_option("--fov", a.fov, "perspective vertical field of view, degrees")->capture_default_str();
+    cmd.add_option("--pixel-size", a.pixelSize, "world units per pixel (0 = fit the volume)")
+        ->capture_default_str();
+    cmd.add_option("--fov", a.fov, "perspective vertical field of view, degrees")
+        ->capture_default_str();
     cmd.add_option("--slab", a.slab, "image-aligned slab thickness, voxels")->capture_default_str();
-    cmd.add_option("--kernel", a.kernel, "reconstruction kernel: gaussian | bspline")->capture_default_str();
-    cmd.add_option("--sigma", a.sigma, "Gaussian sigma in voxels (0 = default)")->capture_default_str();
-    cmd.add_option("--radius", a.radius, "kernel radius in voxels (0 = default)")->capture_default_str();
+    cmd.add_option("--kernel", a.kernel, "reconstruction kernel: gaussian | bspline")
+        ->capture_default_str();
+    cmd.add_option("--sigma", a.sigma, "Gaussian sigma in voxels (0 = default)")
+        ->capture_default_str();
+    cmd.add_option("--radius", a.radius, "kernel radius in voxels (0 = default)")
+        ->capture_default_str();
     cmd.add_option("--early-termination", a.earlyTermination,
-                   "front-to-back: stop when opacity >= 1 - EPS (0 = off)")->capture_default_str();
-    cmd.add_option("--background", a.background, "background R,G,B[,A] in [0, 1]")->capture_default_str();
-    cmd.add_option("--iso-level", a.isoLevel, "iso mode: level of the density")->capture_default_str();
+                   "front-to-back: stop when opacity >= 1 - EPS (0 = off)")
+        ->capture_default_str();
+    cmd.add_option("--background", a.background, "background R,G,B[,A] in [0, 1]")
+        ->capture_default_str();
+    cmd.add_option("--iso-level", a.isoLevel, "iso mode: level of the density")
+        ->capture_default_str();
     cmd.add_option("--window", a.window, "mip/xray PNG display window LOW,HIGH (default 0,max)");
     cmd.add_option("--threads", a.threads, "worker threads (0 = all cores)")->capture_default_str();
-    cmd.add_option("--tile-size", a.tileSize, "screen tile edge in pixels (8..64)")->capture_default_str();
-    cmd.add_option("--ref-step", a.refStep, "reference: initial step, voxels")->capture_default_str();
-    cmd.add_option("--ref-tolerance", a.refTolerance, "reference: step refinement tolerance")->capture_default_str();
-    cmd.add_flag("--shade", a.shade, "headlight Phong shading from the density gradient (pre-classified dvr)");
-    cmd.add_option("--scene", a.scene, "scene FILE.json holding any of these options (flags override it)");
+    cmd.add_option("--tile-size", a.tileSize, "screen tile edge in pixels (8..64)")
+        ->capture_default_str();
+    cmd.add_option("--ref-step", a.refStep, "reference: initial step, voxels")
+        ->capture_default_str();
+    cmd.add_option("--ref-tolerance", a.refTolerance, "reference: step refinement tolerance")
+        ->capture_default_str();
+    cmd.add_flag("--shade", a.shade,
+                 "headlight Phong shading from the density gradient (pre-classified dvr)");
+    cmd.add_option("--scene", a.scene,
+                   "scene FILE.json holding any of these options (flags override it)");
 }
 
 glm::ivec2 parseSize(const std::string& text, const std::string& what) {
@@ -104,31 +119,56 @@ RenderArgs withScene(const RenderArgs& given) {
     try {
         for (auto& [key, value] : j.items()) {
             if (flagGiven(key)) continue;
-            if (key == "renderer") a.renderer = value.get<std::string>();
-            else if (key == "mode") a.mode = value.get<std::string>();
-            else if (key == "order") a.order = value.get<std::string>();
-            else if (key == "classify") a.classify = value.get<std::string>();
-            else if (key == "tf") a.tf = value.get<std::string>();
-            else if (key == "size") a.size = value.get<std::string>();
-            else if (key == "projection") a.projection = value.get<std::string>();
-            else if (key == "kernel") a.kernel = value.get<std::string>();
-            else if (key == "background") a.background = value.get<std::string>();
-            else if (key == "window") a.window = value.get<std::string>();
-            else if (key == "azimuth") a.azimuth = value.get<double>();
-            else if (key == "elevation") a.elevation = value.get<double>();
-            else if (key == "pixel-size") a.pixelSize = value.get<double>();
-            else if (key == "fov") a.fov = value.get<double>();
-            else if (key == "slab") a.slab = value.get<double>();
-            else if (key == "sigma") a.sigma = value.get<double>();
-            else if (key == "radius") a.radius = value.get<double>();
-            else if (key == "early-termination") a.earlyTermination = value.get<double>();
-            else if (key == "iso-level") a.isoLevel = value.get<double>();
-            else if (key == "ref-step") a.refStep = value.get<double>();
-            else if (key == "ref-tolerance") a.refTolerance = value.get<double>();
-            else if (key == "threads") a.threads = value.get<int>();
-            else if (key == "tile-size") a.tileSize = value.get<int>();
-            else if (key == "shade") a.shade = value.get<bool>();
-            else throw Error(given.scene + ": unknown scene key '" + key + "'");
+            if (key == "renderer")
+                a.renderer = value.get<std::string>();
+            else if (key == "mode")
+                a.mode = value.get<std::string>();
+            else if (key == "order")
+                a.order = value.get<std::string>();
+            else if (key == "classify")
+                a.classify = value.get<std::string>();
+            else if (key == "tf")
+                a.tf = value.get<std::string>();
+            else if (key == "size")
+                a.size = value.get<std::string>();
+            else if (key == "projection")
+                a.projection = value.get<std::string>();
+            else if (key == "kernel")
+                a.kernel = value.get<std::string>();
+            else if (key == "background")
+                a.background = value.get<std::string>();
+            else if (key == "window")
+                a.window = value.get<std::string>();
+            else if (key == "azimuth")
+                a.azimuth = value.get<double>();
+            else if (key == "elevation")
+                a.elevation = value.get<double>();
+            else if (key == "pixel-size")
+                a.pixelSize = value.get<double>();
+            else if (key == "fov")
+                a.fov = value.get<double>();
+            else if (key == "slab")
+                a.slab = value.get<double>();
+            else if (key == "sigma")
+                a.sigma = value.get<double>();
+            else if (key == "radius")
+                a.radius = value.get<double>();
+            else if (key == "early-termination")
+                a.earlyTermination = value.get<double>();
+            else if (key == "iso-level")
+                a.isoLevel = value.get<double>();
+            else if (key == "ref-step")
+                a.refStep = value.get<double>();
+            else if (key == "ref-tolerance")
+                a.refTolerance = value.get<double>();
+            else if (key == "threads")
+                a.threads = value.get<int>();
+            else if (key == "tile-size")
+                a.tileSize = value.get<int>();
+            else if (key == "shade")
+                a.shade = value.get<bool>();
+            else
+                throw Error(given.scene + ": unknown scene key '" + key + "'");
         }
     } catch (const nlohmann::json::exception& e) {
         throw Error(given.scene + ": wrong value type (" + std::string(e.what()) + ")");
@@ -166,7 +206,8 @@ RenderSettings settingsFromArgs(const RenderArgs& given) {
     s.earlyTermination = a.earlyTermination;
     const std::vector<double> bg = parseList(a.background, "--background");
     if (bg.size() != 3 && bg.size() != 4) throw Error("--background needs R,G,B or R,G,B,A");
-    s.background = glm::vec4(float(bg[0]), float(bg[1]), float(bg[2]), bg.size() == 4 ? float(bg[3]) : 1.0f);
+    s.background =
+        glm::vec4(float(bg[0]), float(bg[1]), float(bg[2]), bg.size() == 4 ? float(bg[3]) : 1.0f);
     s.isoLevel = a.isoLevel;
     s.threads = a.threads;
     s.tileSize = a.tileSize;

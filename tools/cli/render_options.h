@@ -2,9 +2,8 @@
 // The rendering options shared by render, rotate and bench (DESIGN.md "Command line"),
 // including --scene FILE.json: the scene file is read first and every flag given on the
 // command line overrides it.
-#include <string>
-
 #include <CLI/CLI.hpp>
+#include <string>
 
 #include "splat/image_io.h"
 #include "splat/render.h"

@@ -32,7 +32,7 @@ glm::dvec3 parseSpacing(const std::string& s) {
     std::istringstream in(t);
     double v[3];
     std::string rest;
-    if (!(in >> v[0]) ) throw Error("--spacing '" + s + "': expected X,Y,Z, e.g. 1,1,2.5");
+    if (!(in >> v[0])) throw Error("--spacing '" + s + "': expected X,Y,Z, e.g. 1,1,2.5");
     if (!(in >> v[1])) {
         v[1] = v[2] = v[0];  // one number: isotropic
     } else if (!(in >> v[2]) || (in >> rest)) {

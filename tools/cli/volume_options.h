@@ -1,8 +1,7 @@
 #pragma once
 // Command-line options that say how to read VOLUME (shared by every subcommand).
-#include <string>
-
 #include <CLI/CLI.hpp>
+#include <string>
 
 #include "splat/volume_io.h"
 

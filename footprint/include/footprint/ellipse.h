@@ -83,8 +83,7 @@ EllipticalFootprint ellipticalFootprint(const glm::dvec3& spacing, const glm::dv
 /// plane (d.forward <= 0) gives an empty footprint (scale 0, zero extents).
 EllipticalFootprint perspectiveFootprint(const glm::dvec3& spacing, const glm::dvec3& eye,
                                          const glm::dvec3& right, const glm::dvec3& up,
-                                         const glm::dvec3& forward, double focal,
-                                         double pixelSize, const glm::dvec3& centre,
-                                         double radius);
+                                         const glm::dvec3& forward, double focal, double pixelSize,
+                                         const glm::dvec3& centre, double radius);
 
 }  // namespace footprint

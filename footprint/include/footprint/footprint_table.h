@@ -21,7 +21,7 @@
 namespace footprint {
 
 class FootprintTable {
-public:
+  public:
     /// `resolution` intervals uniformly spaced in r^2 over [0, R^2] (resolution + 1 samples
     /// plus a zero guard). Throws std::invalid_argument unless 2 <= resolution <= 2^24.
     explicit FootprintTable(const Kernel& kernel, int resolution = kDefaultResolution);
@@ -54,7 +54,7 @@ public:
     float invStep() const { return invStep_; }
     float r2Max() const { return r2Max_; }
 
-private:
+  private:
     Kernel kernel_;
     int resolution_ = 0;
     float r2Max_ = 0, invStep_ = 0, tMax_ = 0;

@@ -42,7 +42,7 @@ enum class KernelType {
 };
 
 class Kernel {
-public:
+  public:
     static constexpr double kDefaultSigma = 0.65;
     static constexpr double kDefaultRadius = 2.0;
     static constexpr double kDefaultBSplineScale = 1.0;
@@ -64,9 +64,9 @@ public:
     static std::vector<std::string> names();
 
     KernelType type() const { return type_; }
-    std::string name() const;     ///< e.g. "gaussian(sigma=0.65, R=2)"
+    std::string name() const;  ///< e.g. "gaussian(sigma=0.65, R=2)"
     double radius() const { return radius_; }
-    double sigma() const { return sigma_; }  ///< Gaussian sigma, or B-spline scale
+    double sigma() const { return sigma_; }         ///< Gaussian sigma, or B-spline scale
     double normalisation() const { return norm_; }  ///< N above
 
     /// Normalised kernel value at distance u (voxels); 0 for |u| >= R (and for NaN).
@@ -77,7 +77,7 @@ public:
     /// covers the whole cell, corners and centre included): the partition-of-unity ripple.
     double partitionOfUnityRipple(int samples = 9) const;
 
-private:
+  private:
     double raw(double u) const;  // un-normalised profile
     KernelType type_ = KernelType::Gaussian;
     double sigma_ = 1.0, radius_ = 2.0, norm_ = 1.0, offset_ = 0.0;  // offset_ = e_R

@@ -29,7 +29,7 @@
 namespace footprint {
 
 class SlabTable {
-public:
+  public:
     /// `radialResolution` intervals in r^2 over [0, R^2], `depthResolution` intervals in z
     /// over [-R, R]. Throws std::invalid_argument unless both are in [2, 2^14].
     SlabTable(const Kernel& kernel, int radialResolution = kDefaultRadial,
@@ -75,12 +75,14 @@ public:
         int stride;
         float invR2Step, invZStep, zMin, nrf, nzf;
     };
-    Grid grid() const { return {values_.data(), stride_, invR2Step_, invZStep_, zMin_, nrf_, nzf_}; }
+    Grid grid() const {
+        return {values_.data(), stride_, invR2Step_, invZStep_, zMin_, nrf_, nzf_};
+    }
 
     /// Memory of the fraction grid plus the footprint table.
     std::size_t bytes() const { return values_.size() * sizeof(float) + footprint_.bytes(); }
 
-private:
+  private:
     Kernel kernel_;
     FootprintTable footprint_;
     int nr_ = 0, nz_ = 0, stride_ = 0;

@@ -28,7 +28,7 @@ struct Ray {
 };
 
 class Camera {
-public:
+  public:
     Camera(const CameraParams& params, const Volume& volume);
 
     const CameraParams& params() const { return params_; }
@@ -51,7 +51,7 @@ public:
     /// along view from the ray origin plane (orthographic) or from the eye (perspective).
     glm::dvec3 project(const glm::dvec3& world) const;
 
-private:
+  private:
     CameraParams params_;
 };
 

@@ -17,15 +17,15 @@ enum class RenderMode { Dvr, Mip, Xray, Iso };
 enum class Classification { Pre, Post };
 
 struct SplatList {
-    std::vector<float> x, y, z;            ///< world position of the voxel
-    std::vector<std::uint16_t> i, j, k;    ///< index position
-    std::vector<float> density;            ///< d_i
-    std::vector<float> extinction;         ///< rho_i = f_rho(d_i), per world unit (pre)
-    std::vector<float> r, g, b;            ///< premultiplied emission e_i = colour * rho_i (pre)
+    std::vector<float> x, y, z;          ///< world position of the voxel
+    std::vector<std::uint16_t> i, j, k;  ///< index position
+    std::vector<float> density;          ///< d_i
+    std::vector<float> extinction;       ///< rho_i = f_rho(d_i), per world unit (pre)
+    std::vector<float> r, g, b;          ///< premultiplied emission e_i = colour * rho_i (pre)
     /// Unit normals -grad d / |grad d| (central differences in world units), only when
     /// classify() was asked for them (shading); empty otherwise.
     std::vector<float> nx, ny, nz;
-    std::size_t voxels = 0;                ///< voxels considered
+    std::size_t voxels = 0;  ///< voxels considered
     std::size_t size() const { return x.size(); }
     std::size_t bytes() const;
 };

@@ -2,9 +2,8 @@
 // An RGBA float image, row 0 at the top; pixel (x, y) has its centre at (x + 0.5, y + 0.5).
 // Colour is premultiplied by alpha.
 #include <cstddef>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 namespace splat {
 

@@ -7,9 +7,9 @@
 namespace splat {
 
 struct ImageMetrics {
-    double rmse = 0;         ///< over all pixels and RGB channels
-    double psnr = 0;         ///< 20 log10(peak / rmse), peak = max of the reference (>= 1e-12)
-    double maxAbs = 0;       ///< largest absolute channel difference
+    double rmse = 0;    ///< over all pixels and RGB channels
+    double psnr = 0;    ///< 20 log10(peak / rmse), peak = max of the reference (>= 1e-12)
+    double maxAbs = 0;  ///< largest absolute channel difference
     double meanAbsForeground = 0;  ///< mean abs difference over pixels non-background in either
     std::size_t foregroundPixels = 0;
 };

@@ -3,10 +3,9 @@
 // splatter (axis-aligned | image-aligned sheets) -> compositing -> image, and the
 // reference ray caster of the same model. A Renderer holds everything that does not
 // depend on the view (kernel tables, splat list), so rotation sequences reuse it.
+#include <glm/glm.hpp>
 #include <memory>
 #include <string>
-
-#include <glm/glm.hpp>
 
 #include "splat/camera.h"
 #include "splat/classify.h"
@@ -26,16 +25,16 @@ struct RenderSettings {
     Classification classification = Classification::Pre;
     TransferFunction transfer = TransferFunction::preset("gray-ramp");
     CameraParams camera;
-    std::string kernel = "gaussian";  ///< footprint::Kernel::fromName
+    std::string kernel = "gaussian";           ///< footprint::Kernel::fromName
     double kernelSigma = 0, kernelRadius = 0;  ///< 0: the kernel's defaults
-    double slab = 1.0;                ///< image-aligned slab thickness, voxels
+    double slab = 1.0;                         ///< image-aligned slab thickness, voxels
     /// Front-to-back early termination when opacity >= 1 - epsilon (0 disables).
     double earlyTermination = 1.0 / 256.0;
-    glm::vec4 background{0.0f};       ///< premultiplied RGBA behind the volume
-    double isoLevel = 0.5;            ///< iso mode: level of f (absolute density)
-    Shading shading;                  ///< headlight shading (pre-classified dvr)
-    int threads = 0;                  ///< 0: all cores
-    int tileSize = 32;                ///< screen tile edge, pixels
+    glm::vec4 background{0.0f};  ///< premultiplied RGBA behind the volume
+    double isoLevel = 0.5;       ///< iso mode: level of f (absolute density)
+    Shading shading;             ///< headlight shading (pre-classified dvr)
+    int threads = 0;             ///< 0: all cores
+    int tileSize = 32;           ///< screen tile edge, pixels
     /// Reference ray caster: step in voxels of the first pass and the image tolerance at
     /// which step refinement stops (max abs change of any channel).
     double referenceStep = 0.25, referenceTolerance = 1e-4;
@@ -44,18 +43,18 @@ struct RenderSettings {
 /// Counters of one frame.
 struct RenderStats {
     double milliseconds = 0;
-    std::size_t splats = 0;            ///< splats in the list
-    std::size_t voxels = 0;            ///< voxels considered by classification
-    std::size_t footprintPixels = 0;   ///< footprint-pixel updates
-    std::size_t sheets = 0;            ///< sheets composited (summed over tiles)
-    std::size_t culledSplats = 0;      ///< splats skipped by occlusion culling
-    double referenceStep = 0;          ///< reference: final step (voxels)
+    std::size_t splats = 0;           ///< splats in the list
+    std::size_t voxels = 0;           ///< voxels considered by classification
+    std::size_t footprintPixels = 0;  ///< footprint-pixel updates
+    std::size_t sheets = 0;           ///< sheets composited (summed over tiles)
+    std::size_t culledSplats = 0;     ///< splats skipped by occlusion culling
+    double referenceStep = 0;         ///< reference: final step (voxels)
     /// Stage times of the splatters: project, order + bin to tiles, rasterise + composite.
     double projectMs = 0, binMs = 0, tilesMs = 0;
 };
 
 class Renderer {
-public:
+  public:
     /// Classifies the volume and builds the kernel tables. Throws splat::Error on
     /// impossible settings (slab <= 0, iso with a splatter, ...).
     Renderer(const Volume& volume, const RenderSettings& settings);
@@ -70,7 +69,7 @@ public:
     const SplatList& splats() const;
     const RenderSettings& settings() const;
 
-private:
+  private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };

@@ -3,20 +3,19 @@
 // length (unit distance) unitDistance in world units, like VTK's scalar opacity unit
 // distance, and turned into extinction per world unit with the opacity correction
 //   rho = -ln(1 - alpha) / unitDistance.
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace splat {
 
 struct TransferPoint {
-    float value = 0;         ///< density (absolute units after resolve())
-    glm::vec4 rgba{0.0f};    ///< colour (not premultiplied) and opacity per unit distance
+    float value = 0;       ///< density (absolute units after resolve())
+    glm::vec4 rgba{0.0f};  ///< colour (not premultiplied) and opacity per unit distance
 };
 
 class TransferFunction {
-public:
+  public:
     std::string name = "custom";
     std::vector<TransferPoint> points;  ///< sorted by value
     double unitDistance = 1.0;          ///< reference length of the opacities, world units

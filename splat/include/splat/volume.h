@@ -3,10 +3,9 @@
 // x = origin + S p with S = diag(spacing). Samples are float, x fastest, then y, then z.
 #include <cstddef>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace splat {
 
@@ -15,12 +14,12 @@ namespace splat {
 inline constexpr std::uint64_t kMaxVoxels = std::uint64_t(1) << 32;
 
 struct Volume {
-    glm::ivec3 dims{0};         ///< samples along x, y, z (all >= 1 for a valid volume)
-    glm::dvec3 spacing{1.0};    ///< world units (usually mm) between samples per axis
-    glm::dvec3 origin{0.0};     ///< world position of sample (0, 0, 0)
-    std::vector<float> data;    ///< dims.x * dims.y * dims.z samples, x fastest
-    std::string source;         ///< how it was obtained, e.g. "NIfTI-1 int16 (ch2.nii.gz)"
-    std::string note;           ///< anything a user should know (oblique rotation dropped, ...)
+    glm::ivec3 dims{0};       ///< samples along x, y, z (all >= 1 for a valid volume)
+    glm::dvec3 spacing{1.0};  ///< world units (usually mm) between samples per axis
+    glm::dvec3 origin{0.0};   ///< world position of sample (0, 0, 0)
+    std::vector<float> data;  ///< dims.x * dims.y * dims.z samples, x fastest
+    std::string source;       ///< how it was obtained, e.g. "NIfTI-1 int16 (ch2.nii.gz)"
+    std::string note;         ///< anything a user should know (oblique rotation dropped, ...)
 
     std::size_t voxelCount() const {
         return std::size_t(dims.x) * std::size_t(dims.y) * std::size_t(dims.z);

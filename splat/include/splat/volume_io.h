@@ -18,10 +18,10 @@ enum class NonFinitePolicy {
 /// `name_XxYxZ_type.raw` (e.g. `skull_256x256x256_uint8.raw`); spacing defaults to 1.
 struct RawOptions {
     std::optional<glm::ivec3> dims;
-    std::string type;                     ///< uint8, int8, uint16, int16, uint32, int32, float32, float64
+    std::string type;  ///< uint8, int8, uint16, int16, uint32, int32, float32, float64
     std::optional<glm::dvec3> spacing;
     bool bigEndian = false;
-    std::size_t headerBytes = 0;          ///< bytes to skip at the start of the file
+    std::size_t headerBytes = 0;  ///< bytes to skip at the start of the file
 };
 
 struct LoadOptions {
