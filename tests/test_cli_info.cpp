@@ -57,7 +57,8 @@ TEST_CASE("splat info: bad input exits non-zero with one line on stderr", "[volu
     writeBytes(dir / "gz.nrrd",
                "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\n"
                "encoding: gzip\n\nnot gzip at all");
-    writeBytes(dir / "plain.raw", "xxxxxxxx");
+    // Eight bytes and no dimensions: raw data the name says nothing about.
+    writeBytes(dir / "plain.raw", std::string(8, char(0x2a)));
     writeBytes(dir / "junk.nii", std::string(500, 'j'));
     auto before = std::distance(std::filesystem::directory_iterator(dir),
                                 std::filesystem::directory_iterator());

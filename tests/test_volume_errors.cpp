@@ -85,7 +85,7 @@ TEST_CASE("load errors name the file and the problem", "[volume]") {
                Catch::StartsWith(path("gz.nrrd") + ": corrupt gzip data"));
     writeBytes(path("gz.mha"),
                "NDims = 3\nDimSize = 2 2 2\nElementType = MET_FLOAT\n"
-               "CompressedData = True\nElementDataFile = LOCAL\nxxxxxxxx");
+               "CompressedData = True\nElementDataFile = LOCAL\nnot zlib");  // corrupt on purpose
     CHECK_THAT(loadError(path("gz.mha")), Catch::Contains("corrupt gzip data"));
 
     // Missing detached data file, unreadable NIfTI.

@@ -110,8 +110,8 @@ class SheetBuffer {
 
     /// splat() with a slab section as the weight: the kernel between the depths t0 and t1
     /// (world units along the ray, relative to the splat centre), in kernel units
-    /// z = depthScale (t - (tx dx + ty dy)); fp(r2) (F(r2, z1) - F(r2, z0)) * e.scale. The
-    /// inner loop of the image-aligned splatter.
+    /// z = depthScale (t - (tx dx + ty dy)); fp(r2) (F(r2, z1) - F(r2, z0)) * e.scale.
+    /// Scalar; the image-aligned splatter's vectorised loop is splatSections() below.
     int splatSection(const float (&values)[NCh], float sx, float sy,
                      const footprint::EllipticalFootprint& e, const PixelRect& rect,
                      const footprint::SlabTable& table, const FootprintPoly* poly, float t0,
@@ -265,76 +265,6 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
     return (x1 - x0 + 1) * (y1 - y0 + 1);
 }
 
-template <int NCh>
-int SheetBuffer<NCh>::splatSection(const float (&values)[NCh], float sx, float sy,
-                                   const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                                   const footprint::SlabTable& table, const FootprintPoly* poly,
-                                   float t0, float t1) {
-    const footprint::FootprintTable& fpTable = table.footprint();
-    const footprint::SlabTable::Grid grid = table.grid();
-    const int x0 = rect.x0 - ox_, x1 = rect.x1 - ox_, y0 = rect.y0 - oy_, y1 = rect.y1 - oy_;
-    markDirty(x0, x1, y0, y1);
-    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
-    const __m256 zero = _mm256_setzero_ps();
-    const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
-    const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
-    const FootprintLanes footprintOf(fpTable, poly);
-    const __m256 gInvR = _mm256_set1_ps(grid.invR2Step), gInvZ = _mm256_set1_ps(grid.invZStep);
-    const __m256 gZMin = _mm256_set1_ps(grid.zMin), gNr = _mm256_set1_ps(grid.nrf);
-    const __m256 gNz = _mm256_set1_ps(grid.nzf);
-    const __m256i gStride = _mm256_set1_epi32(grid.stride), ione = _mm256_set1_epi32(1);
-    const __m256 vds = _mm256_set1_ps(e.depthScale), vtx = _mm256_set1_ps(e.tx);
-    const __m256 vt0 = _mm256_set1_ps(t0), vt1 = _mm256_set1_ps(t1);
-    __m256 vv[NCh];
-    for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
-    // F(r2, z) for the lanes' radial cell (i, fr) and depths z: bilinear in the grid.
-    auto fraction = [&](__m256i rowIndex, __m256 fr, __m256 z) {
-        __m256 zz = _mm256_mul_ps(_mm256_sub_ps(z, gZMin), gInvZ);
-        zz = _mm256_min_ps(_mm256_max_ps(zz, zero), gNz);  // NaN -> 0 as fraction()
-        const __m256i j = _mm256_cvttps_epi32(zz);
-        const __m256 fz = _mm256_sub_ps(zz, _mm256_cvtepi32_ps(j));
-        const __m256i idx = _mm256_add_epi32(rowIndex, j);
-        const __m256 p0 = _mm256_i32gather_ps(grid.values, idx, 4);
-        const __m256 p1 = _mm256_i32gather_ps(grid.values, _mm256_add_epi32(idx, ione), 4);
-        const __m256i idx2 = _mm256_add_epi32(idx, gStride);
-        const __m256 p2 = _mm256_i32gather_ps(grid.values, idx2, 4);
-        const __m256 p3 = _mm256_i32gather_ps(grid.values, _mm256_add_epi32(idx2, ione), 4);
-        const __m256 a = _mm256_fmadd_ps(fz, _mm256_sub_ps(p1, p0), p0);
-        const __m256 b = _mm256_fmadd_ps(fz, _mm256_sub_ps(p3, p2), p2);
-        return _mm256_fmadd_ps(fr, _mm256_sub_ps(b, a), a);
-    };
-    for (int y = y0; y <= y1; ++y) {
-        const float dy = float(y + oy_) + 0.5f - sy;
-        const __m256 vgyy = _mm256_set1_ps(e.gamma * dy * dy), vshift = _mm256_set1_ps(e.beta * dy);
-        const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
-        const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
-        float* row = &v_[std::size_t(y) * stride_];
-        for (int x = x0; x <= x1; x += 8) {
-            const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
-            const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox_) + 0.5f - sx));
-            const __m256 q = _mm256_add_ps(dx, vshift);
-            const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), zero);
-            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
-                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
-            const __m256 fp = footprintOf(r2);
-            // Radial cell of the fraction grid, shared by both depths.
-            const __m256 rr = _mm256_min_ps(_mm256_mul_ps(r2, gInvR), gNr);
-            const __m256i ri = _mm256_cvttps_epi32(rr);
-            const __m256 fr = _mm256_sub_ps(rr, _mm256_cvtepi32_ps(ri));
-            const __m256i rowIndex = _mm256_mullo_epi32(ri, gStride);
-            const __m256 tc = _mm256_fmadd_ps(vtx, dx, vtyy);
-            const __m256 z0 = _mm256_mul_ps(vds, _mm256_sub_ps(vt0, tc));
-            const __m256 z1 = _mm256_mul_ps(vds, _mm256_sub_ps(vt1, tc));
-            const __m256 f = _mm256_sub_ps(fraction(rowIndex, fr, z1), fraction(rowIndex, fr, z0));
-            const __m256 w = _mm256_and_ps(inside, _mm256_mul_ps(_mm256_mul_ps(fp, f), vScale));
-            for (int c = 0; c < NCh; ++c) {
-                float* p = row + c * plane_ + x;
-                _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
-            }
-        }
-    }
-    return (x1 - x0 + 1) * (y1 - y0 + 1);
-}
 
 /// The sections of one kernel in n consecutive slabs at once, slab j between the depths
 /// tb[j] and tb[j + 1] (world units along the ray, relative to the splat centre), each
@@ -425,17 +355,6 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
                  [&](float r2, float, float) { return table.lookup(r2) * scale; });
 }
 
-template <int NCh>
-int SheetBuffer<NCh>::splatSection(const float (&values)[NCh], float sx, float sy,
-                                   const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                                   const footprint::SlabTable& table, const FootprintPoly*,
-                                   float t0, float t1) {
-    const float ds = e.depthScale, tx = e.tx, ty = e.ty, scale = e.scale;
-    return splat(values, sx, sy, e, rect, [&](float r2, float dx, float dy) {
-        const float tc = tx * dx + ty * dy;
-        return table.section(r2, ds * (t0 - tc), ds * (t1 - tc)) * scale;
-    });
-}
 
 template <int NCh>
 int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
@@ -448,5 +367,19 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
     return visited;
 }
 #endif
+
+/// Scalar slab section (any build; the vectorised loop is splatSections).
+template <int NCh>
+int SheetBuffer<NCh>::splatSection(const float (&values)[NCh], float sx, float sy,
+                                   const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                                   const footprint::SlabTable& table, const FootprintPoly*,
+                                   float t0, float t1) {
+    const float ds = e.depthScale, tx = e.tx, ty = e.ty, scale = e.scale;
+    return splat(values, sx, sy, e, rect, [&](float r2, float dx, float dy) {
+        const float tc = tx * dx + ty * dy;
+        return table.section(r2, ds * (t0 - tc), ds * (t1 - tc)) * scale;
+    });
+}
+
 
 }  // namespace splat
