@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "footprint/closed_form.h"
 #include "footprint/footprint_table.h"
 #include "footprint/slab_table.h"
 
@@ -18,30 +19,11 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Closed-form footprint of the C1-tapered Gaussian (kernel.h), truncation via erf.
 double gaussianFootprint(const Kernel& k, double r) {
-    const double s = k.sigma(), R = k.radius();
-    if (r >= R) return 0;
-    const double L = std::sqrt(R * R - r * r);
-    const double eR = std::exp(-R * R / (2 * s * s));
-    return k.normalisation() * (s * std::sqrt(2 * kPi) * std::exp(-r * r / (2 * s * s)) *
-                                    std::erf(L / (s * std::sqrt(2.0))) -
-                                2 * L * eR - eR / (2 * s * s) * 4 * L * L * L / 3);
+    return footprint::gaussianFootprintClosedForm(k, r);
 }
-
-// Closed-form C(r, z) of the C1-tapered Gaussian.
 double gaussianCumulative(const Kernel& k, double r, double z) {
-    const double s = k.sigma(), R = k.radius();
-    if (r >= R) return 0;
-    const double L = std::sqrt(R * R - r * r);
-    z = std::clamp(z, -L, L);
-    const double eR = std::exp(-R * R / (2 * s * s));
-    const double q = 1 / (s * std::sqrt(2.0));
-    const double g = s * std::sqrt(kPi / 2) * std::exp(-r * r / (2 * s * s)) *
-                     (std::erf(z * q) + std::erf(L * q));
-    const double lin = eR * (z + L);
-    const double quad = eR / (2 * s * s) * (L * L * (z + L) - (z * z * z + L * L * L) / 3);
-    return k.normalisation() * (g - lin - quad);
+    return footprint::gaussianCumulativeClosedForm(k, r, z);
 }
 
 double maxTableError(const FootprintTable& t, int samples = 100000) {

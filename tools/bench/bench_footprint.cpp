@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "footprint/closed_form.h"
 #include "footprint/footprint_table.h"
 #include "footprint/kernel.h"
 #include "footprint/slab_table.h"
@@ -36,26 +37,6 @@ double seconds(Clock::time_point a, Clock::time_point b) {
 
 bool isGaussian(const Kernel& k) { return k.type() == footprint::KernelType::Gaussian; }
 
-double closedFootprint(const Kernel& k, double r) {
-    const double s = k.sigma(), R = k.radius();
-    if (r >= R) return 0;
-    const double L = std::sqrt(R * R - r * r), eR = std::exp(-R * R / (2 * s * s));
-    return k.normalisation() * (s * std::sqrt(2 * kPi) * std::exp(-r * r / (2 * s * s)) *
-                                    std::erf(L / (s * std::sqrt(2.0))) -
-                                2 * L * eR - eR / (2 * s * s) * 4 * L * L * L / 3);
-}
-
-double closedCumulative(const Kernel& k, double r, double z) {
-    const double s = k.sigma(), R = k.radius();
-    if (r >= R) return 0;
-    const double L = std::sqrt(R * R - r * r);
-    z = std::clamp(z, -L, L);
-    const double eR = std::exp(-R * R / (2 * s * s)), q = 1 / (s * std::sqrt(2.0));
-    return k.normalisation() *
-           (s * std::sqrt(kPi / 2) * std::exp(-r * r / (2 * s * s)) *
-                (std::erf(z * q) + std::erf(L * q)) -
-            eR * (z + L) - eR / (2 * s * s) * (L * L * (z + L) - (z * z * z + L * L * L) / 3));
-}
 
 double checksum(const std::vector<float>& v) {
     double s = 0;
@@ -134,7 +115,7 @@ int main(int argc, char** argv) {
         for (int i = 0; i <= samples; ++i) {
             const double r2 = R * R * i / samples;
             const double ex =
-                closed ? closedFootprint(kernel, std::sqrt(r2)) : reference.exact(std::sqrt(r2));
+                closed ? footprint::gaussianFootprintClosedForm(kernel, std::sqrt(r2)) : reference.exact(std::sqrt(r2));
             err = std::max(err, std::abs(t.lookup(float(r2)) - ex));
             if (!closed) i += 19;  // quadrature is slower
         }
@@ -174,7 +155,7 @@ int main(int argc, char** argv) {
                    b = (i % 4 == 0) ? a + 0.2 * V(g) : R * (2.2 * V(g) - 1.1);
             if (a > b) std::swap(a, b);
             const double ex = closed
-                                  ? closedCumulative(kernel, r, b) - closedCumulative(kernel, r, a)
+                                  ? footprint::gaussianCumulativeClosedForm(kernel, r, b) - footprint::gaussianCumulativeClosedForm(kernel, r, a)
                                   : s.exact(r, b) - s.exact(r, a);
             err = std::max(err, std::abs(s.section(float(r2), float(a), float(b)) - ex));
             // A partition of [-R, R] into 16 random slabs sums to the footprint.
