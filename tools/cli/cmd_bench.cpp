@@ -90,7 +90,10 @@ void registerBench(CLI::App& app) {
                                    {"footprint_pixels", stats.footprintPixels},
                                    {"footprint_pixels_per_s", rate},
                                    {"sheets", stats.sheets},
-                                   {"culled", stats.culledSplats}});
+                                   {"culled", stats.culledSplats},
+                                   {"project_ms", stats.projectMs},
+                                   {"bin_ms", stats.binMs},
+                                   {"tiles_ms", stats.tilesMs}});
         }
         if (!a->json.empty()) {
             const std::string tmp = a->json + ".tmp";
