@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "render_options.h"
+#include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "volume_options.h"
 
@@ -96,13 +97,7 @@ void registerBench(CLI::App& app) {
                                    {"tiles_ms", stats.tilesMs}});
         }
         if (!a->json.empty()) {
-            const std::string tmp = a->json + ".tmp";
-            {
-                std::ofstream f(tmp);
-                f << out.dump(2) << "\n";
-                if (!f) throw Error(a->json + ": cannot write");
-            }
-            std::filesystem::rename(tmp, a->json);
+            writeTextAtomic(a->json, out.dump(2) + "\n");
         }
     });
 }

@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "commands.h"
+#include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
 #include "splat/metrics.h"
@@ -26,27 +27,7 @@ struct CompareArgs {
 };
 
 void writeJsonAtomically(const std::string& path, const nlohmann::json& j) {
-    namespace fs = std::filesystem;
-    const fs::path target(path);
-    const fs::path tmp = target.parent_path() /
-                         ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
-    {
-        std::ofstream out(tmp);
-        if (!out) throw Error("compare: cannot write " + path);
-        out << j.dump(2) << "\n";
-        out.close();
-        if (!out) {
-            std::error_code ec;
-            fs::remove(tmp, ec);
-            throw Error("compare: cannot write " + path);
-        }
-    }
-    std::error_code ec;
-    fs::rename(tmp, target, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw Error("compare: cannot write " + path + ": " + ec.message());
-    }
+    writeTextAtomic(path, j.dump(2) + "\n");
 }
 
 void run(const CompareArgs& a) {

@@ -94,7 +94,7 @@ Volume loadVolume(const std::string& spec, const LoadOptions& options) {
         if (fs::is_directory(st)) {
             v = detail::loadSliceFolder(p);
         } else {
-            std::string ext = detail::lowerExtension(p);
+            std::string ext = lowerExtension(p);
             v = loadByType(p, ext, options);
             if (v.data.empty()) {
                 std::string guess = sniff(p);

@@ -16,8 +16,6 @@ namespace fs = std::filesystem;
 namespace splat {
 
 using detail::displayName;
-using detail::lowerExtension;
-using detail::writeFileAtomic;
 
 namespace {
 
@@ -47,7 +45,8 @@ void saveNifti(const std::string& path, const Volume& v) {
     fs::path target(path);
     const std::string file = target.filename().string();
     // niftilib picks compression from the name, so the temporary keeps the extension.
-    fs::path tmp = detail::temporarySibling(target, file.substr(0, file.size() - ext.size()), ext);
+    AtomicFile out(target);
+    const fs::path& tmp = out.temporary();
     int dims[8] = {3, v.dims.x, v.dims.y, v.dims.z, 1, 1, 1, 1};
     nifti_set_debug_level(0);
     nifti_image* nim = nifti_make_new_nim(dims, DT_FLOAT32, 1);
@@ -79,15 +78,9 @@ void saveNifti(const std::string& path, const Volume& v) {
     nifti_image_free(nim);
     std::error_code ec;
     if (!fs::exists(tmp, ec) || fs::file_size(tmp, ec) == 0) {
-        fs::remove(tmp, ec);
         throw Error(path + ": cannot write NIfTI file");
     }
-    fs::rename(tmp, target, ec);
-    if (ec) {
-        std::error_code ec2;
-        fs::remove(tmp, ec2);
-        throw Error(path + ": cannot rename temporary file: " + ec.message());
-    }
+    out.commit();
 }
 
 void saveNrrd(const std::string& path, const Volume& v) {

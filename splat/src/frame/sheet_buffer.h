@@ -16,7 +16,7 @@
 #include "footprint/ellipse.h"
 #include "footprint/footprint_table.h"
 #include "footprint/slab_table.h"
-#include "footprint_poly.h"
+#include "footprint/footprint_poly.h"
 #include "splat/transfer.h"
 #include "tile_binning.h"
 
@@ -102,11 +102,11 @@ class SheetBuffer {
 
     /// splat() with the whole footprint as the weight, fp(r2) * e.scale: the inner loop of
     /// the axis-aligned splatter, eight pixels at a time where AVX2 is available.
-    /// With `poly` (accurate to FootprintPoly::kTolerance) the table is evaluated without
+    /// With `poly` (accurate to footprint::FootprintPoly::kTolerance) the table is evaluated without
     /// gathers.
     int splatFootprint(const float (&values)[NCh], float sx, float sy,
                        const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                       const footprint::FootprintTable& table, const FootprintPoly* poly);
+                       const footprint::FootprintTable& table, const footprint::FootprintPoly* poly);
 
     /// splat() with a slab section as the weight: the kernel between the depths t0 and t1
     /// (world units along the ray, relative to the splat centre), in kernel units
@@ -114,7 +114,7 @@ class SheetBuffer {
     /// Scalar; the image-aligned splatter's vectorised loop is splatSections() below.
     int splatSection(const float (&values)[NCh], float sx, float sy,
                      const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                     const footprint::SlabTable& table, const FootprintPoly* poly, float t0,
+                     const footprint::SlabTable& table, const footprint::FootprintPoly* poly, float t0,
                      float t1);
 
     /// Turns the dirty part of the sheet into samples composited into `acc`, clears it.
@@ -185,15 +185,15 @@ class SheetBuffer {
 /// scheme evaluates it), else the table itself with two gathers.
 class FootprintLanes {
   public:
-    FootprintLanes(const footprint::FootprintTable& table, const FootprintPoly* poly)
+    FootprintLanes(const footprint::FootprintTable& table, const footprint::FootprintPoly* poly)
         : poly_(poly),
           data_(table.data()),
           inv_(_mm256_set1_ps(table.invStep())),
           last_(_mm256_set1_ps(float(table.resolution()))),
           seg_(_mm256_set1_ps(poly ? poly->segmentScale() : 0.0f)),
-          lastSeg_(_mm256_set1_ps(float(FootprintPoly::kSegments - 1))) {
+          lastSeg_(_mm256_set1_ps(float(footprint::FootprintPoly::kSegments - 1))) {
         if (poly)
-            for (int k = 0; k < FootprintPoly::kMaxCoefficients; ++k)
+            for (int k = 0; k < footprint::FootprintPoly::kMaxCoefficients; ++k)
                 coef_[k] = _mm256_loadu_ps(poly->coefficients()[k].data());
     }
     __m256 operator()(__m256 r2) const {
@@ -218,17 +218,17 @@ class FootprintLanes {
     }
 
   private:
-    const FootprintPoly* poly_;
+    const footprint::FootprintPoly* poly_;
     const float* data_;
     __m256 inv_, last_, seg_, lastSeg_;
-    __m256 coef_[FootprintPoly::kMaxCoefficients] = {};
+    __m256 coef_[footprint::FootprintPoly::kMaxCoefficients] = {};
 };
 
 template <int NCh>
 int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float sy,
                                      const footprint::EllipticalFootprint& e, const PixelRect& rect,
                                      const footprint::FootprintTable& table,
-                                     const FootprintPoly* poly) {
+                                     const footprint::FootprintPoly* poly) {
     const int x0 = rect.x0 - ox_, x1 = rect.x1 - ox_, y0 = rect.y0 - oy_, y1 = rect.y1 - oy_;
     markDirty(x0, x1, y0, y1);
     const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
@@ -273,7 +273,7 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
 template <int NCh>
 int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
                   float sy, const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                  const footprint::SlabTable& table, const FootprintPoly* poly, const float* tb) {
+                  const footprint::SlabTable& table, const footprint::FootprintPoly* poly, const float* tb) {
     const footprint::FootprintTable& fpTable = table.footprint();
     const footprint::SlabTable::Grid grid = table.grid();
     const int ox = sheets[0]->originX(), oy = sheets[0]->originY();
@@ -348,7 +348,7 @@ template <int NCh>
 int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float sy,
                                      const footprint::EllipticalFootprint& e, const PixelRect& rect,
                                      const footprint::FootprintTable& table,
-                                     const FootprintPoly*) {
+                                     const footprint::FootprintPoly*) {
     // Without AVX2 the table's own lookup is as fast as the polynomial and exact.
     const float scale = e.scale;
     return splat(values, sx, sy, e, rect,
@@ -359,7 +359,7 @@ int SheetBuffer<NCh>::splatFootprint(const float (&values)[NCh], float sx, float
 template <int NCh>
 int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
                   float sy, const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                  const footprint::SlabTable& table, const FootprintPoly* poly, const float* tb) {
+                  const footprint::SlabTable& table, const footprint::FootprintPoly* poly, const float* tb) {
     int visited = 0;
     for (int j = 0; j < n; ++j)
         visited += sheets[j]->splatSection(values, sx, sy, e, rect, table, poly,
@@ -372,7 +372,7 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
 template <int NCh>
 int SheetBuffer<NCh>::splatSection(const float (&values)[NCh], float sx, float sy,
                                    const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                                   const footprint::SlabTable& table, const FootprintPoly*,
+                                   const footprint::SlabTable& table, const footprint::FootprintPoly*,
                                    float t0, float t1) {
     const float ds = e.depthScale, tx = e.tx, ty = e.ty, scale = e.scale;
     return splat(values, sx, sy, e, rect, [&](float r2, float dx, float dy) {

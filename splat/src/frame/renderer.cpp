@@ -6,9 +6,9 @@
 #include <mutex>
 #include <optional>
 
-#include "axis_splatter.h"
+#include "splatters/axis_splatter.h"
 #include "footprint/kernel.h"
-#include "image_aligned_splatter.h"
+#include "splatters/image_aligned_splatter.h"
 #include "projection.h"
 #include "splat/error.h"
 #include "splat/reference.h"
@@ -22,7 +22,7 @@ struct Renderer::Impl {
     footprint::Kernel kernel;
     std::optional<footprint::FootprintTable> table;
     std::optional<footprint::SlabTable> slabs;
-    std::optional<FootprintPoly> poly;
+    std::optional<footprint::FootprintPoly> poly;
     TransferTable transfer;
     SplatList splats;  // (k, j, i) order: sorted by slice along z
     // Copies sorted by slice along x and y, made when a view first needs them, so that the
@@ -96,7 +96,7 @@ Renderer::Renderer(const Volume& volume, const RenderSettings& settings) {
     if (settings.renderer != RendererKind::Reference) {
         impl_->table.emplace(impl_->kernel);
         impl_->poly.emplace(*impl_->table);
-        if (impl_->poly->maxError() > FootprintPoly::kTolerance) impl_->poly.reset();
+        if (impl_->poly->maxError() > footprint::FootprintPoly::kTolerance) impl_->poly.reset();
     }
     if (settings.renderer == RendererKind::Sheet) impl_->slabs.emplace(impl_->kernel);
 }

@@ -31,13 +31,6 @@ std::string trim(const std::string& s) {
     return s.substr(b, e - b);
 }
 
-std::string lowerExtension(const fs::path& p) {
-    std::string name = toLower(p.filename().string());
-    for (const char* two : {".nii.gz", ".raw.gz"})
-        if (name.size() > std::strlen(two) && name.ends_with(two)) return two;
-    return toLower(p.extension().string());
-}
-
 std::vector<unsigned char> readFileBytes(const fs::path& p) {
     std::error_code ec;
     if (!fs::exists(p, ec)) throw Error(displayName(p) + ": no such file");
@@ -93,39 +86,6 @@ std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t siz
     if (ret != Z_STREAM_END) throw Error(what + ": corrupt gzip data (" + reason + ")");
     out.resize(produced);
     return out;
-}
-
-fs::path temporarySibling(const fs::path& target, const std::string& stem, const std::string& ext) {
-    static std::random_device rd;
-    std::string name(".");
-    name += stem.empty() ? target.filename().string() : stem;
-    name += ".tmp";
-    name += std::to_string(rd());
-    name += ext;
-    fs::path dir = target.parent_path();
-    return (dir.empty() ? fs::path(".") : dir) / name;
-}
-
-void writeFileAtomic(const fs::path& path, const void* bytes, std::size_t size) {
-    fs::path tmp = temporarySibling(path, "", "");
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw Error(displayName(path) + ": cannot create file");
-        out.write(static_cast<const char*>(bytes), static_cast<std::streamsize>(size));
-        out.close();
-        if (!out) {
-            std::error_code ec;
-            fs::remove(tmp, ec);
-            throw Error(displayName(path) + ": write failed");
-        }
-    }
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        std::error_code ec2;
-        fs::remove(tmp, ec2);
-        throw Error(displayName(path) + ": cannot rename temporary file: " + ec.message());
-    }
 }
 
 bool naturalLess(const std::string& a, const std::string& b) {

@@ -15,7 +15,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "tile_binning.h"
+#include "frame/tile_binning.h"
 
 namespace splat {
 

@@ -1,10 +1,10 @@
 // Piecewise-polynomial footprint evaluation (see footprint_poly.h).
-#include "footprint_poly.h"
+#include "footprint/footprint_poly.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace splat {
+namespace footprint {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
@@ -14,7 +14,7 @@ constexpr double kPi = 3.14159265358979323846;
 template <class F>
 std::array<double, FootprintPoly::kMaxCoefficients> chebyshevInterpolant(F&& f, int d) {
     const int n = d + 1;
-    double x[FootprintPoly::kMaxCoefficients], y[FootprintPoly::kMaxCoefficients];
+    double x[FootprintPoly::kMaxCoefficients] = {}, y[FootprintPoly::kMaxCoefficients] = {};
     for (int k = 0; k < n; ++k) {
         x[k] = std::cos(kPi * (k + 0.5) / n);
         y[k] = f(x[k]);
@@ -31,7 +31,7 @@ std::array<double, FootprintPoly::kMaxCoefficients> chebyshevInterpolant(F&& f, 
 }
 }  // namespace
 
-FootprintPoly::FootprintPoly(const footprint::FootprintTable& table) {
+FootprintPoly::FootprintPoly(const FootprintTable& table) {
     r2Max_ = table.r2Max();
     segScale_ = kSegments / r2Max_;
     const double peak = std::max<double>(table.peak(), 1e-30);
@@ -67,4 +67,4 @@ float FootprintPoly::operator()(float r2) const {
     return p;
 }
 
-}  // namespace splat
+}  // namespace footprint

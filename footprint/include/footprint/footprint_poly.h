@@ -11,7 +11,7 @@
 
 #include "footprint/footprint_table.h"
 
-namespace splat {
+namespace footprint {
 
 class FootprintPoly {
   public:
@@ -19,7 +19,7 @@ class FootprintPoly {
     static constexpr int kMaxCoefficients = 8;  // the vector code assumes exactly 8
     static constexpr double kTolerance = 1e-6;  ///< of the peak
 
-    explicit FootprintPoly(const footprint::FootprintTable& table);
+    explicit FootprintPoly(const FootprintTable& table);
 
     /// coefficient k of every segment, highest degree first (Horner order)
     const std::array<std::array<float, kSegments>, kMaxCoefficients>& coefficients() const {
@@ -40,4 +40,4 @@ class FootprintPoly {
     double maxError_ = 0;
 };
 
-}  // namespace splat
+}  // namespace footprint

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <random>
 
+#include "splat/atomic_file.h"
 #include "splat/error.h"
 
 namespace splat {
@@ -21,24 +22,6 @@ float srgbEncode(float x) {
 }
 
 namespace {
-
-std::string lowerExtension(const std::string& path) {
-    std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
-    return ext;
-}
-
-// A sibling temporary name with the same extension (OpenImageIO picks the format by it).
-std::string temporaryName(const std::string& path) {
-    const fs::path p(path);
-    std::random_device rd;
-    const std::string tag = std::to_string(rd() % 1000000u);
-    std::string name = p.stem().string();
-    name.insert(0, 1, '.');
-    name.append(".tmp").append(tag).append(p.extension().string());
-    return (p.parent_path() / name).string();
-}
 
 std::vector<float> displayValues(const Image& image, const WriteOptions& o) {
     std::vector<float> out(std::size_t(image.width) * image.height * 3);
@@ -70,31 +53,14 @@ void checkImagePath(const std::string& path) {
     if (fs::is_directory(path)) throw Error(path + ": is a folder, not an image file name");
 }
 
-namespace {
-// Renames the finished temporary file over the target, or removes it and throws.
-void commitTemporary(const std::string& tmp, const std::string& path) {
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        std::error_code ignored;
-        fs::remove(tmp, ignored);
-        throw Error(path + ": cannot write image (" + ec.message() + ")");
-    }
-}
-void failTemporary(const std::string& tmp, const std::string& path, const std::string& err) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw Error(path + ": cannot write image (" + (err.empty() ? "write failed" : err) + ")");
-}
-}  // namespace
-
 void writeImage(const std::string& path, const Image& image, const WriteOptions& options) {
     checkImagePath(path);
     const std::string ext = lowerExtension(path);
     const bool isFloat = ext == ".exr" || ext == ".tif" || ext == ".tiff";
     if (image.width < 1 || image.height < 1) throw Error(path + ": image is empty");
 
-    const std::string tmp = temporaryName(path);
+    AtomicFile file(path);
+    const std::string tmp = file.temporary().string();
     auto out = OIIO::ImageOutput::create(tmp);
     if (!out) throw Error(path + ": cannot create an image writer for '" + ext + "'");
     bool ok;
@@ -110,8 +76,9 @@ void writeImage(const std::string& path, const Image& image, const WriteOptions&
     }
     const std::string err = out->geterror();
     ok = out->close() && ok;
-    if (!ok) failTemporary(tmp, path, err);
-    commitTemporary(tmp, path);
+    if (!ok)
+        throw Error(path + ": cannot write image (" + (err.empty() ? "write failed" : err) + ")");
+    file.commit();
 }
 
 void writeAnimatedGif(const std::string& path, const std::vector<Image>& frames,
@@ -119,7 +86,8 @@ void writeAnimatedGif(const std::string& path, const std::vector<Image>& frames,
     checkImagePath(path);
     if (lowerExtension(path) != ".gif") throw Error(path + ": an animation must be a .gif file");
     if (frames.empty()) throw Error(path + ": no frames to write");
-    const std::string tmp = temporaryName(path);
+    AtomicFile file(path);
+    const std::string tmp = file.temporary().string();
     auto out = OIIO::ImageOutput::create(tmp);
     if (!out || !out->supports("multiimage"))
         throw Error(path + ": this OpenImageIO cannot write animated GIFs");
@@ -141,8 +109,9 @@ void writeAnimatedGif(const std::string& path, const std::vector<Image>& frames,
     }
     const std::string err = out->geterror();
     ok = out->close() && ok;
-    if (!ok) failTemporary(tmp, path, err);
-    commitTemporary(tmp, path);
+    if (!ok)
+        throw Error(path + ": cannot write image (" + (err.empty() ? "write failed" : err) + ")");
+    file.commit();
 }
 
 Image readImage(const std::string& path) {

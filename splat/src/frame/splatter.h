@@ -31,7 +31,7 @@ struct FrameInputs {
     const Camera& camera;
     const RenderSettings& settings;  ///< transfer already resolved
     const footprint::FootprintTable& table;
-    const FootprintPoly* poly;          ///< fast evaluation of `table`, if accurate enough
+    const footprint::FootprintPoly* poly;          ///< fast evaluation of `table`, if accurate enough
     const footprint::SlabTable* slabs;  ///< image-aligned only
     const TransferTable& transfer;
     FrameWorkspace& work;

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "splat/atomic_file.h"
 #include "splat/volume.h"
 #include "splat/volume_io.h"
 
@@ -49,18 +50,9 @@ std::vector<unsigned char> readFileBytes(const std::filesystem::path& p);
 /// Inflates gzip or zlib data (auto-detected); throws "WHAT: corrupt gzip data ..."
 std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t size,
                                       const std::string& what);
-/// Lower-case extension including double ones we know (".nii.gz").
-std::string lowerExtension(const std::filesystem::path& p);
 std::string toLower(std::string s);
 std::string trim(const std::string& s);
 
-/// A hidden temporary name next to `target`: ".STEM.tmpNNN EXT" (STEM defaults to
-/// target's file name), for writing before an atomic rename.
-std::filesystem::path temporarySibling(const std::filesystem::path& target, const std::string& stem,
-                                       const std::string& ext);
-/// Writes `bytes` to `path` atomically: a temporary file in the same folder, then
-/// std::filesystem::rename. The temporary is removed on failure.
-void writeFileAtomic(const std::filesystem::path& path, const void* bytes, std::size_t size);
 
 // ---- orientation -----------------------------------------------------------------
 

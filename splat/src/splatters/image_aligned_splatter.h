@@ -1,7 +1,7 @@
 #pragma once
 // The image-aligned sheet-buffer splatter (Mueller & Crawfis 1998).
-#include "projection.h"
-#include "splatter.h"
+#include "frame/projection.h"
+#include "frame/splatter.h"
 
 namespace splat {
 

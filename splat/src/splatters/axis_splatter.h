@@ -1,7 +1,7 @@
 #pragma once
 // The axis-aligned sheet-buffer splatter (Westover).
-#include "projection.h"
-#include "splatter.h"
+#include "frame/projection.h"
+#include "frame/splatter.h"
 
 namespace splat {
 
