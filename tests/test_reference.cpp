@@ -44,7 +44,7 @@ TEST_CASE("reference: xray of one kernel is its footprint fp(r)/|v|", "[referenc
     RenderStats stats;
     const Image im = renderReference(v, splats, kernel, cam, s, &stats);
     CHECK(stats.referenceStep > 0);
-    CHECK(stats.referenceStep <= s.referenceStep);
+    CHECK(stats.referenceStep <= s.quality.referenceStep);
     const double peak = fp.exact(0.0);
     int checked = 0;
     double worst = 0;
@@ -302,14 +302,14 @@ TEST_CASE("reference: self-convergence as the step shrinks", "[reference]") {
     const SplatList splats = classify(v, s.transfer, s.mode, s.classification, kernel.radius());
     const Camera cam(s.camera, v);
     RenderSettings fine = s;
-    fine.referenceStep = 0.05;
-    fine.referenceTolerance = 1e-7;
+    fine.quality.referenceStep = 0.05;
+    fine.quality.referenceTolerance = 1e-7;
     const Image truth = renderReference(v, splats, kernel, cam, fine);
     std::vector<double> errors;
     for (double step : {1.0, 0.5, 0.25}) {
         RenderSettings t = s;
-        t.referenceStep = step;
-        t.referenceTolerance = 1e9;  // no refinement: one comparison pass at step / 2
+        t.quality.referenceStep = step;
+        t.quality.referenceTolerance = 1e9;  // no refinement: one comparison pass at step / 2
         errors.push_back(compareImages(renderReference(v, splats, kernel, cam, t), truth).maxAbs);
     }
     INFO("max abs error at steps 1, 0.5, 0.25 (final passes at half of it): "
@@ -320,8 +320,8 @@ TEST_CASE("reference: self-convergence as the step shrinks", "[reference]") {
     // With the default error control the image is within ~the tolerance of the truth.
     RenderStats stats;
     const Image def = renderReference(v, splats, kernel, cam, s, &stats);
-    CHECK(compareImages(def, truth).maxAbs <= 5 * s.referenceTolerance);
-    CHECK(stats.referenceStep <= s.referenceStep / 2);
+    CHECK(compareImages(def, truth).maxAbs <= 5 * s.quality.referenceTolerance);
+    CHECK(stats.referenceStep <= s.quality.referenceStep / 2);
 }
 
 TEST_CASE("reference: post-classification, deterministic across thread counts", "[reference]") {
@@ -362,6 +362,6 @@ TEST_CASE("reference: perspective camera and empty volumes", "[reference]") {
     const Image empty = renderReference(v, none, kernel, cam, s);
     for (const auto& p : empty.pixels) REQUIRE(p == glm::vec4(0, 0, 0, 1));
     RenderSettings bad = s;
-    bad.referenceStep = 0;
+    bad.quality.referenceStep = 0;
     CHECK_THROWS_AS(renderReference(v, none, kernel, cam, bad), Error);
 }

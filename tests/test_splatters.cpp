@@ -133,8 +133,8 @@ TEST_CASE("one kernel in dvr composites to k (1 - exp(-rho fp))", "[splatter]") 
             s.camera.azimuthDeg = 27;
             s.camera.elevationDeg = 14;
             s.camera.pixelSize = 0.2;
-            s.slab = slab;
-            s.earlyTermination = 0;
+            s.quality.slab = slab;
+            s.quality.earlyTermination = 0;
             const Image img = render(v, s);
             const Camera cam(s.camera, v);
             const double rho = -std::log(1.0 - alpha);
@@ -165,7 +165,7 @@ TEST_CASE("the image-aligned slabs' optical depths sum to the footprint", "[spla
     const Image full = render(v, s);
     s.renderer = RendererKind::Sheet;
     for (double slab : {4.0, 1.0, 0.37, 0.1}) {
-        s.slab = slab;
+        s.quality.slab = slab;
         const Image sections = render(v, s);
         float peak = 0;
         for (const auto& p : full.pixels) peak = std::max(peak, p.r);
@@ -184,7 +184,7 @@ TEST_CASE("front-to-back equals back-to-front, and any thread count gives the sa
             s.classification = c;
             s.camera.azimuthDeg = 52;
             s.camera.elevationDeg = 12;
-            s.earlyTermination = 0;
+            s.quality.earlyTermination = 0;
             s.threads = 1;
             const Image ftb1 = render(v, s);
             s.threads = 2;
@@ -209,9 +209,9 @@ TEST_CASE("early termination changes the image by less than its threshold", "[sp
     for (RendererKind r : kSplatters) {
         RenderSettings s = baseSettings(r, RenderMode::Dvr, 64);
         s.transfer = flatTf(0.3f, glm::vec3(0.9f, 0.7f, 0.5f), 0.5f, 2.0f);
-        s.earlyTermination = 0;
+        s.quality.earlyTermination = 0;
         const Image exact = render(v, s);
-        s.earlyTermination = 0.05;
+        s.quality.earlyTermination = 0.05;
         RenderStats st;
         const Image fast = render(v, s, &st);
         double worst = 0;
@@ -269,11 +269,11 @@ TEST_CASE("iso mode and impossible settings are refused with a clear message", "
     CHECK_THROWS_WITH(render(v, s), Catch::Contains("reference"));
     s.mode = RenderMode::Dvr;
     s.renderer = RendererKind::Sheet;
-    s.slab = 0;
+    s.quality.slab = 0;
     CHECK_THROWS_WITH(render(v, s), Catch::Contains("slab"));
-    s.slab = std::nan("");
+    s.quality.slab = std::nan("");
     CHECK_THROWS_WITH(render(v, s), Catch::Contains("slab"));
-    s.slab = 1;
+    s.quality.slab = 1;
     s.camera.width = 0;
     CHECK_THROWS_WITH(render(v, s), Catch::Contains("image size"));
 }
@@ -284,7 +284,7 @@ TEST_CASE("mip of one kernel is its peak along the ray", "[splatter]") {
     const Volume v = singleVoxel(9);
     RenderSettings s = baseSettings(RendererKind::Sheet, RenderMode::Mip, 32);
     s.camera.pixelSize = 0.25;
-    s.slab = 0.05;
+    s.quality.slab = 0.05;
     const Image img = render(v, s);
     const footprint::Kernel k = footprint::Kernel::defaultKernel();
     const Camera cam(s.camera, v);
@@ -303,10 +303,10 @@ TEST_CASE("no seams between slabs on a constant-density cube", "[splatter]") {
     for (double slab : {1.0, 0.5}) {
         RenderSettings s = baseSettings(RendererKind::Sheet, RenderMode::Dvr, 64);
         s.transfer = flatTf(0.02f);
-        s.slab = slab;
+        s.quality.slab = slab;
         s.camera.elevationDeg = 90;  // looking down z through the slab of constant length
         s.camera.pixelSize = 0.37;
-        s.earlyTermination = 0;
+        s.quality.earlyTermination = 0;
         const Image img = render(v, s);
         double lo = 1e9, hi = 0;
         for (int y = 8; y < 56; ++y)
@@ -336,15 +336,15 @@ TEST_CASE("splatters against the reference ray caster", "[splatter][accuracy]") 
         RenderSettings s = baseSettings(RendererKind::Reference, RenderMode::Dvr, 64);
         s.transfer = TransferFunction::preset(c.tf);
         s.camera.azimuthDeg = 30;
-        s.earlyTermination = 0;
-        s.referenceTolerance = 1e-5;
+        s.quality.earlyTermination = 0;
+        s.quality.referenceTolerance = 1e-5;
         const Image ref = render(v, s);
         s.renderer = RendererKind::Axis;
         const ImageMetrics axis = compareImages(render(v, s), ref);
         s.renderer = RendererKind::Sheet;
         double previous = 1e9;
         for (double slab : {2.0, 1.0, 0.5, 0.25}) {
-            s.slab = slab;
+            s.quality.slab = slab;
             const ImageMetrics sheet = compareImages(render(v, s), ref);
             INFO(c.volume << " sheet slab " << slab << " rmse " << sheet.rmse << " (axis "
                           << axis.rmse << ")");

@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
         base.classification = classify == "post" ? Classification::Post : Classification::Pre;
         base.transfer = TransferFunction::load(tf).resolved(vs.minValue, vs.maxValue);
         base.camera.width = base.camera.height = size;
-        if (earlyTermination >= 0) base.earlyTermination = earlyTermination;
+        if (earlyTermination >= 0) base.quality.earlyTermination = earlyTermination;
 
         const std::vector<Config> configs = {{"axis", RendererKind::Axis, 1.0},
                                              {"sheet, slab 1", RendererKind::Sheet, 1.0},
@@ -109,7 +109,8 @@ int main(int argc, char** argv) {
             "function %s, default kernel and reference settings (step %g voxels, "
             "tolerance %g), splatter early termination %g.\n\n",
             volumeSpec.c_str(), size, size, mode.c_str(), classify.c_str(), tf.c_str(),
-            base.referenceStep, base.referenceTolerance, base.earlyTermination);
+            base.quality.referenceStep, base.quality.referenceTolerance,
+            base.quality.earlyTermination);
         std::printf("| azimuth | renderer | RMSE | PSNR (dB) | max abs | ms/frame |\n");
         std::printf("|---:|---|---:|---:|---:|---:|\n");
         for (double az : azimuths) {
@@ -129,7 +130,7 @@ int main(int argc, char** argv) {
             for (const Config& c : configs) {
                 RenderSettings s = base;
                 s.renderer = c.kind;
-                s.slab = c.slab;
+                s.quality.slab = c.slab;
                 s.camera.azimuthDeg = az;
                 const Renderer renderer(volume, s);
                 renderer.render();  // warm-up (first-touch allocations)

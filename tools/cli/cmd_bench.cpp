@@ -63,7 +63,7 @@ void registerBench(CLI::App& app) {
         out["renderer"] = toString(settings.renderer);
         out["mode"] = toString(settings.mode);
         out["size"] = a->render.size;
-        out["slab"] = settings.slab;
+        out["slab"] = settings.quality.slab;
         out["hardware_threads"] = std::thread::hardware_concurrency();
         std::printf("%-8s %-7s %8s %10s %10s %12s %14s\n", "threads", "renderer", "splats",
                     "median ms", "min ms", "fp px/frame", "fp px/s");

@@ -87,18 +87,6 @@ std::vector<double> parseList(const std::string& text, const std::string& what) 
     return v;
 }
 
-CompositeOrder parseOrder(const std::string& s) {
-    if (s == "ftb") return CompositeOrder::FrontToBack;
-    if (s == "btf") return CompositeOrder::BackToFront;
-    throw Error("unknown compositing order '" + s + "' (ftb or btf)");
-}
-
-Classification parseClassification(const std::string& s) {
-    if (s == "pre") return Classification::Pre;
-    if (s == "post") return Classification::Post;
-    throw Error("unknown classification '" + s + "' (pre or post)");
-}
-
 // Reads the scene file into `a` for every key it has; keys use the flag names without
 // dashes ("renderer", "pixel-size", ...).
 RenderArgs withScene(const RenderArgs& given) {
@@ -199,20 +187,20 @@ RenderSettings settingsFromArgs(const RenderArgs& given) {
         throw Error("unknown projection '" + a.projection + "' (ortho or perspective)");
     s.camera.pixelSize = a.pixelSize;
     s.camera.fovDeg = a.fov;
-    s.slab = a.slab;
+    s.quality.slab = a.slab;
     s.kernel = a.kernel;
     s.kernelSigma = a.sigma;
     s.kernelRadius = a.radius;
-    s.earlyTermination = a.earlyTermination;
+    s.quality.earlyTermination = a.earlyTermination;
     const std::vector<double> bg = parseList(a.background, "--background");
     if (bg.size() != 3 && bg.size() != 4) throw Error("--background needs R,G,B or R,G,B,A");
     s.background =
         glm::vec4(float(bg[0]), float(bg[1]), float(bg[2]), bg.size() == 4 ? float(bg[3]) : 1.0f);
     s.isoLevel = a.isoLevel;
     s.threads = a.threads;
-    s.tileSize = a.tileSize;
-    s.referenceStep = a.refStep;
-    s.referenceTolerance = a.refTolerance;
+    s.quality.tileSize = a.tileSize;
+    s.quality.referenceStep = a.refStep;
+    s.quality.referenceTolerance = a.refTolerance;
     s.shading.enabled = a.shade;
     return s;
 }

@@ -48,13 +48,11 @@ class FootprintTable {
     float peak() const { return values_.empty() ? 0.0f : values_[0]; }
     std::size_t bytes() const { return values_.size() * sizeof(float); }
 
-    /// The raw table, for vectorised lookups that replicate lookup(): entry n holds fp at
-    /// r^2 = n / invStep(), entries up to resolution() + 1 are readable.
-    const float* data() const { return values_.data(); }
-    float invStep() const { return invStep_; }
+    /// R^2: fp is 0 at and beyond it.
     float r2Max() const { return r2Max_; }
 
   private:
+    friend class FootprintLanes;  // footprint/lanes.h: the same lookup, 8 lanes at a time
     Kernel kernel_;
     int resolution_ = 0;
     float r2Max_ = 0, invStep_ = 0, tMax_ = 0;

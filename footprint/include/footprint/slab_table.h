@@ -67,22 +67,11 @@ class SlabTable {
     double radius() const { return kernel_.radius(); }
     int radialResolution() const { return nr_; }
     int depthResolution() const { return nz_; }
-    /// The raw fraction grid, for vectorised lookups that replicate fraction() exactly:
-    /// rr = min(max(r2, 0) invR2Step, nrf), zz = min(max((z - zMin) invZStep, 0), nzf),
-    /// bilinear in values[int(rr) * stride + int(zz)] and its +1 / +stride neighbours.
-    struct Grid {
-        const float* values;
-        int stride;
-        float invR2Step, invZStep, zMin, nrf, nzf;
-    };
-    Grid grid() const {
-        return {values_.data(), stride_, invR2Step_, invZStep_, zMin_, nrf_, nzf_};
-    }
-
     /// Memory of the fraction grid plus the footprint table.
     std::size_t bytes() const { return values_.size() * sizeof(float) + footprint_.bytes(); }
 
   private:
+    friend class FractionLanes;  // footprint/lanes.h: the same fraction(), 8 lanes at a time
     Kernel kernel_;
     FootprintTable footprint_;
     int nr_ = 0, nz_ = 0, stride_ = 0;

@@ -8,13 +8,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "splat/settings.h"
 #include "splat/transfer.h"
 #include "splat/volume.h"
 
 namespace splat {
-
-enum class RenderMode { Dvr, Mip, Xray, Iso };
-enum class Classification { Pre, Post };
 
 struct SplatList {
     std::vector<float> x, y, z;          ///< world position of the voxel
@@ -36,14 +34,6 @@ struct SplatList {
 /// Throws splat::Error if a dimension exceeds 65535.
 SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
                    Classification classification, double radius, bool normals = false);
-
-/// Headlight Phong shading of pre-classified emission (DESIGN.md: shading is modelled only
-/// when asked for): e' = e (ambient + diffuse |n.l|) + specular |n.l|^shininess rho, with
-/// the light at the eye (l = -view), two-sided.
-struct Shading {
-    bool enabled = false;
-    float ambient = 0.35f, diffuse = 0.65f, specular = 0.25f, shininess = 24.0f;
-};
 
 /// Shaded emission of every splat for a view direction (needs normals).
 void shadeEmission(const SplatList& splats, const Shading& shading, const glm::dvec3& view,

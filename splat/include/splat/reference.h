@@ -7,7 +7,7 @@
 #include "splat/camera.h"
 #include "splat/classify.h"
 #include "splat/image.h"
-#include "splat/render.h"
+#include "splat/settings.h"
 #include "splat/volume.h"
 
 namespace splat {

@@ -56,19 +56,19 @@ void TileAccumulator::updateOpacity(int x0, int y0, int x1, int y1) {
         }
 }
 
-void TileAccumulator::resolve(Image& image, int ox, int oy, RenderMode mode,
-                              const glm::vec4& bg) const {
+void TileAccumulator::resolve(Image& image, int ox, int oy, RenderMode mode) const {
     for (int y = 0; y < h_; ++y)
         for (int x = 0; x < w_; ++x) {
             const int p = y * w_ + x;
-            glm::vec4& out = image.at(ox + x, oy + y);
-            if (mode == RenderMode::Dvr) {
-                const float t = 1.0f - a_[p];
-                out = glm::vec4(r_[p], g_[p], b_[p], a_[p]) + t * bg;
-            } else {
-                out = glm::vec4(r_[p], r_[p], r_[p], 1.0f);
-            }
+            image.at(ox + x, oy + y) = mode == RenderMode::Dvr
+                                           ? glm::vec4(r_[p], g_[p], b_[p], a_[p])
+                                           : glm::vec4(r_[p], r_[p], r_[p], 1.0f);
         }
+}
+
+void applyBackground(Image& image, RenderMode mode, const glm::vec4& bg) {
+    if (mode != RenderMode::Dvr) return;
+    for (glm::vec4& out : image.pixels) out = out + (1.0f - out.a) * bg;
 }
 
 }  // namespace splat

@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "splat/render.h"
+#include "frame/transfer_table.h"
+#include "splat/image.h"
+#include "splat/settings.h"
 
 namespace splat {
 
@@ -59,9 +61,10 @@ class TileAccumulator {
     /// Re-evaluates the opaque blocks inside the tile-local rectangle (after a sheet).
     void updateOpacity(int x0, int y0, int x1, int y1);
 
-    /// Writes the tile into `image` at (ox, oy): dvr composites over `background`; mip and
-    /// xray write the value to r, g, b with alpha 1.
-    void resolve(Image& image, int ox, int oy, RenderMode mode, const glm::vec4& background) const;
+    /// Writes the tile's partial image into `image` at (ox, oy): premultiplied colour and
+    /// opacity for dvr, the value in r, g, b with alpha 1 for mip and xray. The background
+    /// is applied to the whole image afterwards (applyBackground).
+    void resolve(Image& image, int ox, int oy, RenderMode mode) const;
 
   private:
     int w_, h_;
@@ -72,5 +75,72 @@ class TileAccumulator {
     std::uint64_t opaqueBlocks_ = 0, allBlocks_ = 0;
     std::vector<float> r_, g_, b_, a_;
 };
+
+/// The last step of a frame: dvr pixels are composited over the background,
+/// I = C + (1 - a) I_bg; other modes have none.
+void applyBackground(Image& image, RenderMode mode, const glm::vec4& background);
+
+// ---- compositing policies: one home per render mode -------------------------------
+// A policy says how many channels a sheet pixel holds, how a sheet pixel becomes a
+// compositing sample (sheet -> sample) and how it is accumulated. `v` points at the
+// pixel's first channel, channels `plane` floats apart; `len` is the world length of the
+// pixel's ray through the sheet.
+
+/// Pre-classified dvr: optical depth and emission, alpha = 1 - exp(-tau), C = E a / tau.
+struct DvrPrePolicy {
+    static constexpr int kChannels = 4;
+    static constexpr bool kTerminates = true;
+    void operator()(TileAccumulator& acc, int p, const float* v, std::size_t plane, float) const {
+        acc.composite(p, sampleFromOpticalDepth(v[0], v[plane], v[2 * plane], v[3 * plane]));
+    }
+};
+
+/// Post-classified dvr: the mean density over the ray's path through the sheet is
+/// classified per pixel; alpha = 1 - exp(-rho len).
+struct DvrPostPolicy {
+    static constexpr int kChannels = 1;
+    static constexpr bool kTerminates = true;
+    const TransferTable* transfer;
+    void operator()(TileAccumulator& acc, int p, const float* v, std::size_t, float len) const {
+        float rho, r, g, b;
+        transfer->lookup(v[0] / len, rho, r, g, b);
+        const float alpha = -std::expm1(-rho * len);
+        acc.composite(p, {alpha, r * alpha, g * alpha, b * alpha});
+    }
+};
+
+/// MIP: the maximum over sheets of the mean of f over the ray's path through each.
+struct MipPolicy {
+    static constexpr int kChannels = 1;
+    static constexpr bool kTerminates = false;
+    void operator()(TileAccumulator& acc, int p, const float* v, std::size_t, float len) const {
+        acc.maximum(p, v[0] / len);
+    }
+};
+
+/// X-ray: the line integral of f, the sum over sheets.
+struct XrayPolicy {
+    static constexpr int kChannels = 1;
+    static constexpr bool kTerminates = false;
+    void operator()(TileAccumulator& acc, int p, const float* v, std::size_t, float) const {
+        acc.add(p, v[0]);
+    }
+};
+
+/// Calls f(policy) with the compositing policy of `mode` and `classification` (iso has
+/// none: the splatters do not render it).
+template <class F>
+decltype(auto) withPolicy(RenderMode mode, Classification classification,
+                          const TransferTable& transfer, F&& f) {
+    switch (mode) {
+        case RenderMode::Mip:
+            return f(MipPolicy{});
+        case RenderMode::Xray:
+            return f(XrayPolicy{});
+        default:
+            return classification == Classification::Pre ? f(DvrPrePolicy{})
+                                                         : f(DvrPostPolicy{&transfer});
+    }
+}
 
 }  // namespace splat

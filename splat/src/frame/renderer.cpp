@@ -1,213 +1,153 @@
-// splat::Renderer: the view-independent state (kernel tables, resolved transfer function,
-// splat list) and the per-frame pipeline project -> bin -> splatter -> composite.
-#include <array>
-#include <chrono>
-#include <cmath>
-#include <mutex>
-#include <optional>
+// The frame pipeline: one frame of a Scene, every stage in order, on the frame's threads.
+//
+//   shade -> project -> order -> bin -> tiles (cut kernels into sheets, composite) -> resolve
+//
+// The stages are free functions over plain arrays (frame/, splatters/); the two splatters
+// differ only in `order` and in how `tiles` cuts a kernel into sheets. The reference ray
+// caster renders the same Scene's fields instead (reference/).
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
-#include "splatters/axis_splatter.h"
-#include "footprint/kernel.h"
-#include "splatters/image_aligned_splatter.h"
-#include "projection.h"
+#include <chrono>
+
+#include "frame/compositing.h"
+#include "frame/frame.h"
+#include "frame/projection.h"
+#include "frame/tile_binning.h"
+#include "reference/reference_frame.h"
 #include "splat/error.h"
-#include "splat/reference.h"
-#include "splat/render.h"
+#include "splatters/splatter.h"
 
 namespace splat {
 
-struct Renderer::Impl {
-    const Volume& volume;
-    RenderSettings settings;
-    footprint::Kernel kernel;
-    std::optional<footprint::FootprintTable> table;
-    std::optional<footprint::SlabTable> slabs;
-    std::optional<footprint::FootprintPoly> poly;
-    TransferTable transfer;
-    SplatList splats;  // (k, j, i) order: sorted by slice along z
-    // Copies sorted by slice along x and y, made when a view first needs them, so that the
-    // splatters read the list in visiting order.
-    mutable std::mutex sortMutex;
-    mutable std::array<std::unique_ptr<SplatList>, 2> sorted;
-    // One frame at a time uses the workspace; concurrent render() calls on one Renderer
-    // are serialised.
-    mutable std::mutex frameMutex;
-    mutable FrameWorkspace work;
-
-    const SplatList& sortedAlong(int axis) const {
-        if (axis == 2) return splats;
-        std::lock_guard<std::mutex> lock(sortMutex);
-        if (!sorted[axis]) sorted[axis] = std::make_unique<SplatList>(sortedBySlice(splats, axis));
-        return *sorted[axis];
-    }
-
-    Impl(const Volume& v, const RenderSettings& s)
-        : volume(v), settings(s), kernel(makeKernel(s)) {}
-
-    /// Shading is modelled only where it applies: pre-classified dvr.
-    bool shaded() const {
-        return settings.shading.enabled && settings.mode == RenderMode::Dvr &&
-               settings.classification == Classification::Pre;
-    }
-
-    static footprint::Kernel makeKernel(const RenderSettings& s) {
-        try {
-            return footprint::Kernel::fromName(s.kernel, s.kernelSigma, s.kernelRadius);
-        } catch (const std::invalid_argument& e) {
-            throw Error(e.what());
-        }
-    }
-};
-
 namespace {
 
-void validate(const Volume& v, const RenderSettings& s) {
-    if (v.voxelCount() == 0 || v.data.size() != v.voxelCount())
-        throw Error("volume is empty or its sample count does not match its dimensions");
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// Emission to splat: the list's own, or (shaded scenes) this view's shaded emission.
+struct Emission {
+    const float *r, *g, *b;
+};
+
+/// Stage "shade": headlight shading of the emission for this view, only when the scene is
+/// shaded.
+Emission shade(const Scene::Impl& scene, const Camera& camera, FrameWorkspace& work,
+               RenderStats& stats) {
+    const SplatList& s = scene.splats;
+    if (!scene.shaded()) return {s.r.data(), s.g.data(), s.b.data()};
+    const auto start = Clock::now();
+    shadeEmission(s, scene.settings.shading, camera.view, work.r, work.g, work.b);
+    stats.shadeMs = msSince(start);
+    return {work.r.data(), work.g.data(), work.b.data()};
+}
+
+/// Stage "project": screen positions, depths and footprint ellipses of every splat.
+void project(const Scene::Impl& scene, const Camera& camera, FrameWorkspace& work,
+             RenderStats& stats) {
+    const auto start = Clock::now();
+    projectSplats(scene.splats, camera, scene.volume->spacing, scene.kernel.radius(), work.proj);
+    stats.projectMs = msSince(start);
+}
+
+/// Stage "order": the splatter's visiting order and sheet plan.
+SheetPlan order(const Splatter& splatter, const Scene::Impl& scene, const Camera& camera,
+                const RenderSettings& s, FrameWorkspace& work, RenderStats& stats) {
+    const auto start = Clock::now();
+    const SheetPlan plan = splatter.order(scene, camera, s, work, stats);
+    stats.orderMs = msSince(start);
+    return plan;
+}
+
+/// Stage "bin": every splat listed in the screen tiles its footprint touches.
+void bin(const Camera& camera, const RenderSettings& s, FrameWorkspace& work, RenderStats& stats) {
+    const auto start = Clock::now();
+    binToTiles(work.proj, work.order, TileGrid(camera.width(), camera.height(), s.quality.tileSize),
+               work.bins);
+    stats.binMs = msSince(start);
+}
+
+Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
+                 RenderStats& stats) {
+    const Splatter& splatter =
+        s.renderer == RendererKind::Axis ? axisAlignedSplatter() : imageAlignedSplatter();
+    const WorkspaceLease work(scene);
+    const Emission e = shade(scene, camera, *work, stats);
+    project(scene, camera, *work, stats);
+    const SheetPlan plan = order(splatter, scene, camera, s, *work, stats);
+    bin(camera, s, *work, stats);
+    const TileInputs in{scene, camera, s, work->proj, work->bins, plan, e.r, e.g, e.b};
+    Image image = splatter.rasterize(in, *work, &stats);
+    applyBackground(image, s.mode, s.background);
+    return image;
+}
+
+Image referenceFrame(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
+                     RenderStats& stats) {
+    if (!scene.shaded())
+        return renderReference(*scene.volume, scene.referenceField(), camera, s, &stats, nullptr);
+    // Shaded emission depends on the view: the field is made for this frame.
+    SplatList lit = scene.splats;
+    shadeEmission(scene.splats, scene.settings.shading, camera.view, lit.r, lit.g, lit.b);
+    const ReferenceField field(*scene.volume, lit, scene.kernel, true);
+    return renderReference(*scene.volume, field, camera, s, &stats, nullptr);
+}
+
+}  // namespace
+
+void validateFrame(const RenderSettings& s) {
+    const Quality& q = s.quality;
     if (s.renderer != RendererKind::Reference && s.mode == RenderMode::Iso)
         throw Error("iso mode is rendered by the reference ray caster only (--renderer reference)");
-    if (!(s.slab > 0) || !std::isfinite(s.slab) || s.slab > 1e4)
+    if (!(q.slab > 0) || !std::isfinite(q.slab) || q.slab > 1e4)
         throw Error("slab thickness must be a positive number of voxels (got " +
-                    std::to_string(s.slab) + ")");
-    if (s.renderer == RendererKind::Sheet && s.slab < 1e-3)
+                    std::to_string(q.slab) + ")");
+    if (s.renderer == RendererKind::Sheet && q.slab < 1e-3)
         throw Error("slab thickness below 0.001 voxels would need millions of sheets");
-    if (!(s.earlyTermination >= 0 && s.earlyTermination < 1))
+    if (!(q.earlyTermination >= 0 && q.earlyTermination < 1))
         throw Error("early termination threshold must be in [0, 1)");
-    if (s.tileSize < 8 || s.tileSize > 64) throw Error("tile size must be between 8 and 64 pixels");
+    if (q.tileSize < 8 || q.tileSize > 64) throw Error("tile size must be between 8 and 64 pixels");
     if (s.threads < 0 || s.threads > 1024)
         throw Error("thread count must be between 0 (all) and 1024");
-    if (!(s.referenceStep > 0) || !(s.referenceTolerance > 0))
+    if (!(q.referenceStep > 0) || !(q.referenceTolerance > 0))
         throw Error("reference step and tolerance must be positive");
     for (int c = 0; c < 4; ++c)
         if (!(s.background[c] >= 0 && s.background[c] <= 1))
             throw Error("background must be in [0, 1]");
 }
 
-}  // namespace
-
-Renderer::Renderer(const Volume& volume, const RenderSettings& settings) {
-    validate(volume, settings);
-    impl_ = std::make_unique<Impl>(volume, settings);
-    const VolumeStats st = volumeStats(volume, 1);
-    impl_->settings.transfer = settings.transfer.resolved(st.minValue, st.maxValue);
-    impl_->splats = classify(volume, impl_->settings.transfer, settings.mode,
-                             settings.classification, impl_->kernel.radius(), impl_->shaded());
-    impl_->transfer = TransferTable(impl_->settings.transfer);
-    if (settings.renderer != RendererKind::Reference) {
-        impl_->table.emplace(impl_->kernel);
-        impl_->poly.emplace(*impl_->table);
-        if (impl_->poly->maxError() > footprint::FootprintPoly::kTolerance) impl_->poly.reset();
-    }
-    if (settings.renderer == RendererKind::Sheet) impl_->slabs.emplace(impl_->kernel);
-}
-
-Renderer::~Renderer() = default;
-Renderer::Renderer(Renderer&&) noexcept = default;
-Renderer& Renderer::operator=(Renderer&&) noexcept = default;
-
-const SplatList& Renderer::splats() const { return impl_->splats; }
-const RenderSettings& Renderer::settings() const { return impl_->settings; }
-
-Image Renderer::render(RenderStats* stats) const { return render(impl_->settings.camera, stats); }
-
-Image Renderer::render(const CameraParams& params, RenderStats* stats) const {
-    const auto start = std::chrono::steady_clock::now();
-    const Impl& m = *impl_;
-    const Camera camera(params, m.volume);
-    RenderSettings settings = m.settings;
-    settings.camera = params;
+Image renderFrame(const Scene::Impl& scene, const RenderSettings& s, RenderStats* stats) {
+    const auto start = Clock::now();
+    validateFrame(s);
     RenderStats local;
-    local.splats = m.splats.size();
-    local.voxels = m.splats.voxels;
+    local.splats = scene.splats.size();
+    local.voxels = scene.splats.voxels;
     Image image;
-    if (settings.renderer == RendererKind::Reference) {
-        if (m.shaded()) {
-            SplatList lit = m.splats;
-            shadeEmission(m.splats, settings.shading, camera.view, lit.r, lit.g, lit.b);
-            image = renderReference(m.volume, lit, m.kernel, camera, settings, &local);
-        } else {
-            image = renderReference(m.volume, m.splats, m.kernel, camera, settings, &local);
-        }
-    } else {
-        const SplatList& list = m.sortedAlong(majorAxis(camera.view));
-        std::lock_guard<std::mutex> lock(m.frameMutex);
-        const float *er = list.r.data(), *eg = list.g.data(), *eb = list.b.data();
-        if (m.shaded()) {
-            shadeEmission(list, settings.shading, camera.view, m.work.r, m.work.g, m.work.b);
-            er = m.work.r.data();
-            eg = m.work.g.data();
-            eb = m.work.b.data();
-        }
-        const FrameInputs in{m.volume,
-                             list,
-                             camera,
-                             settings,
-                             *m.table,
-                             m.poly ? &*m.poly : nullptr,
-                             m.slabs ? &*m.slabs : nullptr,
-                             m.transfer,
-                             m.work,
-                             er,
-                             eg,
-                             eb};
-        const auto t0 = std::chrono::steady_clock::now();
-        ProjectedSplats& proj = m.work.proj;
-        projectSplats(list, camera, m.volume.spacing, m.kernel.radius(), proj);
-        local.projectMs =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                .count();
-        image = settings.renderer == RendererKind::Axis ? renderAxisAligned(in, proj, &local)
-                                                        : renderImageAligned(in, proj, &local);
-    }
-    local.milliseconds =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    runOnThreads(s.threads, [&] {
+        const Camera camera(s.camera, *scene.volume);
+        image = s.renderer == RendererKind::Reference ? referenceFrame(scene, camera, s, local)
+                                                      : splatFrame(scene, camera, s, local);
+    });
+    local.milliseconds = msSince(start);
     if (stats) *stats = local;
     return image;
 }
 
-Image render(const Volume& volume, const RenderSettings& settings, RenderStats* stats) {
-    return Renderer(volume, settings).render(stats);
-}
-
-const char* toString(RendererKind k) {
-    switch (k) {
-        case RendererKind::Axis:
-            return "axis";
-        case RendererKind::Sheet:
-            return "sheet";
-        case RendererKind::Reference:
-            return "reference";
-    }
-    return "?";
-}
-
-const char* toString(RenderMode m) {
-    switch (m) {
-        case RenderMode::Dvr:
-            return "dvr";
-        case RenderMode::Mip:
-            return "mip";
-        case RenderMode::Xray:
-            return "xray";
-        case RenderMode::Iso:
-            return "iso";
-    }
-    return "?";
-}
-
-RendererKind parseRenderer(const std::string& s) {
-    if (s == "axis") return RendererKind::Axis;
-    if (s == "sheet") return RendererKind::Sheet;
-    if (s == "reference") return RendererKind::Reference;
-    throw Error("unknown renderer '" + s + "' (axis, sheet or reference)");
-}
-
-RenderMode parseMode(const std::string& s) {
-    if (s == "dvr") return RenderMode::Dvr;
-    if (s == "mip") return RenderMode::Mip;
-    if (s == "xray") return RenderMode::Xray;
-    if (s == "iso") return RenderMode::Iso;
-    throw Error("unknown mode '" + s + "' (dvr, mip, xray or iso)");
+std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& axis) {
+    if (!camera.perspective()) return {};
+    const int w = camera.width(), h = camera.height();
+    std::vector<float> scale(std::size_t(w) * h);
+    const double ref = std::abs(glm::dot(camera.view, axis));
+    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+        for (int y = rows.begin(); y != rows.end(); ++y)
+            for (int x = 0; x < w; ++x) {
+                const Ray r = camera.ray(x + 0.5, y + 0.5);
+                scale[std::size_t(y) * w + x] = float(ref / std::abs(glm::dot(r.dir, axis)));
+            }
+    });
+    return scale;
 }
 
 }  // namespace splat

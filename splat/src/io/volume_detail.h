@@ -53,7 +53,6 @@ std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t siz
 std::string toLower(std::string s);
 std::string trim(const std::string& s);
 
-
 // ---- orientation -----------------------------------------------------------------
 
 /// Applies a file's index-to-world affine x = t + M p (columns of M = world step of one

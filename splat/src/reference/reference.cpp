@@ -30,7 +30,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -40,197 +39,15 @@
 #include <limits>
 #include <vector>
 
+#include "model/scene_impl.h"
+#include "reference/field.h"
+#include "reference/reference_frame.h"
 #include "splat/error.h"
 
 namespace splat {
 namespace {
 
-constexpr int kBrick = 8;      // brick edge, voxels
 constexpr int kMaxLevels = 6;  // step halvings after the first pass
-constexpr int kLutSize = 1 << 16;
-constexpr double kAmbient = 0.25, kDiffuse = 0.75;
-
-// h(u) tabulated over u^2 in [0, R^2].
-class KernelLut {
-  public:
-    explicit KernelLut(const footprint::Kernel& kernel) {
-        const double r = kernel.radius();
-        r2Max_ = r * r;
-        const double step = r2Max_ / kLutSize;
-        inv_ = 1.0 / step;
-        values_.resize(kLutSize + 2, 0.0f);
-        for (int n = 0; n <= kLutSize; ++n) {
-            const double u2 = std::min(n * step, r2Max_);
-            values_[n] = n == kLutSize ? 0.0f : float(kernel(std::sqrt(u2)));
-        }
-    }
-    double r2Max() const { return r2Max_; }
-    float operator()(double u2) const {
-        if (!(u2 < r2Max_)) return 0.0f;
-        const double t = u2 * inv_;
-        const int n = int(t);
-        const float f = float(t - n);
-        return values_[n] + f * (values_[n + 1] - values_[n]);
-    }
-
-  private:
-    double r2Max_ = 0, inv_ = 0;
-    std::vector<float> values_;
-};
-
-// Dense per-voxel values (C channels interleaved) plus the brick occupancy grid.
-template <int C>
-struct FieldGrid {
-    glm::ivec3 dims{0};
-    double radius = 0;
-    std::vector<float> values;
-    glm::ivec3 nb{0};
-    std::vector<std::uint8_t> bricks;
-    const KernelLut* lut = nullptr;
-
-    std::size_t index(int i, int j, int k) const {
-        return ((std::size_t(k) * dims.y + j) * dims.x + i) * C;
-    }
-    bool brick(int bx, int by, int bz) const {
-        return bricks[(std::size_t(bz) * nb.y + by) * nb.x + bx] != 0;
-    }
-
-    // Sum of the C channels times h at index position p.
-    void eval(const glm::dvec3& p, double out[C]) const {
-        for (int c = 0; c < C; ++c) out[c] = 0.0;
-        const double r = radius, r2 = lut->r2Max();
-        const int i0 = std::max(0, int(std::ceil(p.x - r))),
-                  i1 = std::min(dims.x - 1, int(std::floor(p.x + r)));
-        const int j0 = std::max(0, int(std::ceil(p.y - r))),
-                  j1 = std::min(dims.y - 1, int(std::floor(p.y + r)));
-        const int k0 = std::max(0, int(std::ceil(p.z - r))),
-                  k1 = std::min(dims.z - 1, int(std::floor(p.z + r)));
-        if (i0 > i1 || j0 > j1 || k0 > k1) return;
-        double dx2[64];
-        const int ni = std::min(i1 - i0 + 1, 64);
-        for (int n = 0; n < ni; ++n) {
-            const double d = p.x - (i0 + n);
-            dx2[n] = d * d;
-        }
-        for (int k = k0; k <= k1; ++k) {
-            const double dz = p.z - k, dz2 = dz * dz;
-            if (dz2 >= r2) continue;
-            for (int j = j0; j <= j1; ++j) {
-                const double dy = p.y - j, dyz = dy * dy + dz2;
-                if (dyz >= r2) continue;
-                const float* row = values.data() + index(i0, j, k);
-                for (int n = 0; n < ni; ++n) {
-                    const float w = (*lut)(dyz + dx2[n]);
-                    if (w == 0.0f) continue;
-                    for (int c = 0; c < C; ++c) out[c] += double(w) * double(row[n * C + c]);
-                }
-            }
-        }
-    }
-};
-
-template <int C>
-FieldGrid<C> buildGrid(const Volume& volume, const SplatList& splats, const KernelLut& lut,
-                       double radius, const std::array<const std::vector<float>*, C>& channels) {
-    FieldGrid<C> g;
-    g.dims = volume.dims;
-    g.radius = radius;
-    g.lut = &lut;
-    g.values.assign(volume.voxelCount() * C, 0.0f);
-    // Brick b covers index positions [-R + b B, -R + (b + 1) B) on each axis.
-    g.nb =
-        glm::ivec3(glm::ceil((glm::dvec3(volume.dims) - 1.0 + 2.0 * radius) / double(kBrick))) + 1;
-    g.bricks.assign(std::size_t(g.nb.x) * g.nb.y * g.nb.z, 0);
-    for (const auto* ch : channels)
-        if (ch->size() != splats.size())
-            throw Error("reference: the splat list lacks the channels this mode needs");
-    for (std::size_t s = 0; s < splats.size(); ++s) {
-        const int i = splats.i[s], j = splats.j[s], k = splats.k[s];
-        if (i >= volume.dims.x || j >= volume.dims.y || k >= volume.dims.z)
-            throw Error("reference: splat index outside the volume");
-        bool any = false;
-        for (int c = 0; c < C; ++c) {
-            const float v = (*channels[c])[s];
-            g.values[g.index(i, j, k) + c] = v;
-            any = any || v != 0.0f;
-        }
-        if (!any) continue;
-        // Points within R of voxel p lie in [p - R, p + R]: bricks floor(p / B) ..
-        // floor((p + 2R) / B) in the brick frame that starts at -R.
-        const glm::ivec3 p(i, j, k);
-        glm::ivec3 lo, hi;
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = std::max(0, int(std::floor(p[a] / double(kBrick))));
-            hi[a] = std::min(g.nb[a] - 1, int(std::floor((p[a] + 2.0 * radius) / kBrick)));
-        }
-        for (int bz = lo.z; bz <= hi.z; ++bz)
-            for (int by = lo.y; by <= hi.y; ++by)
-                for (int bx = lo.x; bx <= hi.x; ++bx)
-                    g.bricks[(std::size_t(bz) * g.nb.y + by) * g.nb.x + bx] = 1;
-    }
-    return g;
-}
-
-struct Segment {
-    double a, b;
-};
-
-// Cuts the line p0 + t v (index space, t world units) into the segments crossing marked
-// bricks, within [tLo, tHi] and the volume bounds padded by R.
-template <int C>
-void raySegments(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& v, double tLo,
-                 double tHi, std::vector<Segment>& out) {
-    out.clear();
-    const double r = g.radius;
-    double tA = tLo, tB = tHi;
-    for (int a = 0; a < 3; ++a) {
-        const double lo = -r, hi = g.dims[a] - 1 + r;
-        if (std::abs(v[a]) < 1e-300) {
-            if (p0[a] < lo || p0[a] > hi) return;
-            continue;
-        }
-        double t0 = (lo - p0[a]) / v[a], t1 = (hi - p0[a]) / v[a];
-        if (t0 > t1) std::swap(t0, t1);
-        tA = std::max(tA, t0);
-        tB = std::min(tB, t1);
-    }
-    if (!(tA < tB)) return;
-    const double origin = -r;
-    const glm::dvec3 pa = p0 + tA * v;
-    glm::ivec3 cell, step;
-    glm::dvec3 tMax, tDelta;
-    for (int a = 0; a < 3; ++a) {
-        cell[a] = std::clamp(int(std::floor((pa[a] - origin) / kBrick)), 0, g.nb[a] - 1);
-        if (v[a] > 1e-300) {
-            step[a] = 1;
-            tMax[a] = (origin + (cell[a] + 1.0) * kBrick - p0[a]) / v[a];
-            tDelta[a] = kBrick / v[a];
-        } else if (v[a] < -1e-300) {
-            step[a] = -1;
-            tMax[a] = (origin + cell[a] * double(kBrick) - p0[a]) / v[a];
-            tDelta[a] = -kBrick / v[a];
-        } else {
-            step[a] = 0;
-            tMax[a] = std::numeric_limits<double>::infinity();
-            tDelta[a] = tMax[a];
-        }
-    }
-    double t = tA;
-    while (t < tB) {
-        const int axis = tMax.x <= tMax.y ? (tMax.x <= tMax.z ? 0 : 2) : (tMax.y <= tMax.z ? 1 : 2);
-        const double tn = std::min(tMax[axis], tB);
-        if (tn > t && g.brick(cell.x, cell.y, cell.z)) {
-            if (!out.empty() && out.back().b == t)
-                out.back().b = tn;
-            else
-                out.push_back({t, tn});
-        }
-        t = std::max(t, tn);
-        cell[axis] += step[axis];
-        tMax[axis] += tDelta[axis];
-        if (cell[axis] < 0 || cell[axis] >= g.nb[axis]) break;
-    }
-}
 
 // Per-thread scratch of one ray.
 template <int C>
@@ -245,29 +62,17 @@ using Sample4 = std::array<float, 4>;
 
 class Caster {
   public:
-    Caster(const Volume& volume, const SplatList& splats, const footprint::Kernel& kernel,
-           const Camera& camera, const RenderSettings& settings)
-        : volume_(volume),
-          camera_(camera),
-          settings_(settings),
-          lut_(kernel),
-          radius_(kernel.radius()) {
-        if (!(settings.referenceStep > 0) || !std::isfinite(settings.referenceStep))
+    Caster(const Volume& volume, const ReferenceField& field, const Camera& camera,
+           const RenderSettings& settings)
+        : volume_(volume), camera_(camera), settings_(settings), field_(field) {
+        const Quality& q = settings.quality;
+        if (!(q.referenceStep > 0) || !std::isfinite(q.referenceStep))
             throw Error("reference: referenceStep must be > 0 voxels");
-        if (!(settings.referenceTolerance > 0))
-            throw Error("reference: referenceTolerance must be > 0");
+        if (!(q.referenceTolerance > 0)) throw Error("reference: referenceTolerance must be > 0");
         if (volume.voxelCount() == 0) throw Error("reference: empty volume");
-        if (!(kernel.radius() > 0) || kernel.radius() > 30)
-            throw Error("reference: kernel radius must be in (0, 30] voxels");
         invSpacing_ = 1.0 / volume.spacing;
-        stepWorld_ = settings.referenceStep * volume.minSpacing();
-        preDvr_ =
-            settings.mode == RenderMode::Dvr && settings.classification == Classification::Pre;
-        if (preDvr_)
-            grid4_ = buildGrid<4>(volume, splats, lut_, radius_,
-                                  {&splats.extinction, &splats.r, &splats.g, &splats.b});
-        else
-            grid1_ = buildGrid<1>(volume, splats, lut_, radius_, {&splats.density});
+        stepWorld_ = q.referenceStep * volume.minSpacing();
+        preDvr_ = field.fourChannels();
     }
 
     Image render(RenderStats* stats, Image* depth) {
@@ -283,8 +88,8 @@ class Caster {
                 for (int x = 0; x < w; ++x) {
                     int level = 0;
                     double hitDepth = -1;
-                    image.at(x, y) = preDvr_ ? pixel(grid4_, s4, x, y, level, hitDepth)
-                                             : pixel(grid1_, s1, x, y, level, hitDepth);
+                    image.at(x, y) = preDvr_ ? pixel(field_.grid4(), s4, x, y, level, hitDepth)
+                                             : pixel(field_.grid1(), s1, x, y, level, hitDepth);
                     if (depth)
                         depth->at(x, y) = hitDepth >= 0
                                               ? glm::vec4(glm::vec3(float(hitDepth)), 1.0f)
@@ -295,10 +100,9 @@ class Caster {
             while (localFinest > cur && !finest.compare_exchange_weak(cur, localFinest)) {
             }
         };
-        const int threads = settings_.threads > 0 ? settings_.threads : tbb::task_arena::automatic;
-        tbb::task_arena arena(threads);
-        arena.execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), body); });
-        if (stats) stats->referenceStep = settings_.referenceStep / double(1 << finest.load());
+        tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), body);
+        if (stats)
+            stats->referenceStep = settings_.quality.referenceStep / double(1 << finest.load());
         return image;
     }
 
@@ -365,7 +169,7 @@ class Caster {
         }
         glm::dvec4 prev(0.0), result(0.0);
         double prevDepth = -1;
-        const double tol = settings_.referenceTolerance;
+        const double tol = settings_.quality.referenceTolerance;
         for (int level = 0; level <= kMaxLevels; ++level) {
             double depthHere = -1;
             result = integrate(g, sc, p0, v, level, depthHere);
@@ -392,7 +196,7 @@ class Caster {
     glm::dvec4 integrate(const FieldGrid<C>& g, RayScratch<C>& sc, const glm::dvec3& p0,
                          const glm::dvec3& v, int level, double& depth) const {
         const RenderMode mode = settings_.mode;
-        const double cutoff = std::min(settings_.referenceTolerance, 1e-3) * 1e-3;
+        const double cutoff = std::min(settings_.quality.referenceTolerance, 1e-3) * 1e-3;
         double tau = 0, xray = 0, mip = 0;
         glm::dvec3 emission(0.0);
         double T = 1.0;
@@ -551,29 +355,41 @@ class Caster {
             const glm::dvec3 dir = glm::normalize(v * volume_.spacing);  // world ray direction
             diffuse = std::abs(glm::dot(grad / len, dir));
         }
-        return colour * (kAmbient + kDiffuse * diffuse);
+        return colour *
+               double(settings_.shading.ambient + settings_.shading.diffuse * float(diffuse));
     }
 
     const Volume& volume_;
     const Camera& camera_;
     const RenderSettings& settings_;
-    KernelLut lut_;
-    double radius_;
+    const ReferenceField& field_;
     glm::dvec3 invSpacing_{1.0};
     double stepWorld_ = 1;
     bool preDvr_ = false;
-    FieldGrid<4> grid4_;
-    FieldGrid<1> grid1_;
 };
 
 }  // namespace
+
+void validateReferenceKernel(const footprint::Kernel& kernel) {
+    if (!(kernel.radius() > 0) || kernel.radius() > 30)
+        throw Error("reference: kernel radius must be in (0, 30] voxels");
+}
+
+Image renderReference(const Volume& volume, const ReferenceField& field, const Camera& camera,
+                      const RenderSettings& settings, RenderStats* stats, Image* depth) {
+    Caster caster(volume, field, camera, settings);
+    return caster.render(stats, depth);
+}
 
 Image renderReference(const Volume& volume, const SplatList& splats,
                       const footprint::Kernel& kernel, const Camera& camera,
                       const RenderSettings& settings, RenderStats* stats) {
     const auto start = std::chrono::steady_clock::now();
-    Caster caster(volume, splats, kernel, camera, settings);
-    Image image = caster.render(stats, nullptr);
+    validateReferenceKernel(kernel);
+    const ReferenceField field(volume, splats, kernel, isPreClassifiedDvr(settings));
+    Image image;
+    runOnThreads(settings.threads,
+                 [&] { image = renderReference(volume, field, camera, settings, stats, nullptr); });
     if (stats) {
         stats->splats = splats.size();
         stats->voxels = splats.voxels;
@@ -589,9 +405,11 @@ Image renderReferenceDepth(const Volume& volume, const SplatList& splats,
                            const RenderSettings& settings, RenderStats* stats) {
     if (settings.mode != RenderMode::Iso)
         throw Error("reference: hit depths exist only in iso mode");
-    Caster caster(volume, splats, kernel, camera, settings);
+    validateReferenceKernel(kernel);
+    const ReferenceField field(volume, splats, kernel, false);
     Image depth;
-    caster.render(stats, &depth);
+    runOnThreads(settings.threads,
+                 [&] { renderReference(volume, field, camera, settings, stats, &depth); });
     return depth;
 }
 

@@ -1,0 +1,111 @@
+#pragma once
+// Eight-lane (AVX2 + FMA) evaluation of the footprint tables for the splatters' inner
+// loops, kept beside the tables so that no other library re-implements their
+// interpolation:
+//   FootprintLanes: fp(r^2) of FootprintTable::lookup, from the table (two gathers) or from
+//                   a FootprintPoly (permutes and fused multiply-adds, no gathers);
+//   FractionLanes:  F(r^2, z) of SlabTable::fraction, bilinear (four gathers).
+// Both reproduce the scalar lookups' clamping. Only compiled where the translation unit
+// targets AVX2 and FMA (FOOTPRINT_HAVE_LANES is then defined); elsewhere callers use the
+// scalar lookups, which are exact too. The tests compare both paths with the tables.
+#if defined(__AVX2__) && defined(__FMA__)
+#define FOOTPRINT_HAVE_LANES 1
+#include <immintrin.h>
+
+#include "footprint/footprint_poly.h"
+#include "footprint/footprint_table.h"
+#include "footprint/slab_table.h"
+
+namespace footprint {
+
+class FootprintLanes {
+  public:
+    /// `poly` (optional) must approximate `table`; it is used instead of the table.
+    FootprintLanes(const FootprintTable& table, const FootprintPoly* poly)
+        : poly_(poly),
+          data_(table.values_.data()),
+          inv_(_mm256_set1_ps(table.invStep_)),
+          last_(_mm256_set1_ps(float(table.resolution()))),
+          seg_(_mm256_set1_ps(poly ? poly->segmentScale() : 0.0f)),
+          lastSeg_(_mm256_set1_ps(float(FootprintPoly::kSegments - 1))) {
+        if (poly)
+            for (int k = 0; k < FootprintPoly::kMaxCoefficients; ++k)
+                coef_[k] = _mm256_loadu_ps(poly->coefficients()[k].data());
+    }
+    /// fp(r2) for r2 >= 0; lanes at or beyond R^2 must be masked by the caller.
+    __m256 operator()(__m256 r2) const {
+        if (poly_) {
+            const __m256 s = _mm256_mul_ps(r2, seg_);
+            const __m256 sf = _mm256_min_ps(_mm256_floor_ps(s), lastSeg_);
+            const __m256i seg = _mm256_cvttps_epi32(sf);
+            const __m256 u =
+                _mm256_fmsub_ps(_mm256_set1_ps(2.0f), _mm256_sub_ps(s, sf), _mm256_set1_ps(1.0f));
+            auto a = [&](int k) { return _mm256_permutevar8x32_ps(coef_[7 - k], seg); };  // u^k
+            const __m256 u2 = _mm256_mul_ps(u, u), u4 = _mm256_mul_ps(u2, u2);
+            const __m256 q0 = _mm256_fmadd_ps(a(1), u, a(0)), q1 = _mm256_fmadd_ps(a(3), u, a(2));
+            const __m256 q2 = _mm256_fmadd_ps(a(5), u, a(4)), q3 = _mm256_fmadd_ps(a(7), u, a(6));
+            return _mm256_fmadd_ps(_mm256_fmadd_ps(q3, u2, q2), u4, _mm256_fmadd_ps(q1, u2, q0));
+        }
+        const __m256 t = _mm256_min_ps(_mm256_mul_ps(r2, inv_), last_);
+        const __m256i i = _mm256_cvttps_epi32(t);
+        const __m256 f = _mm256_sub_ps(t, _mm256_cvtepi32_ps(i));
+        const __m256 v0 = _mm256_i32gather_ps(data_, i, 4);
+        const __m256 v1 = _mm256_i32gather_ps(data_ + 1, i, 4);
+        return _mm256_fmadd_ps(f, _mm256_sub_ps(v1, v0), v0);
+    }
+
+  private:
+    const FootprintPoly* poly_;
+    const float* data_;
+    __m256 inv_, last_, seg_, lastSeg_;
+    __m256 coef_[FootprintPoly::kMaxCoefficients] = {};
+};
+
+class FractionLanes {
+  public:
+    explicit FractionLanes(const SlabTable& t)
+        : values_(t.values_.data()),
+          invR_(_mm256_set1_ps(t.invR2Step_)),
+          invZ_(_mm256_set1_ps(t.invZStep_)),
+          zMin_(_mm256_set1_ps(t.zMin_)),
+          nr_(_mm256_set1_ps(t.nrf_)),
+          nz_(_mm256_set1_ps(t.nzf_)),
+          stride_(_mm256_set1_epi32(t.stride_)) {}
+
+    /// The radial part of a lookup, shared by every depth at the same r^2 (r2 >= 0).
+    struct Radial {
+        __m256i row;  ///< index of the grid row below r^2
+        __m256 fr;    ///< fraction towards the next row
+    };
+    Radial radial(__m256 r2) const {
+        const __m256 rr = _mm256_min_ps(_mm256_mul_ps(r2, invR_), nr_);
+        const __m256i ri = _mm256_cvttps_epi32(rr);
+        return {_mm256_mullo_epi32(ri, stride_), _mm256_sub_ps(rr, _mm256_cvtepi32_ps(ri))};
+    }
+    /// F(r^2, z) for the lanes' radial part and depths z (kernel units).
+    __m256 operator()(const Radial& r, __m256 z) const {
+        const __m256 zero = _mm256_setzero_ps();
+        __m256 zz = _mm256_mul_ps(_mm256_sub_ps(z, zMin_), invZ_);
+        zz = _mm256_min_ps(_mm256_max_ps(zz, zero), nz_);  // NaN -> 0 as fraction()
+        const __m256i j = _mm256_cvttps_epi32(zz);
+        const __m256 fz = _mm256_sub_ps(zz, _mm256_cvtepi32_ps(j));
+        const __m256i one = _mm256_set1_epi32(1);
+        const __m256i idx = _mm256_add_epi32(r.row, j);
+        const __m256i idx2 = _mm256_add_epi32(idx, stride_);
+        const __m256 p0 = _mm256_i32gather_ps(values_, idx, 4);
+        const __m256 p1 = _mm256_i32gather_ps(values_, _mm256_add_epi32(idx, one), 4);
+        const __m256 p2 = _mm256_i32gather_ps(values_, idx2, 4);
+        const __m256 p3 = _mm256_i32gather_ps(values_, _mm256_add_epi32(idx2, one), 4);
+        const __m256 a = _mm256_fmadd_ps(fz, _mm256_sub_ps(p1, p0), p0);
+        const __m256 b = _mm256_fmadd_ps(fz, _mm256_sub_ps(p3, p2), p2);
+        return _mm256_fmadd_ps(r.fr, _mm256_sub_ps(b, a), a);
+    }
+
+  private:
+    const float* values_;
+    __m256 invR_, invZ_, zMin_, nr_, nz_;
+    __m256i stride_;
+};
+
+}  // namespace footprint
+#endif

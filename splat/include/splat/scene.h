@@ -1,0 +1,53 @@
+#pragma once
+// splat::Scene: the view-independent state of a volume rendering, built once and rendered
+// from any number of views by any renderer (axis-aligned sheets, image-aligned sheets,
+// reference ray caster). It holds the resolved transfer function, the classified splat
+// list (only the voxels the transfer function keeps), the kernel and its footprint tables,
+// and, made when a renderer first needs them, the per-axis visiting orders of the
+// axis-aligned splatter, the slab-section table of the image-aligned one and the dense
+// field the reference ray caster reads. A Scene may be rendered from several threads at
+// once (each frame takes its own workspace).
+#include <memory>
+
+#include "footprint/kernel.h"
+#include "splat/classify.h"
+#include "splat/image.h"
+#include "splat/settings.h"
+#include "splat/volume.h"
+
+namespace splat {
+
+class Scene {
+  public:
+    /// Classifies `volume` with settings.mode, .classification, .transfer, .kernel* and
+    /// .shading, on settings.threads threads. Throws splat::Error on impossible settings.
+    Scene(std::shared_ptr<const Volume> volume, const RenderSettings& settings);
+    /// Does not copy the volume: it must outlive the Scene.
+    Scene(const Volume& volume, const RenderSettings& settings);
+    ~Scene();
+    Scene(Scene&&) noexcept;
+    Scene& operator=(Scene&&) noexcept;
+
+    /// Renders one frame. `frame` chooses the renderer, camera, order, background,
+    /// threads and the per-frame Quality knobs (slab, early termination, reference step
+    /// and tolerance, tile size); its scene part (mode, classification, kernel, shading,
+    /// table resolutions) must equal the Scene's, or splat::Error is thrown.
+    Image render(const RenderSettings& frame, RenderStats* stats = nullptr) const;
+    /// The Scene's settings with another renderer and camera.
+    Image render(RendererKind renderer, const CameraParams& camera,
+                 RenderStats* stats = nullptr) const;
+
+    const Volume& volume() const;
+    /// The settings the Scene was built with, transfer function resolved to absolute values.
+    const RenderSettings& settings() const;
+    const SplatList& splats() const;
+    const footprint::Kernel& kernel() const;
+
+    struct Impl;  ///< the frame stages' view of the Scene (splat/src)
+    const Impl& impl() const { return *impl_; }
+
+  private:
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace splat

@@ -1,0 +1,99 @@
+#pragma once
+// The vocabulary of a render: what to draw (mode, classification, transfer function,
+// kernel, shading), how (renderer, compositing order, camera) and the Quality knobs that
+// trade speed for accuracy. Every such knob lives in Quality, so that a speed/accuracy
+// study can move any of them; defaults are the figures the README's tables are made with.
+#include <glm/glm.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "splat/camera.h"
+#include "splat/transfer.h"
+
+namespace splat {
+
+enum class RendererKind { Axis, Sheet, Reference };
+enum class RenderMode { Dvr, Mip, Xray, Iso };
+enum class Classification { Pre, Post };
+enum class CompositeOrder { FrontToBack, BackToFront };
+
+/// Headlight Blinn-Phong style shading of pre-classified emission (DESIGN: modelled only
+/// when asked for): e' = e (ambient + diffuse |n.l|) + specular |n.l|^shininess rho, with
+/// the light at the eye (l = -view), two-sided. The reference's iso surfaces use the same
+/// ambient and diffuse terms.
+struct Shading {
+    bool enabled = false;
+    float ambient = 0.35f, diffuse = 0.65f, specular = 0.25f, shininess = 24.0f;
+};
+
+/// Every knob that trades speed for accuracy.
+struct Quality {
+    /// Image-aligned slab thickness, voxels (one voxel = the smallest spacing).
+    double slab = 1.0;
+    /// Front-to-back early termination when opacity >= 1 - epsilon (0 disables).
+    double earlyTermination = 1.0 / 256.0;
+    /// Footprint table entries over r^2 in [0, R^2] (footprint::FootprintTable).
+    int footprintResolution = 4096;
+    /// Slab-section table: intervals in r^2 and in depth (footprint::SlabTable).
+    int slabRadialResolution = 128, slabDepthResolution = 1024;
+    /// The vectorised loops evaluate the footprint as a piecewise polynomial when it
+    /// matches the table to this fraction of the peak; 0 always reads the table.
+    double polynomialTolerance = 1e-6;
+    /// Reference ray caster: first-pass step in voxels, and the per-pixel change at which
+    /// step halving stops.
+    double referenceStep = 0.25, referenceTolerance = 1e-4;
+    /// Screen tile edge, pixels (8..64): each tile owns its sheets and compositing.
+    int tileSize = 32;
+};
+
+struct RenderSettings {
+    RendererKind renderer = RendererKind::Axis;
+    RenderMode mode = RenderMode::Dvr;
+    CompositeOrder order = CompositeOrder::FrontToBack;
+    Classification classification = Classification::Pre;
+    TransferFunction transfer = TransferFunction::preset("gray-ramp");
+    CameraParams camera;
+    std::string kernel = "gaussian";           ///< footprint::Kernel::fromName
+    double kernelSigma = 0, kernelRadius = 0;  ///< 0: the kernel's defaults
+    glm::vec4 background{0.0f};                ///< premultiplied RGBA behind the volume
+    double isoLevel = 0.5;                     ///< iso mode: level of f (absolute density)
+    Shading shading;                           ///< pre-classified dvr
+    int threads = 0;                           ///< every stage of a frame; 0: all cores
+    Quality quality;
+};
+
+/// Counters of one frame.
+struct RenderStats {
+    double milliseconds = 0;
+    std::size_t splats = 0;           ///< splats in the list
+    std::size_t voxels = 0;           ///< voxels considered by classification
+    std::size_t footprintPixels = 0;  ///< footprint-pixel updates
+    std::size_t sheets = 0;           ///< sheets composited (summed over tiles)
+    std::size_t culledSplats = 0;     ///< splats skipped by occlusion culling
+    double referenceStep = 0;         ///< reference: final step (voxels)
+    /// Axis-aligned splatter: the volume axis (0 = i, 1 = j, 2 = k) its sheets were
+    /// perpendicular to, and the sign of the ray direction along it (+1: sheets visited
+    /// in increasing index order front to back). -1 and 0 for the other renderers.
+    int sheetAxis = -1, sheetSign = 0;
+    /// Image-aligned splatter: slabs of the frame's slab grid.
+    std::size_t slabs = 0;
+    /// Stage times, ms: shade, project, order (visiting keys), bin, tiles (cut kernels into
+    /// sheets and composite), resolve (background).
+    double shadeMs = 0, projectMs = 0, orderMs = 0, binMs = 0, tilesMs = 0;
+};
+
+/// The one enum <-> string table: names as used by the command line and scene files.
+const char* toString(RendererKind);
+const char* toString(RenderMode);
+const char* toString(Classification);
+const char* toString(CompositeOrder);
+const char* toString(Projection);
+/// Parse a name; throw splat::Error listing the accepted names otherwise.
+RendererKind parseRenderer(std::string_view);
+RenderMode parseMode(std::string_view);
+Classification parseClassification(std::string_view);
+CompositeOrder parseOrder(std::string_view);
+Projection parseProjection(std::string_view);
+
+}  // namespace splat

@@ -1,0 +1,14 @@
+#pragma once
+// One frame of a Scene (frame/renderer.cpp).
+#include "model/scene_impl.h"
+
+namespace splat {
+
+/// Throws splat::Error for settings no renderer can honour.
+void validateFrame(const RenderSettings& settings);
+
+/// Renders `settings.renderer`'s frame of `scene`; every stage runs on at most
+/// settings.threads threads.
+Image renderFrame(const Scene::Impl& scene, const RenderSettings& settings, RenderStats* stats);
+
+}  // namespace splat

@@ -1,0 +1,205 @@
+// splat::Scene (the view-independent state, built once), splat::Renderer and render().
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "frame/frame.h"
+#include "model/scene_impl.h"
+#include "reference/field.h"
+#include "reference/reference_frame.h"
+#include "splat/error.h"
+#include "splat/render.h"
+
+namespace splat {
+
+namespace {
+
+footprint::Kernel makeKernel(const RenderSettings& s) {
+    try {
+        return footprint::Kernel::fromName(s.kernel, s.kernelSigma, s.kernelRadius);
+    } catch (const std::invalid_argument& e) {
+        throw Error(e.what());
+    }
+}
+
+footprint::FootprintTable makeTable(const footprint::Kernel& kernel, const Quality& q) {
+    try {
+        return footprint::FootprintTable(kernel, q.footprintResolution);
+    } catch (const std::invalid_argument& e) {
+        throw Error(std::string("footprint table: ") + e.what());
+    }
+}
+
+void validateScene(const Volume& v, const RenderSettings& s) {
+    if (v.voxelCount() == 0 || v.data.size() != v.voxelCount())
+        throw Error("volume is empty or its sample count does not match its dimensions");
+    validateFrame(s);
+    if (!(s.quality.polynomialTolerance >= 0)) throw Error("polynomial tolerance must be >= 0");
+}
+
+/// The settings that belong to a Scene (classification and tables), which a frame may not
+/// change.
+bool sameScenePart(const RenderSettings& a, const RenderSettings& b) {
+    return a.mode == b.mode && a.classification == b.classification && a.kernel == b.kernel &&
+           a.kernelSigma == b.kernelSigma && a.kernelRadius == b.kernelRadius &&
+           a.shading.enabled == b.shading.enabled &&
+           a.quality.footprintResolution == b.quality.footprintResolution &&
+           a.quality.slabRadialResolution == b.quality.slabRadialResolution &&
+           a.quality.slabDepthResolution == b.quality.slabDepthResolution &&
+           a.quality.polynomialTolerance == b.quality.polynomialTolerance;
+}
+
+}  // namespace
+
+void runOnThreads(int threads, const std::function<void()>& f) {
+    if (threads > 0) {
+        tbb::task_arena arena(threads);
+        arena.execute(f);
+    } else {
+        f();
+    }
+}
+
+void orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys,
+                const std::vector<std::uint32_t>* base, std::vector<std::uint32_t>& order) {
+    std::vector<std::uint32_t> start(std::size_t(keys) + 1, 0);
+    for (std::uint32_t k : key) ++start[std::size_t(k) + 1];
+    for (std::size_t k = 0; k < keys; ++k) start[k + 1] += start[k];
+    const std::size_t n = key.size();
+    order.resize(n);
+    for (std::size_t q = 0; q < n; ++q) {
+        const std::uint32_t s = base ? (*base)[q] : std::uint32_t(q);
+        order[start[key[s]]++] = s;
+    }
+}
+
+Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
+    : volume(std::move(v)),
+      settings(s),
+      kernel(makeKernel(s)),
+      table(makeTable(kernel, s.quality)) {
+    const VolumeStats st = volumeStats(*volume, 1);
+    settings.transfer = s.transfer.resolved(st.minValue, st.maxValue);
+    splats =
+        classify(*volume, settings.transfer, s.mode, s.classification, kernel.radius(), shaded());
+    transfer = TransferTable(settings.transfer);
+    if (s.quality.polynomialTolerance > 0) {
+        poly.emplace(table);
+        if (poly->maxError() > s.quality.polynomialTolerance) poly.reset();
+    }
+}
+
+const std::vector<std::uint32_t>& Scene::Impl::sliceOrder(int axis) const {
+    std::lock_guard<std::mutex> lock(lazyMutex_);
+    if (!sliceOrder_[axis]) {
+        const std::vector<std::uint16_t>& index =
+            axis == 0 ? splats.i : (axis == 1 ? splats.j : splats.k);
+        auto order = std::make_unique<std::vector<std::uint32_t>>();
+        if (axis == 2) {  // the list is in (k, j, i) order already
+            order->resize(index.size());
+            for (std::size_t n = 0; n < index.size(); ++n) (*order)[n] = std::uint32_t(n);
+        } else {
+            orderByKey(std::vector<std::uint32_t>(index.begin(), index.end()),
+                       std::uint32_t(volume->dims[axis]), nullptr, *order);
+        }
+        sliceOrder_[axis] = std::move(order);
+    }
+    return *sliceOrder_[axis];
+}
+
+const footprint::SlabTable& Scene::Impl::slabTable() const {
+    std::lock_guard<std::mutex> lock(lazyMutex_);
+    if (!slabTable_) {
+        try {
+            slabTable_ = std::make_unique<footprint::SlabTable>(
+                kernel, settings.quality.slabRadialResolution,
+                settings.quality.slabDepthResolution);
+        } catch (const std::invalid_argument& e) {
+            throw Error(std::string("slab table: ") + e.what());
+        }
+    }
+    return *slabTable_;
+}
+
+const ReferenceField& Scene::Impl::referenceField() const {
+    std::lock_guard<std::mutex> lock(lazyMutex_);
+    if (!field_) {
+        validateReferenceKernel(kernel);
+        field_ =
+            std::make_shared<ReferenceField>(*volume, splats, kernel, isPreClassifiedDvr(settings));
+    }
+    return *field_;
+}
+
+std::unique_ptr<FrameWorkspace> Scene::Impl::acquireWorkspace() const {
+    std::lock_guard<std::mutex> lock(poolMutex_);
+    if (pool_.empty()) return std::make_unique<FrameWorkspace>();
+    std::unique_ptr<FrameWorkspace> w = std::move(pool_.back());
+    pool_.pop_back();
+    return w;
+}
+
+void Scene::Impl::releaseWorkspace(std::unique_ptr<FrameWorkspace> w) const {
+    std::lock_guard<std::mutex> lock(poolMutex_);
+    pool_.push_back(std::move(w));
+}
+
+Scene::Scene(std::shared_ptr<const Volume> volume, const RenderSettings& settings) {
+    if (!volume) throw Error("scene: no volume");
+    validateScene(*volume, settings);
+    runOnThreads(settings.threads,
+                 [&] { impl_ = std::make_unique<Impl>(std::move(volume), settings); });
+}
+
+Scene::Scene(const Volume& volume, const RenderSettings& settings)
+    : Scene(std::shared_ptr<const Volume>(&volume, [](const Volume*) {}), settings) {}
+
+Scene::~Scene() = default;
+Scene::Scene(Scene&&) noexcept = default;
+Scene& Scene::operator=(Scene&&) noexcept = default;
+
+const Volume& Scene::volume() const { return *impl_->volume; }
+const RenderSettings& Scene::settings() const { return impl_->settings; }
+const SplatList& Scene::splats() const { return impl_->splats; }
+const footprint::Kernel& Scene::kernel() const { return impl_->kernel; }
+
+Image Scene::render(const RenderSettings& frame, RenderStats* stats) const {
+    if (!sameScenePart(frame, impl_->settings))
+        throw Error(
+            "scene: a frame cannot change the mode, classification, kernel, shading or table "
+            "resolutions; build a new Scene for those");
+    RenderSettings s = frame;
+    s.transfer = impl_->settings.transfer;
+    s.shading = impl_->settings.shading;
+    return renderFrame(*impl_, s, stats);
+}
+
+Image Scene::render(RendererKind renderer, const CameraParams& camera, RenderStats* stats) const {
+    RenderSettings s = impl_->settings;
+    s.renderer = renderer;
+    s.camera = camera;
+    return renderFrame(*impl_, s, stats);
+}
+
+Renderer::Renderer(const Volume& volume, const RenderSettings& settings)
+    : scene_(volume, settings), settings_(scene_.settings()) {
+    settings_.renderer = settings.renderer;
+}
+
+Renderer::Renderer(std::shared_ptr<const Volume> volume, const RenderSettings& settings)
+    : scene_(std::move(volume), settings), settings_(scene_.settings()) {
+    settings_.renderer = settings.renderer;
+}
+
+Image Renderer::render(RenderStats* stats) const { return scene_.render(settings_, stats); }
+
+Image Renderer::render(const CameraParams& camera, RenderStats* stats) const {
+    RenderSettings s = settings_;
+    s.camera = camera;
+    return scene_.render(s, stats);
+}
+
+Image render(const Volume& volume, const RenderSettings& settings, RenderStats* stats) {
+    return Renderer(volume, settings).render(stats);
+}
+
+}  // namespace splat

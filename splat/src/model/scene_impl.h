@@ -1,0 +1,92 @@
+#pragma once
+// What the frame stages see of a Scene (splat/scene.h): the view-independent state, the
+// parts made lazily when a renderer first needs them, and a pool of per-frame workspaces.
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include "footprint/footprint_poly.h"
+#include "footprint/footprint_table.h"
+#include "footprint/kernel.h"
+#include "footprint/slab_table.h"
+#include "frame/projection.h"
+#include "frame/tile_binning.h"
+#include "frame/transfer_table.h"
+#include "splat/scene.h"
+
+namespace splat {
+
+class ReferenceField;
+
+/// Per-frame arrays, reused by the frames of a sequence so that they do not allocate (and
+/// fault in) fresh memory every frame. One frame uses one workspace at a time.
+struct FrameWorkspace {
+    ProjectedSplats proj;
+    TileBins bins;
+    std::vector<std::uint32_t> order;             ///< visiting order of the splats
+    std::vector<std::uint32_t> key, first, last;  ///< per splat, splatter-specific
+    std::vector<float> r, g, b;                   ///< shaded emission of this view
+};
+
+struct Scene::Impl {
+    std::shared_ptr<const Volume> volume;
+    RenderSettings settings;  ///< transfer function resolved
+    footprint::Kernel kernel;
+    SplatList splats;  ///< (k, j, i) order
+    TransferTable transfer;
+    footprint::FootprintTable table;
+    std::optional<footprint::FootprintPoly> poly;  ///< when within polynomialTolerance
+
+    Impl(std::shared_ptr<const Volume> v, const RenderSettings& s);
+
+    /// Shading is modelled only where it applies: pre-classified dvr.
+    bool shaded() const {
+        return settings.shading.enabled && settings.mode == RenderMode::Dvr &&
+               settings.classification == Classification::Pre;
+    }
+    /// Splat indices ordered (stably) by slice index along `axis`, made on first use.
+    const std::vector<std::uint32_t>& sliceOrder(int axis) const;
+    /// The slab-section table of the image-aligned splatter, made on first use.
+    const footprint::SlabTable& slabTable() const;
+    /// The dense field of the reference ray caster (unshaded scenes), made on first use.
+    const ReferenceField& referenceField() const;
+
+    std::unique_ptr<FrameWorkspace> acquireWorkspace() const;
+    void releaseWorkspace(std::unique_ptr<FrameWorkspace> w) const;
+
+  private:
+    mutable std::mutex lazyMutex_, poolMutex_;
+    mutable std::unique_ptr<std::vector<std::uint32_t>> sliceOrder_[3];
+    mutable std::unique_ptr<footprint::SlabTable> slabTable_;
+    mutable std::shared_ptr<const ReferenceField> field_;
+    mutable std::vector<std::unique_ptr<FrameWorkspace>> pool_;
+};
+
+/// A workspace taken from a Scene's pool for the duration of one frame.
+class WorkspaceLease {
+  public:
+    explicit WorkspaceLease(const Scene::Impl& scene)
+        : scene_(scene), work_(scene.acquireWorkspace()) {}
+    ~WorkspaceLease() { scene_.releaseWorkspace(std::move(work_)); }
+    WorkspaceLease(const WorkspaceLease&) = delete;
+    WorkspaceLease& operator=(const WorkspaceLease&) = delete;
+    FrameWorkspace& operator*() const { return *work_; }
+    FrameWorkspace* operator->() const { return work_.get(); }
+
+  private:
+    const Scene::Impl& scene_;
+    std::unique_ptr<FrameWorkspace> work_;
+};
+
+/// Stable counting sort: the elements of `base` (or 0 .. key.size() - 1 when `base` is
+/// null) ordered by key[element], keys in [0, keys).
+void orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys,
+                const std::vector<std::uint32_t>* base, std::vector<std::uint32_t>& order);
+
+/// Runs `f` on at most `threads` threads (0: all cores): every parallel stage inside
+/// runs in that arena.
+void runOnThreads(int threads, const std::function<void()>& f);
+
+}  // namespace splat

@@ -1,0 +1,63 @@
+// The one enum <-> string table (see splat/settings.h).
+#include "splat/settings.h"
+
+#include <array>
+#include <utility>
+
+#include "splat/error.h"
+
+namespace splat {
+
+namespace {
+
+template <class E, std::size_t N>
+using Names = std::array<std::pair<E, const char*>, N>;
+
+constexpr Names<RendererKind, 3> kRenderers{{{RendererKind::Axis, "axis"},
+                                             {RendererKind::Sheet, "sheet"},
+                                             {RendererKind::Reference, "reference"}}};
+constexpr Names<RenderMode, 4> kModes{{{RenderMode::Dvr, "dvr"},
+                                       {RenderMode::Mip, "mip"},
+                                       {RenderMode::Xray, "xray"},
+                                       {RenderMode::Iso, "iso"}}};
+constexpr Names<Classification, 2> kClassifications{
+    {{Classification::Pre, "pre"}, {Classification::Post, "post"}}};
+constexpr Names<CompositeOrder, 2> kOrders{
+    {{CompositeOrder::FrontToBack, "ftb"}, {CompositeOrder::BackToFront, "btf"}}};
+constexpr Names<Projection, 2> kProjections{
+    {{Projection::Orthographic, "ortho"}, {Projection::Perspective, "perspective"}}};
+
+template <class E, std::size_t N>
+const char* nameOf(const Names<E, N>& names, E value) {
+    for (const auto& [e, name] : names)
+        if (e == value) return name;
+    return "?";
+}
+
+template <class E, std::size_t N>
+E parseName(const Names<E, N>& names, std::string_view text, const char* what) {
+    std::string accepted;
+    for (const auto& [e, name] : names) {
+        if (text == name) return e;
+        accepted += accepted.empty() ? "" : ", ";
+        accepted += name;
+    }
+    throw Error("unknown " + std::string(what) + " '" + std::string(text) + "' (" + accepted + ")");
+}
+
+}  // namespace
+
+const char* toString(RendererKind v) { return nameOf(kRenderers, v); }
+const char* toString(RenderMode v) { return nameOf(kModes, v); }
+const char* toString(Classification v) { return nameOf(kClassifications, v); }
+const char* toString(CompositeOrder v) { return nameOf(kOrders, v); }
+const char* toString(Projection v) { return nameOf(kProjections, v); }
+RendererKind parseRenderer(std::string_view s) { return parseName(kRenderers, s, "renderer"); }
+RenderMode parseMode(std::string_view s) { return parseName(kModes, s, "mode"); }
+Classification parseClassification(std::string_view s) {
+    return parseName(kClassifications, s, "classification");
+}
+CompositeOrder parseOrder(std::string_view s) { return parseName(kOrders, s, "order"); }
+Projection parseProjection(std::string_view s) { return parseName(kProjections, s, "projection"); }
+
+}  // namespace splat

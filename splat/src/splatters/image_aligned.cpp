@@ -1,0 +1,204 @@
+// The image-aligned sheet-buffer splatter (K. Mueller and R. Crawfis, "Eliminating popping
+// artifacts in sheet buffer-based splatting", IEEE Visualization 1998): sheets are slabs
+// of thickness T parallel to the image plane; every kernel adds to each slab it crosses the
+// section of its footprint between the slab's two depths, C(r, z1) - C(r, z0) from the
+// cumulative slab table (footprint/slab_table.h). The sheets never change orientation, so
+// there is no popping; the cost grows as T shrinks.
+//
+// Splats are visited through depth buckets: sorted by the first slab they touch (last
+// slab for back-to-front). The tile sweep keeps a ring of sheets as deep as a kernel is
+// thick: when it reaches a splat, the splat's sections are added to every slab it crosses
+// at once (sharing r^2, the footprint and the section boundaries between them).
+#include <cmath>
+#include <string>
+
+#include "footprint/lanes.h"
+#include "splat/error.h"
+#include "splatters/splatter.h"
+
+namespace splat {
+
+namespace {
+
+/// Most slabs a frame may have: beyond this, the depth range is absurd for the slab
+/// thickness (e.g. an extreme spacing ratio), and the buckets would not fit in memory.
+constexpr double kMaxSlabs = double(1 << 24);
+
+/// The sections of one kernel in n consecutive slabs at once, slab j between the depths
+/// tb[j] and tb[j + 1] (world units along the ray, relative to the splat centre), each added
+/// to sheets[j]. Sharing r^2, fp(r^2) and the fraction F(r^2, z) at every inner slab
+/// boundary between the slabs halves the work of splatting slab by slab.
+template <int NCh>
+int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
+                  float sy, const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                  const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
+                  const float* tb) {
+#if defined(FOOTPRINT_HAVE_LANES)
+    const footprint::FootprintTable& fpTable = table.footprint();
+    const int ox = sheets[0]->originX(), oy = sheets[0]->originY();
+    const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
+    for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
+    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), zero = _mm256_setzero_ps();
+    const __m256 signBit = _mm256_set1_ps(-0.0f);
+    const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
+    const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
+    const footprint::FootprintLanes footprintOf(fpTable, poly);
+    const footprint::FractionLanes fraction(table);
+    const __m256 vds = _mm256_set1_ps(e.depthScale), vtx = _mm256_set1_ps(e.tx);
+    __m256 vv[NCh];
+    for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+    for (int y = y0; y <= y1; ++y) {
+        const float dy = float(y + oy) + 0.5f - sy;
+        const __m256 vgyy = _mm256_set1_ps(e.gamma * dy * dy), vshift = _mm256_set1_ps(e.beta * dy);
+        const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
+        const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
+        for (int x = x0; x <= x1; x += 8) {
+            const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
+            const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
+            const __m256 q = _mm256_add_ps(dx, vshift);
+            const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), zero);
+            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
+                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
+            const __m256 weight = _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vScale));
+            const footprint::FractionLanes::Radial radial = fraction.radial(r2);
+            const __m256 tc = _mm256_fmadd_ps(vtx, dx, vtyy);
+            // Kernel-space depth of boundary b along these rays: z = depthScale (t - tc).
+            auto depth = [&](int b) {
+                return _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc));
+            };
+            __m256 below = fraction(radial, depth(0));
+            for (int j = 0; j < n; ++j) {
+                const __m256 above = fraction(radial, depth(j + 1));
+                // |F(above) - F(below)|: the boundaries run back to front when compositing is.
+                const __m256 w =
+                    _mm256_mul_ps(weight, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
+                below = above;
+                for (int c = 0; c < NCh; ++c) {
+                    float* p = sheets[j]->row(c, y) + x;
+                    _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
+                }
+            }
+        }
+    }
+    return n * (x1 - x0 + 1) * (y1 - y0 + 1);
+#else
+    (void)poly;
+    int visited = 0;
+    const float ds = e.depthScale, tx = e.tx, ty = e.ty, scale = e.scale;
+    for (int j = 0; j < n; ++j) {
+        const float t0 = std::min(tb[j], tb[j + 1]), t1 = std::max(tb[j], tb[j + 1]);
+        visited += sheets[j]->splat(values, sx, sy, e, rect, [&](float r2, float dx, float dy) {
+            const float tc = tx * dx + ty * dy;
+            return table.section(r2, ds * (t0 - tc), ds * (t1 - tc)) * scale;
+        });
+    }
+    return visited;
+#endif
+}
+
+/// Each splat is cut into the slabs first..last it crosses.
+struct SlabSections {
+    const TileInputs& in;
+    const std::vector<std::uint32_t>&keys, &first, &last;
+    const footprint::SlabTable& table;
+    bool ftb;
+
+    std::uint32_t key(std::uint32_t id) const { return keys[id]; }
+    std::uint32_t span(std::uint32_t id) const { return last[id] - first[id] + 1; }
+    template <int NCh>
+    int cut(SheetBuffer<NCh>* const* sheets, std::uint32_t id, const float (&v)[NCh], float sx,
+            float sy, const footprint::EllipticalFootprint& e, const PixelRect& r) const {
+        // Slab boundaries in visiting order, as depths along this splat's rays relative to
+        // its centre: t = (plane depth - centre) / cos.
+        const ProjectedSplats& proj = in.proj;
+        const int n = int(span(id));
+        float tb[kMaxSpan + 1];
+        const float perRay = proj.perspective ? proj.depthPerRay[id] : 1.0f;
+        for (int b = 0; b <= n; ++b) {
+            const std::uint32_t plane =
+                ftb ? first[id] + std::uint32_t(b) : last[id] + 1 - std::uint32_t(b);
+            tb[b] =
+                (in.plan.depthOrigin + float(plane) * in.plan.thickness - proj.depth[id]) * perRay;
+        }
+        return splatSections(sheets, n, v, sx, sy, e, r, table,
+                             in.scene.poly ? &*in.scene.poly : nullptr, tb);
+    }
+    /// Most slabs one kernel may span (the slab thickness is at least 1e-3 voxels).
+    static constexpr int kMaxSpan = 8192;
+};
+
+class ImageAligned final : public Splatter {
+  public:
+    SheetPlan order(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
+                    FrameWorkspace& work, RenderStats& stats) const override {
+        const ProjectedSplats& proj = work.proj;
+        const std::size_t count = proj.depth.size();
+        const bool ftb = s.order == CompositeOrder::FrontToBack;
+        const float thickness = float(s.quality.slab * scene.volume->minSpacing());
+        const float ext = proj.depthExtent;
+        // The slab grid covers every kernel's depth range [depth - ext, depth + ext].
+        float zmin = 0.0f, zmax = 0.0f;
+        if (count > 0) {
+            zmin = zmax = proj.depth[0];
+            for (float d : proj.depth) {
+                zmin = std::min(zmin, d);
+                zmax = std::max(zmax, d);
+            }
+        }
+        zmin -= ext;
+        zmax += ext;
+        const double slabCount = double(std::floor((zmax - zmin) / thickness)) + 1;
+        const double span = double(std::ceil(2.0f * ext / thickness)) + 2;
+        if (!(slabCount <= kMaxSlabs) || !(span <= SlabSections::kMaxSpan))
+            throw Error("image-aligned splatter: the volume's depth range (" +
+                        std::to_string(zmax - zmin) + ") at slab thickness " +
+                        std::to_string(thickness) +
+                        " would need too many slabs; use a thicker --slab or check the spacing");
+        const std::uint32_t slabs = std::uint32_t(slabCount);
+        work.first.resize(count);
+        work.last.resize(count);
+        work.key.resize(count);
+        for (std::size_t n = 0; n < count; ++n) {
+            work.first[n] =
+                std::min(slabs - 1, std::uint32_t((proj.depth[n] - ext - zmin) / thickness));
+            work.last[n] =
+                std::min(slabs - 1, std::uint32_t((proj.depth[n] + ext - zmin) / thickness));
+            work.key[n] = ftb ? work.first[n] : slabs - 1 - work.last[n];
+        }
+        // Within a slab, splats are visited in slice order along the major axis, which keeps
+        // the accesses to the splat arrays coherent.
+        const int m = sheetAxis(camera.view, scene.volume->spacing).axis;
+        orderByKey(work.key, slabs, &scene.sliceOrder(m), work.order);
+        SheetPlan plan;
+        plan.sheets = slabs;
+        plan.ring = std::uint32_t(span);
+        plan.pathLength = thickness;
+        plan.normal = camera.view;
+        plan.depthOrigin = zmin;
+        plan.thickness = thickness;
+        stats.slabs = slabs;
+        return plan;
+    }
+
+    Image rasterize(const TileInputs& in, const FrameWorkspace& work,
+                    RenderStats* stats) const override {
+        const SlabSections cutter{in,
+                                  work.key,
+                                  work.first,
+                                  work.last,
+                                  in.scene.slabTable(),
+                                  in.settings.order == CompositeOrder::FrontToBack};
+        return withPolicy(
+            in.settings.mode, in.settings.classification, in.scene.transfer,
+            [&](const auto& policy) { return rasterizeTiles(in, policy, cutter, stats); });
+    }
+};
+
+}  // namespace
+
+const Splatter& imageAlignedSplatter() {
+    static const ImageAligned splatter;
+    return splatter;
+}
+
+}  // namespace splat

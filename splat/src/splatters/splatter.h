@@ -1,0 +1,37 @@
+#pragma once
+// The two splatters behind one small interface. They share every stage of the frame
+// (shade, project, bin, the tile sweep, compositing); each decides only
+//   order:     the visiting order of the splats and how the view's sheets lie, and
+//   rasterize: how one splat's kernel is cut into the sheets of one tile
+//              (its Cutter for the shared tile sweep, frame/tile_driver.h).
+// axis_aligned.cpp: Westover's sheets along the volume axis (whole footprints);
+// image_aligned.cpp: Mueller & Crawfis's slabs parallel to the image (slab sections).
+#include "frame/tile_driver.h"
+#include "model/scene_impl.h"
+
+namespace splat {
+
+class Splatter {
+  public:
+    virtual ~Splatter() = default;
+    /// Stage "order": writes the visiting order into work.order (and any per-splat keys
+    /// the splatter needs) and returns the view's sheet plan.
+    virtual SheetPlan order(const Scene::Impl& scene, const Camera& camera,
+                            const RenderSettings& settings, FrameWorkspace& work,
+                            RenderStats& stats) const = 0;
+    /// Stage "tiles": the tile sweep with this splatter's Cutter, into a partial image.
+    virtual Image rasterize(const TileInputs& in, const FrameWorkspace& work,
+                            RenderStats* stats) const = 0;
+};
+
+const Splatter& axisAlignedSplatter();
+const Splatter& imageAlignedSplatter();
+
+/// Index (0, 1, 2) of the volume axis most parallel to the ray direction in index space,
+/// S^-1 view (DESIGN: anisotropic spacing is honoured), and the sign of that component.
+struct SheetAxis {
+    int axis, sign;
+};
+SheetAxis sheetAxis(const glm::dvec3& view, const glm::dvec3& spacing);
+
+}  // namespace splat
