@@ -1,4 +1,4 @@
-// The `splat` command-line program: see README.md ("Command line") and DESIGN.md.
+// The `splat` command-line program: see README.md ("Command line") and splat/DESIGN.md.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>

@@ -1,5 +1,5 @@
 #pragma once
-// The rendering options shared by render, rotate and bench (DESIGN.md "Command line"),
+// The rendering options shared by render, rotate and bench (splat/DESIGN.md "Command line"),
 // including --scene FILE.json: the scene file is read first and every flag given on the
 // command line overrides it.
 #include <CLI/CLI.hpp>

@@ -34,7 +34,7 @@ struct Volume {
     glm::dvec3 world(const glm::dvec3& p) const { return origin + spacing * p; }
     /// World position of the volume centre, index (n - 1) / 2 on every axis.
     glm::dvec3 center() const { return world((glm::dvec3(dims) - 1.0) * 0.5); }
-    /// Smallest spacing: the world length of "one voxel" in DESIGN.md.
+    /// Smallest spacing: the world length of "one voxel" in splat/DESIGN.md.
     double minSpacing() const { return glm::min(spacing.x, glm::min(spacing.y, spacing.z)); }
     /// Memory held by the samples, in bytes.
     std::size_t bytes() const { return data.size() * sizeof(float); }

@@ -25,7 +25,7 @@ inline Sample sampleFromOpticalDepth(float tau, float er, float eg, float eb) {
     return {alpha, er * k, eg * k, eb * k};
 }
 
-/// Compositing state of one tile: premultiplied colour and opacity (b in DESIGN.md) for
+/// Compositing state of one tile: premultiplied colour and opacity (b in splat/DESIGN.md) for
 /// dvr; for mip the running maximum and for xray the running sum, both in r.
 class TileAccumulator {
   public:

@@ -2,7 +2,7 @@
 //
 // Files store samples along their own index axes; the affine x = t + M p says where
 // each index step goes in world space (NIfTI sform/qform in RAS+, NRRD space
-// directions). DESIGN.md's volume has world axes along index axes with positive
+// directions). splat/DESIGN.md's volume has world axes along index axes with positive
 // spacing, so we find the signed permutation closest to M (largest total |cosine|
 // between each file axis and the world axis it is assigned to), reorder and flip the
 // samples accordingly, and report whatever rotation is left.

@@ -1,4 +1,4 @@
-// Orthographic and perspective cameras following DESIGN.md's convention.
+// Orthographic and perspective cameras following splat/DESIGN.md's convention.
 #include "splat/camera.h"
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// The reference ray caster (DESIGN.md, "The model"): one ray per pixel through the
+// The reference ray caster (splat/DESIGN.md, "The model"): one ray per pixel through the
 // continuous fields f(x) = sum_i d_i h(|S^-1 (x - x_i)|) (and rho, e for pre-classification),
 // integrated with error control.
 //
