@@ -1,0 +1,217 @@
+// Stage-level tests of the frame pipeline (splat/src/frame, splatters, footprint lanes):
+// each fast stage against a slow reference implementation of the same step, and the
+// frame's threading contract.
+#include <tbb/info.h>
+#include <tbb/task_scheduler_observer.h>
+
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <random>
+
+#include "footprint/lanes.h"
+#include "frame/compositing.h"
+#include "frame/tile_binning.h"
+#include "model/scene_impl.h"
+#include "splat/error.h"
+#include "splat/render.h"
+#include "splat/scene.h"
+#include "splat/synthetic.h"
+#include "splatters/splatter.h"
+
+using namespace splat;
+
+TEST_CASE("binning: every tile lists exactly the splats whose rectangle touches it, in order",
+          "[stages]") {
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<int> pos(-20, 140), size(0, 40);
+    ProjectedSplats p;
+    const std::size_t n = 3000;
+    p.rect.resize(n);
+    for (auto& r : p.rect) {
+        const int x = pos(rng), y = pos(rng);
+        r = {std::max(x, 0), std::max(y, 0), std::min(x + size(rng), 99),
+             std::min(y + size(rng), 69)};
+    }
+    p.rect[5] = {1, 1, 0, 0};  // empty
+    std::vector<std::uint32_t> order(n);
+    for (std::size_t q = 0; q < n; ++q) order[q] = std::uint32_t((q * 7919) % n);
+    const TileGrid grid(100, 70, 16);
+    TileBins bins;
+    binToTiles(p, order, grid, bins);
+    REQUIRE(bins.begin.size() == std::size_t(grid.count()) + 1);
+    for (int t = 0; t < grid.count(); ++t) {
+        const int ox = (t % grid.tilesX) * 16, oy = (t / grid.tilesX) * 16;
+        std::vector<std::uint32_t> expected;
+        for (std::uint32_t id : order) {
+            const PixelRect& r = p.rect[id];
+            if (!r.empty() && r.x0 <= ox + 15 && r.x1 >= ox && r.y0 <= oy + 15 && r.y1 >= oy)
+                expected.push_back(id);
+        }
+        const std::vector<std::uint32_t> got(bins.splats.begin() + bins.begin[t],
+                                             bins.splats.begin() + bins.begin[t + 1]);
+        REQUIRE(got == expected);
+    }
+}
+
+TEST_CASE("compositing: over (back to front) equals under (front to back) on random samples",
+          "[stages]") {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const int pixels = 64, depth = 40;
+    std::vector<Sample> samples(std::size_t(pixels) * depth);
+    for (auto& s : samples) {
+        const float a = u(rng) * u(rng);
+        s = {a, a * u(rng), a * u(rng), a * u(rng)};  // premultiplied
+    }
+    TileAccumulator ftb(8, 8, CompositeOrder::FrontToBack, 0.0),
+        btf(8, 8, CompositeOrder::BackToFront, 0.0);
+    for (int d = 0; d < depth; ++d)
+        for (int p = 0; p < pixels; ++p) {
+            ftb.composite(p, samples[std::size_t(d) * pixels + p]);
+            btf.composite(p, samples[std::size_t(depth - 1 - d) * pixels + p]);
+        }
+    Image a(8, 8), b(8, 8);
+    ftb.resolve(a, 0, 0, RenderMode::Dvr);
+    btf.resolve(b, 0, 0, RenderMode::Dvr);
+    // The closed form: I = sum_d C_d prod_{e<d} (1 - a_e).
+    for (int p = 0; p < pixels; ++p) {
+        double t = 1, r = 0, alpha = 0;
+        for (int d = 0; d < depth; ++d) {
+            const Sample& s = samples[std::size_t(d) * pixels + p];
+            r += t * s.r;
+            alpha += t * s.alpha;
+            t *= 1 - s.alpha;
+        }
+        REQUIRE(a.pixels[p].r == Approx(r).margin(1e-6));
+        REQUIRE(b.pixels[p].r == Approx(r).margin(1e-6));
+        REQUIRE(a.pixels[p].a == Approx(alpha).margin(1e-6));
+        REQUIRE(b.pixels[p].a == Approx(alpha).margin(1e-6));
+    }
+    // Background after resolve: I + (1 - a) bg.
+    Image c = a;
+    applyBackground(c, RenderMode::Dvr, glm::vec4(0.2f, 0.3f, 0.4f, 1.0f));
+    CHECK(c.pixels[0].g == Approx(a.pixels[0].g + (1 - a.pixels[0].a) * 0.3f).margin(1e-7));
+    CHECK(c.pixels[0].a == Approx(1.0f).margin(1e-6));
+}
+
+#if defined(FOOTPRINT_HAVE_LANES)
+TEST_CASE("footprint lanes equal the tables' scalar lookups", "[stages]") {
+    const footprint::Kernel kernel = footprint::Kernel::fromName("gaussian", 0, 0);
+    const footprint::FootprintTable table(kernel);
+    const footprint::FootprintPoly poly(table);
+    const footprint::SlabTable slabs(kernel);
+    const footprint::FootprintLanes fromTable(table, nullptr), fromPoly(table, &poly);
+    const footprint::FractionLanes fraction(slabs);
+    const float r2max = table.r2Max();
+    double worstTable = 0, worstPoly = 0, worstFraction = 0;
+    alignas(32) float r2[8], z[8], out[8];
+    for (int n = 0; n < 4096; n += 8) {
+        for (int l = 0; l < 8; ++l) {
+            r2[l] = r2max * float(n + l) / 4100.0f;
+            z[l] = -2.5f + 5.0f * float((n + l) * 37 % 4096) / 4096.0f;
+        }
+        const __m256 v = _mm256_load_ps(r2);
+        _mm256_store_ps(out, fromTable(v));
+        for (int l = 0; l < 8; ++l)
+            worstTable = std::max(worstTable, double(std::abs(out[l] - table.lookup(r2[l]))));
+        _mm256_store_ps(out, fromPoly(v));
+        for (int l = 0; l < 8; ++l)
+            worstPoly = std::max(worstPoly, double(std::abs(out[l] - table.lookup(r2[l]))));
+        _mm256_store_ps(out, fraction(fraction.radial(v), _mm256_load_ps(z)));
+        for (int l = 0; l < 8; ++l)
+            worstFraction =
+                std::max(worstFraction, double(std::abs(out[l] - slabs.fraction(r2[l], z[l]))));
+    }
+    const double peak = table.peak();
+    CHECK(worstTable <= 1e-7 * peak);   // the same interpolation, FMA rounding only
+    CHECK(worstPoly <= 1.5e-6 * peak);  // FootprintPoly's tolerance, 1e-6 of the peak
+    CHECK(worstFraction <= 1e-6);       // F in [0, 1], same bilinear interpolation
+}
+#endif
+
+namespace {
+// Counts worker threads that join the calling thread's implicit arena.
+class WorkerCounter : public tbb::task_scheduler_observer {
+  public:
+    WorkerCounter() { observe(true); }
+    ~WorkerCounter() override { observe(false); }
+    void on_scheduler_entry(bool isWorker) override {
+        if (isWorker) ++entries;
+    }
+    std::atomic<int> entries{0};
+};
+}  // namespace
+
+TEST_CASE("--threads 1 runs every stage of a frame (and classification) on one thread",
+          "[stages]") {
+    const Volume v = makeSynthetic("phantom", 48);
+    RenderSettings s;
+    s.transfer = TransferFunction::preset("ct-soft");
+    s.camera.width = s.camera.height = 96;
+    s.camera.azimuthDeg = 30;
+    s.shading.enabled = true;
+    for (RendererKind k : {RendererKind::Axis, RendererKind::Sheet, RendererKind::Reference}) {
+        s.renderer = k;
+        s.threads = 1;
+        WorkerCounter one;
+        const Image a = render(v, s);
+        CHECK(one.entries == 0);
+        if (tbb::info::default_concurrency() > 1) {
+            s.threads = 0;  // all cores: workers join the caller's arena (the check is alive)
+            WorkerCounter all;
+            const Image b = render(v, s);
+            CHECK(all.entries > 0);
+            REQUIRE(a.pixels == b.pixels);  // and the image does not depend on it
+        }
+    }
+}
+
+TEST_CASE("one Scene renders every renderer; frames report their sheet orientation", "[stages]") {
+    const Volume v = makeSynthetic("phantom", 48);
+    RenderSettings s;
+    s.transfer = TransferFunction::preset("ct-soft");
+    s.camera.width = s.camera.height = 64;
+    const Scene scene(v, s);
+    CameraParams cam = s.camera;
+    for (double az : {10.0, 44.0, 46.0, 100.0, 170.0, 260.0}) {
+        cam.azimuthDeg = az;
+        RenderStats st;
+        const Image axis = scene.render(RendererKind::Axis, cam, &st);
+        // Azimuth a looks along (-sin a, cos a, 0): the sheets follow the larger component.
+        const double sx = -std::sin(az * 3.14159265358979 / 180),
+                     sy = std::cos(az * 3.14159265358979 / 180);
+        const int axisExpected = std::abs(sx) >= std::abs(sy) ? 0 : 1;
+        CHECK(st.sheetAxis == axisExpected);
+        CHECK(st.sheetSign == ((axisExpected == 0 ? sx : sy) >= 0 ? 1 : -1));
+        const Image sheet = scene.render(RendererKind::Sheet, cam, &st);
+        CHECK(st.sheetAxis == -1);
+        CHECK(st.slabs > 0);
+        // The same frame through a fresh Renderer is the same image.
+        RenderSettings one = s;
+        one.camera = cam;
+        one.renderer = RendererKind::Axis;
+        REQUIRE(render(v, one).pixels == axis.pixels);
+        one.renderer = RendererKind::Sheet;
+        REQUIRE(render(v, one).pixels == sheet.pixels);
+    }
+    // A frame cannot change what the Scene classified.
+    RenderSettings post = s;
+    post.classification = Classification::Post;
+    CHECK_THROWS_AS(scene.render(post), Error);
+}
+
+TEST_CASE("anisotropic spacing: the sheet axis is the major axis of S^-1 view", "[stages]") {
+    // Spacing 1 x 1 x 4: looking down at 30 degrees elevation the world view is mostly
+    // horizontal, but in index space the z component is 4x smaller still.
+    CHECK(
+        sheetAxis(glm::dvec3(0.0, std::cos(0.5236), -std::sin(0.5236)), glm::dvec3(1, 1, 4)).axis ==
+        1);
+    // Spacing 4 x 1 x 1 at azimuth 60: world view mostly along -x, index space along y.
+    CHECK(
+        sheetAxis(glm::dvec3(-std::sin(1.0472), std::cos(1.0472), 0.0), glm::dvec3(4, 1, 1)).axis ==
+        1);
+    CHECK(
+        sheetAxis(glm::dvec3(-std::sin(1.0472), std::cos(1.0472), 0.0), glm::dvec3(1, 1, 1)).axis ==
+        0);
+    CHECK(sheetAxis(glm::dvec3(0, 0, -1), glm::dvec3(1, 1, 1)).sign == -1);
+}
