@@ -5,18 +5,42 @@
 //   FootprintLanes: fp(r^2) of FootprintTable::lookup, from the table (two gathers) or from
 //                   a FootprintPoly (permutes and fused multiply-adds, no gathers);
 //   FractionLanes:  F(r^2, z) of SlabTable::fraction, bilinear (four gathers).
-// Both reproduce the scalar lookups' clamping. Only compiled where the translation unit
-// targets AVX2 and FMA (FOOTPRINT_HAVE_LANES is then defined); elsewhere callers use the
-// scalar lookups, which are exact too. The tests compare both paths with the tables.
-#if defined(__AVX2__) && defined(__FMA__)
+// Both reproduce the scalar lookups' clamping. On x86-64 (FOOTPRINT_HAVE_LANES defined)
+// they are compiled for AVX2 + FMA whatever the translation unit targets: code between
+// FOOTPRINT_LANES_BEGIN and FOOTPRINT_LANES_END is, so a portable build carries the vector
+// loops and calls them only where footprint::cpuHasLanes() (checked at run time); native
+// builds (-march with AVX2) call them unconditionally. Elsewhere callers use the scalar
+// lookups, which are exact too. The tests compare both paths with the tables.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define FOOTPRINT_HAVE_LANES 1
 #include <immintrin.h>
+
+#if defined(__clang__)
+#define FOOTPRINT_LANES_BEGIN \
+    _Pragma("clang attribute push(__attribute__((target(\"avx2,fma\"))), apply_to = function)")
+#define FOOTPRINT_LANES_END _Pragma("clang attribute pop")
+#else
+#define FOOTPRINT_LANES_BEGIN _Pragma("GCC push_options") _Pragma("GCC target(\"avx2,fma\")")
+#define FOOTPRINT_LANES_END _Pragma("GCC pop_options")
+#endif
 
 #include "footprint/footprint_poly.h"
 #include "footprint/footprint_table.h"
 #include "footprint/slab_table.h"
 
 namespace footprint {
+
+/// True when this CPU runs the AVX2 + FMA lanes (always, in a build that targets them).
+inline bool cpuHasLanes() {
+#if defined(__AVX2__) && defined(__FMA__)
+    return true;
+#else
+    static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    return has;
+#endif
+}
+
+FOOTPRINT_LANES_BEGIN
 
 class FootprintLanes {
   public:
@@ -106,6 +130,8 @@ class FractionLanes {
     __m256 invR_, invZ_, zMin_, nr_, nz_;
     __m256i stride_;
 };
+
+FOOTPRINT_LANES_END
 
 }  // namespace footprint
 #endif

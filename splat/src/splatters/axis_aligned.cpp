@@ -24,11 +24,13 @@ namespace {
 
 /// Adds values * fp(r^2) * e.scale, the whole footprint, to the pixels of `rect`: eight
 /// pixels at a time where AVX2 is available (fp from the polynomial when given).
-template <int NCh>
-int splatFootprint(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx, float sy,
-                   const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                   const footprint::FootprintTable& table, const footprint::FootprintPoly* poly) {
 #if defined(FOOTPRINT_HAVE_LANES)
+FOOTPRINT_LANES_BEGIN
+template <int NCh>
+int splatFootprintLanes(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx, float sy,
+                        const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                        const footprint::FootprintTable& table,
+                        const footprint::FootprintPoly* poly) {
     const int ox = sheet.originX(), oy = sheet.originY();
     const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
     sheet.markDirty(x0, x1, y0, y1);
@@ -63,13 +65,29 @@ int splatFootprint(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx
         }
     }
     return (x1 - x0 + 1) * (y1 - y0 + 1);
-#else
+}
+FOOTPRINT_LANES_END
+#endif
+
+template <int NCh>
+int splatFootprintScalar(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx, float sy,
+                         const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                         const footprint::FootprintTable& table, const footprint::FootprintPoly*) {
     // Without AVX2 the table's own lookup is as fast as the polynomial and exact.
-    (void)poly;
     const float scale = e.scale;
     return sheet.splat(values, sx, sy, e, rect,
                        [&](float r2, float, float) { return table.lookup(r2) * scale; });
+}
+
+template <int NCh>
+int splatFootprint(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx, float sy,
+                   const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                   const footprint::FootprintTable& table, const footprint::FootprintPoly* poly) {
+#if defined(FOOTPRINT_HAVE_LANES)
+    if (footprint::cpuHasLanes())
+        return splatFootprintLanes(sheet, values, sx, sy, e, rect, table, poly);
 #endif
+    return splatFootprintScalar(sheet, values, sx, sy, e, rect, table, poly);
 }
 
 /// Each splat lies in the one sheet of its slice along the major axis.

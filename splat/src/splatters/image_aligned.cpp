@@ -28,12 +28,13 @@ constexpr double kMaxSlabs = double(1 << 24);
 /// tb[j] and tb[j + 1] (world units along the ray, relative to the splat centre), each added
 /// to sheets[j]. Sharing r^2, fp(r^2) and the fraction F(r^2, z) at every inner slab
 /// boundary between the slabs halves the work of splatting slab by slab.
-template <int NCh>
-int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
-                  float sy, const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                  const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
-                  const float* tb) {
 #if defined(FOOTPRINT_HAVE_LANES)
+FOOTPRINT_LANES_BEGIN
+template <int NCh>
+int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
+                       float sy, const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                       const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
+                       const float* tb) {
     const footprint::FootprintTable& fpTable = table.footprint();
     const int ox = sheets[0]->originX(), oy = sheets[0]->originY();
     const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
@@ -81,8 +82,15 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
         }
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
-#else
-    (void)poly;
+}
+FOOTPRINT_LANES_END
+#endif
+
+template <int NCh>
+int splatSectionsScalar(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh],
+                        float sx, float sy, const footprint::EllipticalFootprint& e,
+                        const PixelRect& rect, const footprint::SlabTable& table,
+                        const footprint::FootprintPoly*, const float* tb) {
     int visited = 0;
     const float ds = e.depthScale, tx = e.tx, ty = e.ty, scale = e.scale;
     for (int j = 0; j < n; ++j) {
@@ -93,7 +101,18 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
         });
     }
     return visited;
+}
+
+template <int NCh>
+int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
+                  float sy, const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                  const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
+                  const float* tb) {
+#if defined(FOOTPRINT_HAVE_LANES)
+    if (footprint::cpuHasLanes())
+        return splatSectionsLanes(sheets, n, values, sx, sy, e, rect, table, poly, tb);
 #endif
+    return splatSectionsScalar(sheets, n, values, sx, sy, e, rect, table, poly, tb);
 }
 
 /// Each splat is cut into the slabs first..last it crosses.
