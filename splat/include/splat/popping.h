@@ -1,0 +1,137 @@
+#pragma once
+// Popping-artifact analysis (splat/DESIGN.md, "Artifact analysis"). A sweep of views
+// theta_0 < theta_1 < ... is rendered by each renderer X from one Scene, and per interval
+// [theta_n, theta_n+1]:
+//   temporal change  T_X(n) = RMS(I_X(theta_n+1) - I_X(theta_n))
+//   error            e_X(n) = RMS(D_X(theta_n)),  D_X = I_X - I_ref   (reference in the set)
+//   error jump       J_X(n) = RMS(D_X(theta_n+1) - D_X(theta_n))
+//   cross jump       C(n)   = RMS(Delta(theta_n+1) - Delta(theta_n)), Delta = I_axis - I_sheet
+//                             (cheap detection without the reference)
+//   perceptual       FLIP1_X(n) = mean LDR-FLIP between consecutive frames, and mean
+//                             LDR-FLIP against the reference (Andersson et al. 2020)
+// RMS is over all pixels and the RGB channels of the images composited over the background.
+// An event is an interval whose detection signal (J_X with a reference, else C for the
+// axis-aligned splatter and T_X otherwise) exceeds the sweep's robust threshold
+// max(median + k * MAD, floor * median), MAD scaled to a standard deviation (x 1.4826).
+// Events are refined by bisection: a renderer pops at theta* when its change stays bounded
+// away from zero as the interval shrinks, while a continuous renderer's change falls about
+// linearly with it (fitted slope ~1 on log-log axes). Flicker is fast but continuous
+// change: the ratio of a renderer's median T to the reference's.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "splat/error.h"
+#include "splat/image.h"
+#include "splat/scene.h"
+#include "splat/settings.h"
+
+namespace splat {
+
+/// The views of a sweep: the base camera turned about one angle.
+struct Sweep {
+    enum class Angle { Azimuth, Elevation };
+    Angle angle = Angle::Azimuth;
+    double from = 40, to = 50, step = 0.5;  ///< degrees; `to` is the last view (inclusive)
+    CameraParams base;                      ///< the other camera parameters
+    /// The sweep's views: from, from + step, ..., to (the last within step / 1000 of to).
+    std::vector<double> angles() const;
+    CameraParams camera(double angle) const;
+};
+
+/// Progress of a long computation: `done` of `total` units, what is being done. Returning
+/// false cancels it cleanly (the call throws splat::Cancelled; nothing is left half-done).
+using ProgressFn =
+    std::function<bool(std::size_t done, std::size_t total, const std::string& what)>;
+
+/// Thrown when a ProgressFn returned false.
+class Cancelled : public Error {
+  public:
+    Cancelled() : Error("cancelled") {}
+};
+
+struct PoppingOptions {
+    std::vector<RendererKind> renderers{RendererKind::Axis, RendererKind::Sheet,
+                                        RendererKind::Reference};
+    double madK = 5.0;            ///< event threshold: median + madK * MAD ...
+    double floorRatio = 2.0;      ///< ... and at least floorRatio * median
+    int refine = 10;              ///< bisection levels around each event (0: none)
+    double pixelsPerDegree = 67;  ///< LDR-FLIP viewing condition
+    bool flip = true;             ///< compute the perceptual columns
+    int thumbnail = 160;          ///< longest side of the animation frames kept, pixels
+    ProgressFn progress;          ///< optional; called after every frame
+};
+
+/// A change measured at one interval width while refining an event.
+struct RefinementStep {
+    double width = 0;  ///< degrees
+    double from = 0;   ///< the refined interval [from, from + width]
+    /// Per renderer (PoppingResult::renderers order): T over the interval, and J when the
+    /// reference is in the set (else 0).
+    std::vector<double> change, jump;
+};
+
+/// Frames of the views on both sides of an event, per renderer (full resolution).
+struct EventFrames {
+    std::vector<Image> before, after;  ///< PoppingResult::renderers order
+};
+
+struct PoppingEvent {
+    RendererKind renderer = RendererKind::Axis;  ///< whose signal fired
+    double angleFrom = 0, angleTo = 0;           ///< the sweep interval
+    double signal = 0;                           ///< J (or C, or T) over it
+    /// Refinement: the change at the finest width, the finest width, and the slope of
+    /// log(change) against log(width) fitted over the refinement steps (~0: a
+    /// discontinuity; ~1: continuous change).
+    double refinedJump = 0, refinedWidth = 0, refinedSlope = 0, refinedAngle = 0;
+    std::vector<RefinementStep> refinement;
+    /// Axis-aligned splatter's sheet axis (0, 1, 2; -1 for others) and sign before and after.
+    int sheetAxisBefore = -1, sheetAxisAfter = -1, sheetSignBefore = 0, sheetSignAfter = 0;
+    bool predicted = false;  ///< a predicted sheet switch lies in [angleFrom, angleTo]
+    EventFrames frames;      ///< at angleFrom and angleTo
+};
+
+/// Everything measured for one renderer over the sweep.
+struct RendererSeries {
+    RendererKind renderer = RendererKind::Axis;
+    /// Per interval n (angles.size() - 1 entries).
+    std::vector<double> T, J, flipT;
+    /// Per view n (angles.size() entries): error against the reference and its mean FLIP.
+    std::vector<double> e, flipRef;
+    std::vector<int> sheetAxis, sheetSign;  ///< per view (axis-aligned; else -1, 0)
+    std::vector<double> signal;             ///< the detection signal per interval
+    double threshold = 0, medianSignal = 0, spikeRatio = 0;  ///< max signal / median
+    double medianT = 0, flickerRatio = 0;  ///< median T / reference's median T (0 without)
+    double msPerFrame = 0, totalMs = 0;    ///< median frame time, total render time
+    std::vector<Image> thumbnails;         ///< per view, for the side-by-side animation
+};
+
+struct PoppingResult {
+    Sweep sweep;
+    PoppingOptions options;   ///< as used (progress omitted)
+    RenderSettings settings;  ///< the scene's settings
+    std::vector<RendererKind> renderers;
+    std::vector<double> angles;
+    std::vector<RendererSeries> series;     ///< renderers order
+    std::vector<double> crossJump;          ///< C per interval (axis and sheet both present)
+    std::vector<double> predictedSwitches;  ///< angles where the sheet axis changes
+    std::vector<PoppingEvent> events;
+    double totalMs = 0;
+    const RendererSeries* find(RendererKind k) const;
+};
+
+/// Renders the sweep with every renderer of `options` from `scene`, measures, detects and
+/// refines events. Throws splat::Error on bad sweeps, splat::Cancelled when cancelled.
+PoppingResult analyzePopping(const Scene& scene, const Sweep& sweep, const PoppingOptions& options);
+
+/// The angles in (from, to) where the axis-aligned splatter's sheet axis (the major axis of
+/// S^-1 view) changes along the sweep, to 1e-9 degrees.
+std::vector<double> predictSheetSwitches(const Sweep& sweep, const Volume& volume);
+
+/// Writes `dir`/report.html (self-contained: inline SVG plots, embedded images and
+/// animation), metrics.csv (one row per renderer and interval) and summary.json (schema in
+/// the README), each atomically. `commandLine` is shown in the report (how to reproduce it).
+void writePoppingReport(const PoppingResult& result, const std::string& dir,
+                        const std::string& commandLine);
+
+}  // namespace splat
