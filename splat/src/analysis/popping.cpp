@@ -1,0 +1,358 @@
+// Popping-artifact analysis (see splat/popping.h and splat/DESIGN.md, "Artifact analysis").
+#include "splat/popping.h"
+
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "splatters/splatter.h"
+
+#if __has_include("splat/flip.h")
+#include "splat/flip.h"
+#define SPLAT_HAVE_FLIP 1
+#endif
+
+namespace splat {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+constexpr std::size_t kMaxViews = 100000;
+
+/// RMS over pixels and RGB of (a - b) - (c - d); c, d may be null (then of a - b).
+double rmsDiff(const Image& a, const Image& b, const Image* c = nullptr, const Image* d = nullptr) {
+    double sum = 0;
+    const std::size_t n = a.pixels.size();
+    for (std::size_t p = 0; p < n; ++p)
+        for (int ch = 0; ch < 3; ++ch) {
+            double v = double(a.pixels[p][ch]) - double(b.pixels[p][ch]);
+            if (c && d) v -= double(c->pixels[p][ch]) - double(d->pixels[p][ch]);
+            sum += v * v;
+        }
+    return n ? std::sqrt(sum / double(3 * n)) : 0.0;
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0;
+    const std::size_t m = v.size() / 2;
+    std::nth_element(v.begin(), v.begin() + m, v.end());
+    const double hi = v[m];
+    if (v.size() % 2) return hi;
+    return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + m));
+}
+
+/// median + k * MAD (scaled to a standard deviation), and at least floor * median.
+double robustThreshold(const std::vector<double>& s, double k, double floorRatio) {
+    const double med = median(s);
+    std::vector<double> dev(s.size());
+    for (std::size_t n = 0; n < s.size(); ++n) dev[n] = std::abs(s[n] - med);
+    const double mad = 1.4826 * median(dev);
+    return std::max(med + k * mad, floorRatio * med);
+}
+
+/// Downscaled copy (box filter) with the longest side at most `side` pixels.
+Image thumbnail(const Image& im, int side) {
+    const int longest = std::max(im.width, im.height);
+    const int f = std::max(1, (longest + side - 1) / std::max(side, 1));
+    if (f == 1) return im;
+    Image out(im.width / f, im.height / f);
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x) {
+            glm::vec4 sum(0.0f);
+            for (int v = 0; v < f; ++v)
+                for (int u = 0; u < f; ++u) sum += im.at(x * f + u, y * f + v);
+            out.at(x, y) = sum / float(f * f);
+        }
+    return out;
+}
+
+/// One view rendered by every renderer.
+struct View {
+    std::vector<Image> images;
+    std::vector<RenderStats> stats;
+};
+
+class Analyzer {
+  public:
+    Analyzer(const Scene& scene, const Sweep& sweep, const PoppingOptions& options)
+        : scene_(scene), sweep_(sweep), options_(options) {
+        kinds_ = options.renderers;
+        if (kinds_.empty()) throw Error("popping: no renderer to analyse");
+        for (std::size_t i = 0; i < kinds_.size(); ++i)
+            for (std::size_t j = 0; j < i; ++j)
+                if (kinds_[i] == kinds_[j])
+                    throw Error(std::string("popping: renderer '") + toString(kinds_[i]) +
+                                "' listed twice");
+        ref_ = indexOf(RendererKind::Reference);
+        axis_ = indexOf(RendererKind::Axis);
+        sheet_ = indexOf(RendererKind::Sheet);
+        if (!(options.madK >= 0) || !(options.floorRatio >= 0))
+            throw Error("popping: the event threshold's k and floor must be >= 0");
+        if (options.refine < 0 || options.refine > 40)
+            throw Error("popping: --refine must be between 0 and 40 levels");
+    }
+
+    PoppingResult run() {
+        const auto start = Clock::now();
+        PoppingResult r;
+        r.sweep = sweep_;
+        r.options = options_;
+        r.options.progress = nullptr;
+        r.settings = scene_.settings();
+        r.renderers = kinds_;
+        r.angles = sweep_.angles();
+        if (r.angles.size() < 3)
+            throw Error("popping: a sweep needs at least 3 views (from, to and step give " +
+                        std::to_string(r.angles.size()) + ")");
+        r.predictedSwitches = predictSheetSwitches(sweep_, scene_.volume());
+        const std::size_t views = r.angles.size();
+        totalUnits_ = views * kinds_.size();
+        r.series.resize(kinds_.size());
+        for (std::size_t k = 0; k < kinds_.size(); ++k) r.series[k].renderer = kinds_[k];
+
+        std::vector<std::vector<double>> frameMs(kinds_.size());
+        View prev;
+        for (std::size_t n = 0; n < views; ++n) {
+            const View cur = renderView(r.angles[n]);
+            for (std::size_t k = 0; k < kinds_.size(); ++k) {
+                RendererSeries& s = r.series[k];
+                frameMs[k].push_back(cur.stats[k].milliseconds);
+                s.totalMs += cur.stats[k].milliseconds;
+                s.sheetAxis.push_back(cur.stats[k].sheetAxis);
+                s.sheetSign.push_back(cur.stats[k].sheetSign);
+                s.thumbnails.push_back(thumbnail(cur.images[k], options_.thumbnail));
+                if (ref_ >= 0) {
+                    s.e.push_back(rmsDiff(cur.images[k], cur.images[ref_]));
+                    s.flipRef.push_back(flip(cur.images[k], cur.images[ref_]));
+                }
+                if (n > 0) {
+                    s.T.push_back(rmsDiff(cur.images[k], prev.images[k]));
+                    s.flipT.push_back(flip(cur.images[k], prev.images[k]));
+                    if (ref_ >= 0)
+                        s.J.push_back(rmsDiff(cur.images[k], cur.images[ref_], &prev.images[k],
+                                              &prev.images[ref_]));
+                }
+            }
+            if (n > 0 && axis_ >= 0 && sheet_ >= 0)
+                r.crossJump.push_back(rmsDiff(cur.images[axis_], cur.images[sheet_],
+                                              &prev.images[axis_], &prev.images[sheet_]));
+            prev = cur;
+        }
+        for (std::size_t k = 0; k < kinds_.size(); ++k) {
+            RendererSeries& s = r.series[k];
+            s.msPerFrame = median(frameMs[k]);
+            s.medianT = median(s.T);
+            s.signal = signalOf(r, k);
+            s.medianSignal = median(s.signal);
+            s.threshold = robustThreshold(s.signal, options_.madK, options_.floorRatio);
+            const double mx = *std::max_element(s.signal.begin(), s.signal.end());
+            s.spikeRatio = s.medianSignal > 0 ? mx / s.medianSignal : (mx > 0 ? INFINITY : 1.0);
+        }
+        if (ref_ >= 0)
+            for (RendererSeries& s : r.series)
+                s.flickerRatio =
+                    r.series[ref_].medianT > 0 ? s.medianT / r.series[ref_].medianT : 0;
+        for (std::size_t k = 0; k < kinds_.size(); ++k)
+            for (std::size_t n = 0; n < r.series[k].signal.size(); ++n)
+                if (r.series[k].signal[n] > r.series[k].threshold)
+                    r.events.push_back(event(r, k, n));
+        r.totalMs = msSince(start);
+        return r;
+    }
+
+  private:
+    int indexOf(RendererKind k) const {
+        for (std::size_t i = 0; i < kinds_.size(); ++i)
+            if (kinds_[i] == k) return int(i);
+        return -1;
+    }
+
+    /// The detection signal of renderer k per interval.
+    std::vector<double> signalOf(const PoppingResult& r, std::size_t k) const {
+        if (ref_ >= 0 && int(k) != ref_) return r.series[k].J;
+        if (ref_ < 0 && int(k) == axis_ && sheet_ >= 0) return r.crossJump;
+        return r.series[k].T;
+    }
+
+    /// The detection measure of renderer k between two views.
+    double measure(std::size_t k, const View& a, const View& b) const {
+        if (ref_ >= 0 && int(k) != ref_)
+            return rmsDiff(b.images[k], b.images[ref_], &a.images[k], &a.images[ref_]);
+        if (ref_ < 0 && int(k) == axis_ && sheet_ >= 0)
+            return rmsDiff(b.images[axis_], b.images[sheet_], &a.images[axis_], &a.images[sheet_]);
+        return rmsDiff(b.images[k], a.images[k]);
+    }
+
+    RefinementStep step(const View& a, const View& b, double from, double width) const {
+        RefinementStep st;
+        st.from = from;
+        st.width = width;
+        for (std::size_t k = 0; k < kinds_.size(); ++k) {
+            st.change.push_back(rmsDiff(b.images[k], a.images[k]));
+            st.jump.push_back(
+                ref_ >= 0 ? rmsDiff(b.images[k], b.images[ref_], &a.images[k], &a.images[ref_])
+                          : 0.0);
+        }
+        return st;
+    }
+
+    PoppingEvent event(const PoppingResult& r, std::size_t k, std::size_t n) {
+        PoppingEvent ev;
+        ev.renderer = kinds_[k];
+        ev.angleFrom = r.angles[n];
+        ev.angleTo = r.angles[n + 1];
+        ev.signal = r.series[k].signal[n];
+        if (axis_ >= 0) {
+            ev.sheetAxisBefore = r.series[axis_].sheetAxis[n];
+            ev.sheetAxisAfter = r.series[axis_].sheetAxis[n + 1];
+            ev.sheetSignBefore = r.series[axis_].sheetSign[n];
+            ev.sheetSignAfter = r.series[axis_].sheetSign[n + 1];
+        }
+        for (double s : r.predictedSwitches)
+            if (s >= ev.angleFrom && s <= ev.angleTo) ev.predicted = true;
+        // Proof of discontinuity: bisect towards the half where the measure is larger.
+        double a = ev.angleFrom, b = ev.angleTo;
+        View va = renderView(a), vb = renderView(b);
+        ev.frames.before = va.images;
+        ev.frames.after = vb.images;
+        ev.refinement.push_back(step(va, vb, a, b - a));
+        for (int level = 0; level < options_.refine; ++level) {
+            const double m = 0.5 * (a + b);
+            View vm = renderView(m);
+            if (measure(k, va, vm) >= measure(k, vm, vb)) {
+                b = m;
+                vb = std::move(vm);
+            } else {
+                a = m;
+                va = std::move(vm);
+            }
+            ev.refinement.push_back(step(va, vb, a, b - a));
+        }
+        const RefinementStep& last = ev.refinement.back();
+        ev.refinedJump = ref_ >= 0 && int(k) != ref_ ? last.jump[k] : measure(k, va, vb);
+        ev.refinedWidth = last.width;
+        ev.refinedAngle = 0.5 * (a + b);
+        // Least-squares slope of log(measure) against log(width).
+        double sx = 0, sy = 0, sxx = 0, sxy = 0;
+        int cnt = 0;
+        for (const RefinementStep& st : ev.refinement) {
+            const double v = ref_ >= 0 && int(k) != ref_ ? st.jump[k] : st.change[k];
+            if (!(v > 0)) continue;
+            const double x = std::log(st.width), y = std::log(v);
+            sx += x;
+            sy += y;
+            sxx += x * x;
+            sxy += x * y;
+            ++cnt;
+        }
+        if (cnt >= 2 && cnt * sxx - sx * sx > 0)
+            ev.refinedSlope = (cnt * sxy - sx * sy) / (cnt * sxx - sx * sx);
+        return ev;
+    }
+
+    /// Every renderer's frame of one view. Renderers run one after another, each frame on
+    /// all of the scene's threads (the image does not depend on the thread count).
+    View renderView(double angle) {
+        View v;
+        v.images.resize(kinds_.size());
+        v.stats.resize(kinds_.size());
+        RenderSettings s = scene_.settings();
+        s.camera = sweep_.camera(angle);
+        for (std::size_t k = 0; k < kinds_.size(); ++k) {
+            s.renderer = kinds_[k];
+            v.images[k] = scene_.render(s, &v.stats[k]);
+            ++done_;
+            if (options_.progress && !options_.progress(std::min(done_, totalUnits_), totalUnits_,
+                                                        std::string(toString(kinds_[k])) + " at " +
+                                                            std::to_string(angle)))
+                throw Cancelled();
+        }
+        return v;
+    }
+
+    /// Mean LDR-FLIP of two frames (display values: linear RGB in [0, 1]).
+    double flip(const Image& test, const Image& reference) const {
+#if defined(SPLAT_HAVE_FLIP)
+        if (!options_.flip) return 0;
+        FlipOptions fo;
+        fo.pixelsPerDegree = options_.pixelsPerDegree;
+        return flipMean(test, reference, fo);
+#else
+        (void)test;
+        (void)reference;
+        return 0;
+#endif
+    }
+
+    const Scene& scene_;
+    const Sweep& sweep_;
+    const PoppingOptions& options_;
+    std::vector<RendererKind> kinds_;
+    int ref_ = -1, axis_ = -1, sheet_ = -1;
+    std::size_t done_ = 0, totalUnits_ = 0;
+};
+
+}  // namespace
+
+std::vector<double> Sweep::angles() const {
+    if (!std::isfinite(from) || !std::isfinite(to) || !std::isfinite(step) || !(step > 0))
+        throw Error("sweep: --from, --to and --step must be finite, with --step > 0");
+    if (to < from) throw Error("sweep: --to must not be below --from");
+    const double count = std::floor((to - from) / step + 1e-3) + 1;
+    if (count > double(kMaxViews))
+        throw Error("sweep: " + std::to_string(count) + " views is more than " +
+                    std::to_string(kMaxViews));
+    std::vector<double> a(static_cast<std::size_t>(count));
+    for (std::size_t n = 0; n < a.size(); ++n) a[n] = from + double(n) * step;
+    return a;
+}
+
+CameraParams Sweep::camera(double angle) const {
+    CameraParams c = base;
+    (this->angle == Angle::Azimuth ? c.azimuthDeg : c.elevationDeg) = angle;
+    return c;
+}
+
+const RendererSeries* PoppingResult::find(RendererKind k) const {
+    for (const RendererSeries& s : series)
+        if (s.renderer == k) return &s;
+    return nullptr;
+}
+
+std::vector<double> predictSheetSwitches(const Sweep& sweep, const Volume& volume) {
+    const std::vector<double> angles = sweep.angles();
+    auto axisAt = [&](double angle) {
+        const Camera cam(sweep.camera(angle), volume);
+        return sheetAxis(cam.view, volume.spacing).axis;
+    };
+    std::vector<double> out;
+    constexpr int kSub = 16;  // sub-steps per interval, so two switches in one are found
+    for (std::size_t n = 0; n + 1 < angles.size(); ++n)
+        for (int q = 0; q < kSub; ++q) {
+            double a = angles[n] + (angles[n + 1] - angles[n]) * q / kSub;
+            double b = angles[n] + (angles[n + 1] - angles[n]) * (q + 1) / kSub;
+            const int before = axisAt(a);
+            if (axisAt(b) == before) continue;
+            while (b - a > 1e-9) {
+                const double m = 0.5 * (a + b);
+                (axisAt(m) == before ? a : b) = m;
+            }
+            out.push_back(0.5 * (a + b));
+        }
+    return out;
+}
+
+PoppingResult analyzePopping(const Scene& scene, const Sweep& sweep,
+                             const PoppingOptions& options) {
+    return Analyzer(scene, sweep, options).run();
+}
+
+}  // namespace splat
