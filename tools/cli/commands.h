@@ -3,6 +3,7 @@
 // callback; the callbacks throw splat::Error on bad input, and main() turns that into one
 // line on stderr and a non-zero exit status.
 #include <CLI/CLI.hpp>
+#include <string>
 
 namespace splat::cli {
 
@@ -11,5 +12,10 @@ void registerRender(CLI::App& app);   // cmd_render.cpp
 void registerRotate(CLI::App& app);   // cmd_rotate.cpp
 void registerCompare(CLI::App& app);  // cmd_compare.cpp
 void registerBench(CLI::App& app);    // cmd_bench.cpp
+void registerPopping(CLI::App& app);  // cmd_popping.cpp
+
+/// The command line as typed (for reports that say how to reproduce them).
+const std::string& commandLine();
+void setCommandLine(int argc, char** argv);
 
 }  // namespace splat::cli

@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
     splat::cli::registerRotate(app);
     splat::cli::registerCompare(app);
     splat::cli::registerBench(app);
+    splat::cli::registerPopping(app);
+    splat::cli::setCommandLine(argc, argv);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

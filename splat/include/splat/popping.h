@@ -59,6 +59,9 @@ struct PoppingOptions {
     double pixelsPerDegree = 67;  ///< LDR-FLIP viewing condition
     bool flip = true;             ///< compute the perceptual columns
     int thumbnail = 160;          ///< longest side of the animation frames kept, pixels
+    /// Frames rendered at once, each on one thread (0: one per thread for images up to
+    /// 256 x 256, else 1: one frame at a time on every thread). The images are the same.
+    int parallelFrames = 0;
     ProgressFn progress;          ///< optional; called after every frame
 };
 

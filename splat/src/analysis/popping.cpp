@@ -5,8 +5,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <numeric>
 
 #include "splatters/splatter.h"
@@ -120,31 +122,25 @@ class Analyzer {
 
         std::vector<std::vector<double>> frameMs(kinds_.size());
         View prev;
-        for (std::size_t n = 0; n < views; ++n) {
-            const View cur = renderView(r.angles[n]);
-            for (std::size_t k = 0; k < kinds_.size(); ++k) {
-                RendererSeries& s = r.series[k];
-                frameMs[k].push_back(cur.stats[k].milliseconds);
-                s.totalMs += cur.stats[k].milliseconds;
-                s.sheetAxis.push_back(cur.stats[k].sheetAxis);
-                s.sheetSign.push_back(cur.stats[k].sheetSign);
-                s.thumbnails.push_back(thumbnail(cur.images[k], options_.thumbnail));
-                if (ref_ >= 0) {
-                    s.e.push_back(rmsDiff(cur.images[k], cur.images[ref_]));
-                    s.flipRef.push_back(flip(cur.images[k], cur.images[ref_]));
-                }
-                if (n > 0) {
-                    s.T.push_back(rmsDiff(cur.images[k], prev.images[k]));
-                    s.flipT.push_back(flip(cur.images[k], prev.images[k]));
-                    if (ref_ >= 0)
-                        s.J.push_back(rmsDiff(cur.images[k], cur.images[ref_], &prev.images[k],
-                                              &prev.images[ref_]));
-                }
+        // Views are rendered in batches, several frames at once on one thread each where
+        // that is faster than one frame on every thread (small images); the metrics are
+        // then taken in order.
+        const std::size_t batch = framesAtOnce();
+        for (std::size_t n0 = 0; n0 < views; n0 += batch) {
+            const std::size_t n1 = std::min(views, n0 + batch);
+            std::vector<View> rendered(n1 - n0);
+            if (batch == 1) {
+                rendered[0] = renderView(r.angles[n0]);
+            } else {
+                tbb::parallel_for(
+                    n0, n1, [&](std::size_t n) { rendered[n - n0] = renderView(r.angles[n], 1); });
+                if (cancelled_) throw Cancelled();
             }
-            if (n > 0 && axis_ >= 0 && sheet_ >= 0)
-                r.crossJump.push_back(rmsDiff(cur.images[axis_], cur.images[sheet_],
-                                              &prev.images[axis_], &prev.images[sheet_]));
-            prev = cur;
+            for (std::size_t n = n0; n < n1; ++n) {
+                const View& cur = rendered[n - n0];
+                measureView(r, n, cur, prev, frameMs);
+                prev = cur;
+            }
         }
         for (std::size_t k = 0; k < kinds_.size(); ++k) {
             RendererSeries& s = r.series[k];
@@ -166,6 +162,43 @@ class Analyzer {
                     r.events.push_back(event(r, k, n));
         r.totalMs = msSince(start);
         return r;
+    }
+
+    void measureView(PoppingResult& r, std::size_t n, const View& cur, const View& prev,
+                     std::vector<std::vector<double>>& frameMs) const {
+        for (std::size_t k = 0; k < kinds_.size(); ++k) {
+            RendererSeries& s = r.series[k];
+            frameMs[k].push_back(cur.stats[k].milliseconds);
+            s.totalMs += cur.stats[k].milliseconds;
+            s.sheetAxis.push_back(cur.stats[k].sheetAxis);
+            s.sheetSign.push_back(cur.stats[k].sheetSign);
+            s.thumbnails.push_back(thumbnail(cur.images[k], options_.thumbnail));
+            if (ref_ >= 0) {
+                s.e.push_back(rmsDiff(cur.images[k], cur.images[ref_]));
+                s.flipRef.push_back(flip(cur.images[k], cur.images[ref_]));
+            }
+            if (n > 0) {
+                s.T.push_back(rmsDiff(cur.images[k], prev.images[k]));
+                s.flipT.push_back(flip(cur.images[k], prev.images[k]));
+                if (ref_ >= 0)
+                    s.J.push_back(rmsDiff(cur.images[k], cur.images[ref_], &prev.images[k],
+                                          &prev.images[ref_]));
+            }
+        }
+        if (n > 0 && axis_ >= 0 && sheet_ >= 0)
+            r.crossJump.push_back(rmsDiff(cur.images[axis_], cur.images[sheet_],
+                                          &prev.images[axis_], &prev.images[sheet_]));
+    }
+
+    /// Frames rendered at once: options.parallelFrames, or (0) one per thread for images
+    /// up to 256 x 256 pixels, where a frame alone does not keep the threads busy.
+    std::size_t framesAtOnce() const {
+        if (options_.parallelFrames > 0) return std::size_t(options_.parallelFrames);
+        const CameraParams& c = sweep_.base;
+        const int threads = scene_.settings().threads > 0 ? scene_.settings().threads
+                                                          : tbb::info::default_concurrency();
+        return std::int64_t(c.width) * c.height <= 256 * 256 ? std::size_t(std::max(threads, 1))
+                                                             : 1;
     }
 
   private:
@@ -258,24 +291,31 @@ class Analyzer {
         return ev;
     }
 
-    /// Every renderer's frame of one view. Renderers run one after another, each frame on
-    /// all of the scene's threads (the image does not depend on the thread count).
-    View renderView(double angle) {
+    /// Every renderer's frame of one view, each on `threads` threads (0: the scene's).
+    /// Safe to call from several threads at once.
+    View renderView(double angle, int threads = 0) {
         View v;
         v.images.resize(kinds_.size());
         v.stats.resize(kinds_.size());
         RenderSettings s = scene_.settings();
         s.camera = sweep_.camera(angle);
+        if (threads > 0) s.threads = threads;
         for (std::size_t k = 0; k < kinds_.size(); ++k) {
+            if (cancelled_) return v;
             s.renderer = kinds_[k];
             v.images[k] = scene_.render(s, &v.stats[k]);
-            ++done_;
-            if (options_.progress && !options_.progress(std::min(done_, totalUnits_), totalUnits_,
-                                                        std::string(toString(kinds_[k])) + " at " +
-                                                            std::to_string(angle)))
-                throw Cancelled();
+            report(std::string(toString(kinds_[k])) + " at " + std::to_string(angle));
         }
+        if (threads == 0 && cancelled_) throw Cancelled();
         return v;
+    }
+
+    /// One frame done: tell the progress callback (serialised), remember a cancellation.
+    void report(const std::string& what) {
+        std::lock_guard<std::mutex> lock(progressMutex_);
+        ++done_;
+        totalUnits_ = std::max(totalUnits_, done_);
+        if (options_.progress && !options_.progress(done_, totalUnits_, what)) cancelled_ = true;
     }
 
     /// Mean LDR-FLIP of two frames (display values: linear RGB in [0, 1]).
@@ -298,6 +338,8 @@ class Analyzer {
     std::vector<RendererKind> kinds_;
     int ref_ = -1, axis_ = -1, sheet_ = -1;
     std::size_t done_ = 0, totalUnits_ = 0;
+    std::mutex progressMutex_;
+    std::atomic<bool> cancelled_{false};
 };
 
 }  // namespace
