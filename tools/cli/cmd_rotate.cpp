@@ -1,93 +1,351 @@
-// `splat rotate VOLUME [options] --frames N [--from DEG --to DEG] -o DIR [--gif FILE]`:
-// a rotation sequence about the vertical axis (azimuth), frames named frame_0000.png, ...
+// `splat rotate VOLUME [options] --frames N [--from DEG --to DEG] [--sweep azimuth|elevation |
+// --path FILE.json] -o DIR [--name PATTERN] [--resume | --overwrite] [--gif FILE]
+// [--contact-sheet FILE] [--mp4 FILE]`: a rotation sequence through the sequence engine
+// (splat/sequence.h). Frames are written atomically as they are finished, so an interrupted
+// run leaves only complete frames, and --resume renders only the missing ones. The folder
+// keeps a manifest (.splat-rotate.json) of what its frames show: resuming with other
+// settings, or writing into a folder with other frames, is refused unless --overwrite.
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
+#include <regex>
 
 #include "commands.h"
+#include "progress.h"
 #include "render_options.h"
+#include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
+#include "splat/sequence.h"
 #include "volume_options.h"
+
+extern char** environ;
 
 namespace splat::cli {
 
+namespace fs = std::filesystem;
+
 namespace {
+constexpr const char* kManifest = ".splat-rotate.json";
+
 struct RotateCommand {
     VolumeArgs volume;
     RenderArgs render;
-    std::string outDir, gif, format = "png";
-    int frames = 36, fps = 12;
+    std::string outDir, gif, contact, mp4, format = "png", name = "frame_%04d", sweep = "azimuth",
+                                           path;
+    int frames = 36, fps = 12, parallelFrames = 0;
     double from = 0, to = 360;
+    bool resume = false, overwrite = false, quiet = false;
 };
 
-std::string frameName(const std::string& dir, int f, const std::string& ext) {
-    char name[64];
-    std::snprintf(name, sizeof name, "frame_%04d.%s", f, ext.c_str());
-    return (std::filesystem::path(dir) / name).string();
+/// Checks a frame name pattern: exactly one integer conversion (%d, %4d, %04d), no folder.
+void checkPattern(const std::string& p) {
+    static const std::regex ok(R"(^[^%/]*%0?[0-9]?d[^%/]*$)");
+    if (!std::regex_match(p, ok))
+        throw Error("--name '" + p + "' must hold exactly one %d (e.g. frame_%04d) and no '/'");
+}
+
+std::string frameFile(const RotateCommand& a, std::size_t f) {
+    char name[512];
+    std::snprintf(name, sizeof name, a.name.c_str(), int(f));
+    return (fs::path(a.outDir) / (std::string(name) + "." + a.format)).string();
+}
+
+/// Files in the folder that look like frames of this pattern, with their index.
+std::vector<std::pair<std::size_t, fs::path>> existingFrames(const RotateCommand& a) {
+    const std::string p = a.name;
+    const std::size_t pc = p.find('%'), d = p.find('d', pc);
+    const auto esc = [](const std::string& s) {
+        return std::regex_replace(s, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)");
+    };
+    const std::regex re("^" + esc(p.substr(0, pc)) + "([0-9]+)" + esc(p.substr(d + 1)) + "\\." +
+                        esc(a.format) + "$");
+    std::vector<std::pair<std::size_t, fs::path>> out;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(a.outDir, ec)) {
+        std::smatch m;
+        const std::string file = e.path().filename().string();
+        if (std::regex_match(file, m, re)) out.emplace_back(std::stoul(m[1].str()), e.path());
+    }
+    return out;
+}
+
+/// What the frames show: settings that must match for --resume.
+nlohmann::json manifestOf(const RotateCommand& a, const RenderSettings& s) {
+    return {{"volume", a.volume.spec},
+            {"frames", a.frames},
+            {"from", a.from},
+            {"to", a.to},
+            {"sweep", a.sweep},
+            {"path", a.path},
+            {"name", a.name},
+            {"format", a.format},
+            {"renderer", toString(s.renderer)},
+            {"mode", toString(s.mode)},
+            {"classify", toString(s.classification)},
+            {"tf", a.render.tf},
+            {"size", a.render.size},
+            {"azimuth", s.camera.azimuthDeg},
+            {"elevation", s.camera.elevationDeg},
+            {"slab", s.quality.slab},
+            {"projection", toString(s.camera.projection)},
+            {"shade", s.shading.enabled}};
+}
+
+/// Refuses folders whose frames would be mixed with this run's; returns the frames to keep.
+std::vector<bool> prepareFolder(const RotateCommand& a, const nlohmann::json& manifest) {
+    std::error_code ec;
+    if (fs::exists(a.outDir, ec) && !fs::is_directory(a.outDir, ec))
+        throw Error(a.outDir + ": exists and is not a folder");
+    std::vector<bool> keep(std::size_t(a.frames), false);
+    if (!fs::is_directory(a.outDir, ec)) return keep;
+    const auto frames = existingFrames(a);
+    if (frames.empty()) return keep;
+    const fs::path mpath = fs::path(a.outDir) / kManifest;
+    bool same = false;
+    if (std::ifstream in(mpath); in) {
+        try {
+            nlohmann::json old = nlohmann::json::parse(in);
+            old.erase("window");
+            same = old == manifest;
+        } catch (const std::exception&) {
+        }
+    }
+    if (a.overwrite) {
+        for (const auto& [i, p] : frames) fs::remove(p, ec);
+        return keep;
+    }
+    if (!a.resume)
+        throw Error(a.outDir + " already holds " + std::to_string(frames.size()) +
+                    " frames; use --resume to finish them or --overwrite to replace them");
+    if (!same)
+        throw Error(a.outDir + ": its frames were rendered with other settings (" + kManifest +
+                    "); use --overwrite to replace them");
+    for (const auto& [i, p] : frames) {
+        if (i >= keep.size())
+            throw Error(a.outDir + ": holds frame " + std::to_string(i) + " beyond --frames " +
+                        std::to_string(a.frames) + "; use --overwrite");
+        keep[i] = true;
+    }
+    return keep;
+}
+
+std::string findProgram(const std::string& name) {
+    const char* path = std::getenv("PATH");
+    std::string dirs = path ? path : "/usr/bin:/bin";
+    std::size_t start = 0;
+    while (start <= dirs.size()) {
+        const std::size_t end = std::min(dirs.find(':', start), dirs.size());
+        const fs::path p = fs::path(dirs.substr(start, end - start)) / name;
+        if (::access(p.c_str(), X_OK) == 0) return p.string();
+        start = end + 1;
+    }
+    return {};
+}
+
+/// Encodes the PNG frames into an MP4 with the ffmpeg program, atomically.
+void writeMp4(const RotateCommand& a, const std::string& ffmpeg) {
+    AtomicFile out(a.mp4);
+    const std::string input = (fs::path(a.outDir) / (a.name + ".png")).string();
+    const std::string fps = std::to_string(a.fps), tmp = out.temporary().string();
+    std::vector<std::string> args = {"ffmpeg",
+                                     "-loglevel",
+                                     "error",
+                                     "-nostdin",
+                                     "-y",
+                                     "-framerate",
+                                     fps,
+                                     "-start_number",
+                                     "0",
+                                     "-i",
+                                     input,
+                                     "-vf",
+                                     "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                                     "-c:v",
+                                     "libx264",
+                                     "-pix_fmt",
+                                     "yuv420p",
+                                     tmp};
+    std::vector<char*> argv;
+    for (auto& s : args) argv.push_back(s.data());
+    argv.push_back(nullptr);
+    pid_t pid;
+    if (posix_spawn(&pid, ffmpeg.c_str(), nullptr, nullptr, argv.data(), environ) != 0)
+        throw Error(a.mp4 + ": cannot run " + ffmpeg);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        throw Error(a.mp4 + ": ffmpeg failed (exit status " + std::to_string(WEXITSTATUS(status)) +
+                    ")");
+    out.commit();
 }
 }  // namespace
 
 void registerRotate(CLI::App& app) {
     auto a = std::make_shared<RotateCommand>();
-    CLI::App* cmd = app.add_subcommand("rotate", "render a rotation sequence (azimuth from..to)");
+    CLI::App* cmd = app.add_subcommand("rotate", "render a rotation sequence or a camera path");
     addVolumeOptions(*cmd, a->volume);
     addRenderOptions(*cmd, a->render);
     cmd->add_option("--frames", a->frames, "number of frames")->capture_default_str();
-    cmd->add_option("--from", a->from, "first azimuth, degrees")->capture_default_str();
-    cmd->add_option("--to", a->to, "azimuth after the last frame, degrees (360 closes the loop)")
+    cmd->add_option("--from", a->from, "first angle, degrees")->capture_default_str();
+    cmd->add_option("--to", a->to,
+                    "angle one step after the last frame, degrees (frames are spaced evenly over "
+                    "[from, to): 0..360 loops without repeating a view)")
         ->capture_default_str();
+    cmd->add_option("--sweep", a->sweep, "the angle turned: azimuth or elevation")
+        ->capture_default_str();
+    cmd->add_option("--path", a->path,
+                    "camera path JSON {\"keys\": [{\"azimuth\", \"elevation\", \"distance\", "
+                    "\"pixel_size\"}, ...]}, interpolated over --frames (instead of --sweep)");
     cmd->add_option("-o,--output", a->outDir, "output folder for the frames (created)")->required();
+    cmd->add_option("--name", a->name, "frame file name pattern (printf %d of the frame index)")
+        ->capture_default_str();
     cmd->add_option("--format", a->format, "frame format: png, exr or tif")->capture_default_str();
+    cmd->add_flag("--resume", a->resume, "render only the frames missing from the folder");
+    cmd->add_flag("--overwrite", a->overwrite, "replace the frames the folder holds");
     cmd->add_option("--gif", a->gif, "also write an animated GIF");
-    cmd->add_option("--fps", a->fps, "GIF frames per second")->capture_default_str();
+    cmd->add_option("--contact-sheet", a->contact,
+                    "also write a contact sheet (all frames, tiled)");
+    cmd->add_option("--mp4", a->mp4,
+                    "also write an MP4 video (needs the ffmpeg program; png frames)");
+    cmd->add_option("--fps", a->fps, "GIF and MP4 frames per second (1..100)")
+        ->capture_default_str();
+    cmd->add_option("--parallel-frames", a->parallelFrames,
+                    "frames rendered at once, one thread each (0: automatic)")
+        ->capture_default_str();
+    cmd->add_flag("-q,--quiet", a->quiet, "no progress output");
     cmd->callback([a] {
+        // Everything that can be refused is refused before anything is rendered or created.
         if (a->frames < 1 || a->frames > 100000)
             throw Error("--frames must be between 1 and 100000");
-        if (!std::isfinite(a->from) || !std::isfinite(a->to))
-            throw Error("--from/--to must be finite");
+        if (a->fps < 1 || a->fps > 100) throw Error("--fps must be between 1 and 100");
+        if (a->parallelFrames < 0 || a->parallelFrames > 1024)
+            throw Error("--parallel-frames must be between 0 and 1024");
         if (a->format != "png" && a->format != "exr" && a->format != "tif")
             throw Error("--format must be png, exr or tif");
-        if (!a->gif.empty()) {
-            // Like the frames folder, the GIF's folder is created if needed.
-            const std::filesystem::path parent = std::filesystem::path(a->gif).parent_path();
-            std::error_code ec;
-            if (!parent.empty() && std::filesystem::path(a->gif).extension() == ".gif")
-                std::filesystem::create_directories(parent, ec);
-            checkImagePath(a->gif);
+        if (a->sweep != "azimuth" && a->sweep != "elevation")
+            throw Error("--sweep must be azimuth or elevation");
+        if (a->resume && a->overwrite) throw Error("--resume and --overwrite exclude each other");
+        checkPattern(a->name);
+        for (const std::string* out : {&a->gif, &a->contact})
+            if (!out->empty()) {
+                const fs::path parent = fs::path(*out).parent_path();
+                std::error_code ec;
+                if (!parent.empty()) fs::create_directories(parent, ec);
+                checkImagePath(*out);
+            }
+        if (!a->gif.empty() && lowerExtension(a->gif) != ".gif")
+            throw Error(a->gif + ": --gif needs a .gif file name");
+        std::string ffmpeg;
+        if (!a->mp4.empty()) {
+            if (lowerExtension(a->mp4) != ".mp4")
+                throw Error(a->mp4 + ": --mp4 needs a .mp4 file name");
+            if (a->format != "png") throw Error("--mp4 is made from png frames (--format png)");
+            ffmpeg = findProgram("ffmpeg");
+            if (ffmpeg.empty())
+                throw Error(
+                    "--mp4 needs the ffmpeg program, which is not installed "
+                    "(Debian: apt-get install ffmpeg)");
         }
         const RenderSettings settings = settingsFromArgs(a->render);
-        // The GIF is assembled in memory: keep it under 4 GiB of float frames.
-        if (!a->gif.empty() &&
+        const bool keepImages = !a->gif.empty() || !a->contact.empty();
+        if (keepImages &&
             double(a->frames) * settings.camera.width * settings.camera.height > double(1 << 28))
-            throw Error("--gif with " + std::to_string(a->frames) + " frames of " + a->render.size +
+            throw Error("--gif/--contact-sheet with " + std::to_string(a->frames) + " frames of " +
+                        a->render.size +
                         " would not fit in memory; use fewer frames or a smaller --size");
-        const Volume volume = loadVolumeFromArgs(a->volume);
+        const CameraPath path =
+            a->path.empty() ? CameraPath::turn(settings.camera,
+                                               a->sweep == "azimuth" ? CameraPath::Angle::Azimuth
+                                                                     : CameraPath::Angle::Elevation,
+                                               a->from, a->to, a->frames, true)
+                            : CameraPath::fromJson(a->path, settings.camera, a->frames);
+        nlohmann::json manifest = manifestOf(*a, settings);
+        const std::vector<bool> keep = prepareFolder(*a, manifest);
+        auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
+        const Scene scene(volume, settings);
         std::error_code ec;
-        std::filesystem::create_directories(a->outDir, ec);
-        if (!std::filesystem::is_directory(a->outDir))
-            throw Error(a->outDir + ": cannot create output folder");
-        const Renderer renderer(volume, settings);
-        std::vector<Image> frames;
-        double totalMs = 0;
-        WriteOptions display;
-        for (int f = 0; f < a->frames; ++f) {
-            CameraParams cam = settings.camera;
-            cam.azimuthDeg = a->from + (a->to - a->from) * f / a->frames;
-            RenderStats stats;
-            Image image = renderer.render(cam, &stats);
-            totalMs += stats.milliseconds;
-            if (f == 0) display = displayOptions(a->render, settings, image);
-            writeImage(frameName(a->outDir, f, a->format), image, display);
-            std::fprintf(stderr, "\rframe %d/%d (azimuth %.1f, %.0f ms)   ", f + 1, a->frames,
-                         cam.azimuthDeg, stats.milliseconds);
-            if (!a->gif.empty()) frames.push_back(std::move(image));
+        fs::create_directories(a->outDir, ec);
+        if (!fs::is_directory(a->outDir)) throw Error(a->outDir + ": cannot create output folder");
+
+        // The display window (mip, xray) is fixed by the first frame a folder gets, and
+        // kept in the manifest so that resumed frames match.
+        std::optional<WriteOptions> display;
+        if (std::ifstream in(fs::path(a->outDir) / kManifest); in && a->resume) {
+            try {
+                const nlohmann::json old = nlohmann::json::parse(in);
+                if (old.contains("window")) {
+                    WriteOptions w;
+                    w.mapping = DisplayMapping::Window;
+                    w.windowLow = old["window"][0].get<float>();
+                    w.windowHigh = old["window"][1].get<float>();
+                    display = w;
+                }
+            } catch (const std::exception&) {
+            }
         }
-        std::fprintf(stderr, "\n");
-        if (!a->gif.empty()) writeAnimatedGif(a->gif, frames, display, a->fps);
-        std::printf("wrote %d frames to %s%s%s (%.1f ms per frame)\n", a->frames, a->outDir.c_str(),
-                    a->gif.empty() ? "" : " and ", a->gif.c_str(), totalMs / a->frames);
+        std::vector<Image> shown(keepImages ? std::size_t(a->frames) : 0);
+        double totalMs = 0;
+        std::size_t rendered = 0;
+        installInterruptHandler();
+        ProgressReporter progress("frames", a->quiet);
+        SequenceOptions so;
+        so.parallelFrames = a->parallelFrames;
+        so.skip = [&](std::size_t v) { return keep[v]; };
+        so.progress = [&](std::size_t d, std::size_t t, const std::string& w) {
+            return progress(d, t, w);
+        };
+        try {
+            renderSequence(scene, {settings.renderer}, path, so, [&](SequenceFrame&& f) {
+                Image& image = f.images[0];
+                if (!display) {
+                    display = displayOptions(a->render, settings, image);
+                    if (display->mapping == DisplayMapping::Window)
+                        manifest["window"] = {display->windowLow, display->windowHigh};
+                    writeTextAtomic(fs::path(a->outDir) / kManifest, manifest.dump(2) + "\n");
+                }
+                writeImage(frameFile(*a, f.view), image, *display);
+                totalMs += f.stats[0].milliseconds;
+                ++rendered;
+                if (keepImages) shown[f.view] = toDisplay(image, *display);
+            });
+        } catch (const Cancelled&) {
+            progress.finish();
+            throw Error("interrupted after " + std::to_string(rendered) +
+                        " new frames; the frames written are complete (--resume finishes them)");
+        }
+        progress.finish();
+        if (rendered == 0 && !fs::exists(fs::path(a->outDir) / kManifest))
+            writeTextAtomic(fs::path(a->outDir) / kManifest, manifest.dump(2) + "\n");
+        if (keepImages) {
+            // Frames kept from an earlier run are read back.
+            for (std::size_t f = 0; f < shown.size(); ++f)
+                if (keep[f]) {
+                    const Image im = readImage(frameFile(*a, f));
+                    shown[f] = a->format == "png" || !display ? im : toDisplay(im, *display);
+                }
+            WriteOptions asIs;
+            asIs.mapping = DisplayMapping::Display;
+            if (!a->gif.empty()) writeAnimatedGif(a->gif, shown, asIs, a->fps);
+            if (!a->contact.empty()) {
+                std::vector<Image> small;
+                for (const Image& im : shown) small.push_back(downscale(im, 160));
+                writeImage(a->contact, contactSheet(small), asIs);
+            }
+        }
+        if (!a->mp4.empty()) writeMp4(*a, ffmpeg);
+        std::printf("wrote %zu frames to %s (%zu kept)%s%s%s%s%s%s (%.1f ms per frame)\n", rendered,
+                    a->outDir.c_str(), std::size_t(a->frames) - rendered,
+                    a->gif.empty() ? "" : ", ", a->gif.c_str(), a->contact.empty() ? "" : ", ",
+                    a->contact.c_str(), a->mp4.empty() ? "" : ", ", a->mp4.c_str(),
+                    rendered ? totalMs / double(rendered) : 0.0);
     });
 }
 

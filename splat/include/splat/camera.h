@@ -21,6 +21,9 @@ struct CameraParams {
     /// Perspective: vertical field of view in degrees; the eye is placed so that the
     /// bounding sphere fits.
     double fovDeg = 30;
+    /// Perspective: distance of the eye from the volume centre, world units (0: the
+    /// distance at which the bounding sphere fits the field of view).
+    double distance = 0;
 };
 
 struct Ray {

@@ -10,8 +10,9 @@ namespace splat {
 
 /// How float values become display values in 8-bit files (.png, .gif).
 enum class DisplayMapping {
-    Srgb,    ///< colour in [0, 1], sRGB-encoded (dvr, iso)
-    Window,  ///< grey, linear map of [windowLow, windowHigh] of the red channel to [0, 1]
+    Srgb,     ///< colour in [0, 1], sRGB-encoded (dvr, iso)
+    Window,   ///< grey, linear map of [windowLow, windowHigh] of the red channel to [0, 1]
+    Display,  ///< the values are display values already (e.g. read back from a PNG)
 };
 
 struct WriteOptions {
@@ -36,5 +37,15 @@ Image readImage(const std::string& path);
 
 /// Encodes a linear value in [0, 1] with the sRGB transfer curve.
 float srgbEncode(float linear);
+
+/// The display values (RGB in [0, 1], alpha 1) an 8-bit file would hold for `image`.
+Image toDisplay(const Image& image, const WriteOptions& options);
+
+/// A box-filtered copy whose longest side is at most `maxSide` pixels (an integer factor).
+Image downscale(const Image& image, int maxSide);
+
+/// Frames (any sizes up to the first's) tiled left to right, top to bottom, `columns` per
+/// row (0: about square), on black.
+Image contactSheet(const std::vector<Image>& frames, int columns = 0);
 
 }  // namespace splat

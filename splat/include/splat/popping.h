@@ -24,6 +24,7 @@
 #include "splat/error.h"
 #include "splat/image.h"
 #include "splat/scene.h"
+#include "splat/sequence.h"
 #include "splat/settings.h"
 
 namespace splat {
@@ -39,17 +40,6 @@ struct Sweep {
     CameraParams camera(double angle) const;
 };
 
-/// Progress of a long computation: `done` of `total` units, what is being done. Returning
-/// false cancels it cleanly (the call throws splat::Cancelled; nothing is left half-done).
-using ProgressFn =
-    std::function<bool(std::size_t done, std::size_t total, const std::string& what)>;
-
-/// Thrown when a ProgressFn returned false.
-class Cancelled : public Error {
-  public:
-    Cancelled() : Error("cancelled") {}
-};
-
 struct PoppingOptions {
     std::vector<RendererKind> renderers{RendererKind::Axis, RendererKind::Sheet,
                                         RendererKind::Reference};
@@ -62,7 +52,7 @@ struct PoppingOptions {
     /// Frames rendered at once, each on one thread (0: one per thread for images up to
     /// 256 x 256, else 1: one frame at a time on every thread). The images are the same.
     int parallelFrames = 0;
-    ProgressFn progress;          ///< optional; called after every frame
+    ProgressFn progress;  ///< optional; called after every frame
 };
 
 /// A change measured at one interval width while refining an event.

@@ -1,9 +1,6 @@
 // Popping-artifact analysis (see splat/popping.h and splat/DESIGN.md, "Artifact analysis").
 #include "splat/popping.h"
 
-#include <tbb/info.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -11,6 +8,7 @@
 #include <mutex>
 #include <numeric>
 
+#include "splat/image_io.h"
 #include "splatters/splatter.h"
 
 #if __has_include("splat/flip.h")
@@ -60,22 +58,6 @@ double robustThreshold(const std::vector<double>& s, double k, double floorRatio
     return std::max(med + k * mad, floorRatio * med);
 }
 
-/// Downscaled copy (box filter) with the longest side at most `side` pixels.
-Image thumbnail(const Image& im, int side) {
-    const int longest = std::max(im.width, im.height);
-    const int f = std::max(1, (longest + side - 1) / std::max(side, 1));
-    if (f == 1) return im;
-    Image out(im.width / f, im.height / f);
-    for (int y = 0; y < out.height; ++y)
-        for (int x = 0; x < out.width; ++x) {
-            glm::vec4 sum(0.0f);
-            for (int v = 0; v < f; ++v)
-                for (int u = 0; u < f; ++u) sum += im.at(x * f + u, y * f + v);
-            out.at(x, y) = sum / float(f * f);
-        }
-    return out;
-}
-
 /// One view rendered by every renderer.
 struct View {
     std::vector<Image> images;
@@ -121,27 +103,20 @@ class Analyzer {
         for (std::size_t k = 0; k < kinds_.size(); ++k) r.series[k].renderer = kinds_[k];
 
         std::vector<std::vector<double>> frameMs(kinds_.size());
+        CameraPath path;
+        for (double angle : r.angles) path.views.push_back(sweep_.camera(angle));
+        SequenceOptions so;
+        so.parallelFrames = options_.parallelFrames;
+        so.progress = [&](std::size_t, std::size_t, const std::string& what) {
+            report(what);
+            return !cancelled_;
+        };
         View prev;
-        // Views are rendered in batches, several frames at once on one thread each where
-        // that is faster than one frame on every thread (small images); the metrics are
-        // then taken in order.
-        const std::size_t batch = framesAtOnce();
-        for (std::size_t n0 = 0; n0 < views; n0 += batch) {
-            const std::size_t n1 = std::min(views, n0 + batch);
-            std::vector<View> rendered(n1 - n0);
-            if (batch == 1) {
-                rendered[0] = renderView(r.angles[n0]);
-            } else {
-                tbb::parallel_for(
-                    n0, n1, [&](std::size_t n) { rendered[n - n0] = renderView(r.angles[n], 1); });
-                if (cancelled_) throw Cancelled();
-            }
-            for (std::size_t n = n0; n < n1; ++n) {
-                const View& cur = rendered[n - n0];
-                measureView(r, n, cur, prev, frameMs);
-                prev = cur;
-            }
-        }
+        renderSequence(scene_, kinds_, path, so, [&](SequenceFrame&& f) {
+            View cur{std::move(f.images), std::move(f.stats)};
+            measureView(r, f.view, cur, prev, frameMs);
+            prev = std::move(cur);
+        });
         for (std::size_t k = 0; k < kinds_.size(); ++k) {
             RendererSeries& s = r.series[k];
             s.msPerFrame = median(frameMs[k]);
@@ -172,7 +147,7 @@ class Analyzer {
             s.totalMs += cur.stats[k].milliseconds;
             s.sheetAxis.push_back(cur.stats[k].sheetAxis);
             s.sheetSign.push_back(cur.stats[k].sheetSign);
-            s.thumbnails.push_back(thumbnail(cur.images[k], options_.thumbnail));
+            s.thumbnails.push_back(downscale(cur.images[k], options_.thumbnail));
             if (ref_ >= 0) {
                 s.e.push_back(rmsDiff(cur.images[k], cur.images[ref_]));
                 s.flipRef.push_back(flip(cur.images[k], cur.images[ref_]));
@@ -188,17 +163,6 @@ class Analyzer {
         if (n > 0 && axis_ >= 0 && sheet_ >= 0)
             r.crossJump.push_back(rmsDiff(cur.images[axis_], cur.images[sheet_],
                                           &prev.images[axis_], &prev.images[sheet_]));
-    }
-
-    /// Frames rendered at once: options.parallelFrames, or (0) one per thread for images
-    /// up to 256 x 256 pixels, where a frame alone does not keep the threads busy.
-    std::size_t framesAtOnce() const {
-        if (options_.parallelFrames > 0) return std::size_t(options_.parallelFrames);
-        const CameraParams& c = sweep_.base;
-        const int threads = scene_.settings().threads > 0 ? scene_.settings().threads
-                                                          : tbb::info::default_concurrency();
-        return std::int64_t(c.width) * c.height <= 256 * 256 ? std::size_t(std::max(threads, 1))
-                                                             : 1;
     }
 
   private:
@@ -291,22 +255,19 @@ class Analyzer {
         return ev;
     }
 
-    /// Every renderer's frame of one view, each on `threads` threads (0: the scene's).
-    /// Safe to call from several threads at once.
-    View renderView(double angle, int threads = 0) {
+    /// Every renderer's frame of one view (refinement).
+    View renderView(double angle) {
         View v;
         v.images.resize(kinds_.size());
         v.stats.resize(kinds_.size());
         RenderSettings s = scene_.settings();
         s.camera = sweep_.camera(angle);
-        if (threads > 0) s.threads = threads;
         for (std::size_t k = 0; k < kinds_.size(); ++k) {
-            if (cancelled_) return v;
             s.renderer = kinds_[k];
             v.images[k] = scene_.render(s, &v.stats[k]);
             report(std::string(toString(kinds_[k])) + " at " + std::to_string(angle));
         }
-        if (threads == 0 && cancelled_) throw Cancelled();
+        if (cancelled_) throw Cancelled();
         return v;
     }
 

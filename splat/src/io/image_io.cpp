@@ -32,6 +32,8 @@ std::vector<float> displayValues(const Image& image, const WriteOptions& o) {
             float v;
             if (o.mapping == DisplayMapping::Window)
                 v = std::clamp((c.r - o.windowLow) / span, 0.0f, 1.0f);
+            else if (o.mapping == DisplayMapping::Display)
+                v = std::clamp(std::isfinite(c[ch]) ? c[ch] : 0.0f, 0.0f, 1.0f);
             else
                 v = srgbEncode(std::isfinite(c[ch]) ? c[ch] : 0.0f);
             out[n * 3 + ch] = v;
@@ -132,6 +134,50 @@ Image readImage(const std::string& path) {
         img.pixels[n] = c;
     }
     return img;
+}
+
+Image toDisplay(const Image& image, const WriteOptions& options) {
+    const std::vector<float> v = displayValues(image, options);
+    Image out(image.width, image.height);
+    for (std::size_t n = 0; n < out.pixels.size(); ++n)
+        out.pixels[n] = glm::vec4(v[n * 3], v[n * 3 + 1], v[n * 3 + 2], 1.0f);
+    return out;
+}
+
+Image downscale(const Image& im, int maxSide) {
+    const int longest = std::max(im.width, im.height);
+    const int f = std::max(1, (longest + std::max(maxSide, 1) - 1) / std::max(maxSide, 1));
+    if (f == 1) return im;
+    Image out(std::max(1, im.width / f), std::max(1, im.height / f));
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x) {
+            glm::vec4 sum(0.0f);
+            int count = 0;
+            for (int v = 0; v < f; ++v)
+                for (int u = 0; u < f; ++u)
+                    if (x * f + u < im.width && y * f + v < im.height) {
+                        sum += im.at(x * f + u, y * f + v);
+                        ++count;
+                    }
+            out.at(x, y) = sum / float(count);
+        }
+    return out;
+}
+
+Image contactSheet(const std::vector<Image>& frames, int columns) {
+    if (frames.empty()) return Image();
+    const int n = int(frames.size());
+    const int cols = columns > 0 ? columns : int(std::ceil(std::sqrt(double(n))));
+    const int rows = (n + cols - 1) / cols;
+    const int w = frames[0].width, h = frames[0].height;
+    Image sheet(cols * w, rows * h, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    for (int f = 0; f < n; ++f) {
+        const int ox = (f % cols) * w, oy = (f / cols) * h;
+        for (int y = 0; y < std::min(h, frames[f].height); ++y)
+            for (int x = 0; x < std::min(w, frames[f].width); ++x)
+                sheet.at(ox + x, oy + y) = frames[f].at(x, y);
+    }
+    return sheet;
 }
 
 }  // namespace splat

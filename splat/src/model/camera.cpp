@@ -27,6 +27,8 @@ Camera::Camera(const CameraParams& params, const Volume& volume) : params_(param
                     std::to_string(kMaxImagePixels >> 20) + " Mpixels");
     if (!std::isfinite(params.azimuthDeg) || !std::isfinite(params.elevationDeg))
         throw Error("azimuth and elevation must be finite numbers");
+    if (!(params.distance >= 0) || !std::isfinite(params.distance))
+        throw Error("camera distance must be a finite number of world units >= 0 (0 = fit)");
     if (!(params.pixelSize >= 0) || !std::isfinite(params.pixelSize))
         throw Error("pixel size must be a positive number of world units (0 = fit)");
     if (params.projection == Projection::Perspective &&
@@ -47,7 +49,7 @@ Camera::Camera(const CameraParams& params, const Volume& volume) : params_(param
         focal = glm::length(target - eye);
     } else {
         const double half = 0.5 * params.fovDeg * kPi / 180.0;
-        focal = boundingRadius / std::sin(half) + 1e-9;
+        focal = params.distance > 0 ? params.distance : boundingRadius / std::sin(half) + 1e-9;
         eye = target - view * focal;
         pixelSize = params.pixelSize > 0 ? params.pixelSize : 2.0 * focal * std::tan(half) / side;
     }

@@ -1,0 +1,68 @@
+#pragma once
+// Rendering sequences of views (rotations, sweeps, camera paths) from one Scene: the engine
+// shared by `splat rotate` and the popping analyzer. Frames come back in index order; they
+// are rendered several at once (one thread each) where that is faster than one frame on
+// every thread, and the images do not depend on which.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "splat/camera.h"
+#include "splat/error.h"
+#include "splat/image.h"
+#include "splat/scene.h"
+#include "splat/settings.h"
+
+namespace splat {
+
+/// Progress of a long computation: `done` of `total` units, what is being done. Returning
+/// false cancels it cleanly (the call throws splat::Cancelled; nothing is left half-done).
+using ProgressFn =
+    std::function<bool(std::size_t done, std::size_t total, const std::string& what)>;
+
+/// Thrown when a ProgressFn returned false.
+class Cancelled : public Error {
+  public:
+    Cancelled() : Error("cancelled") {}
+};
+
+/// The views of a sequence.
+struct CameraPath {
+    std::vector<CameraParams> views;
+
+    enum class Angle { Azimuth, Elevation };
+    /// `frames` views turning `angle` evenly from `from` towards `to`: with `closed` the last
+    /// view is one step before `to` (from 0 to 360 loops without repeating a view), else
+    /// the last view is `to`.
+    static CameraPath turn(const CameraParams& base, Angle angle, double from, double to,
+                           int frames, bool closed);
+    /// A JSON camera path: {"keys": [{"azimuth": 0, "elevation": 10, "distance": 400}, ...]}
+    /// (each key's missing fields keep the base camera's), `frames` views interpolated
+    /// linearly along the keys by their index (at least 2 keys; `frames` >= 2).
+    static CameraPath fromJson(const std::string& path, const CameraParams& base, int frames);
+};
+
+struct SequenceOptions {
+    /// Frames rendered at once, each on one thread; 0: one per thread for images up to
+    /// 256 x 256 pixels, else one frame at a time on every thread.
+    int parallelFrames = 0;
+    ProgressFn progress;  ///< called after every frame (serialised)
+    /// Views to leave out (e.g. frames already on disk); null: none.
+    std::function<bool(std::size_t view)> skip;
+};
+
+/// One view as rendered by each renderer asked for.
+struct SequenceFrame {
+    std::size_t view = 0;
+    std::vector<Image> images;  ///< renderers order
+    std::vector<RenderStats> stats;
+};
+
+/// Renders every view of `path` with each of `renderers` from `scene`, and hands the
+/// frames to `sink` in view order (from the calling thread). Throws splat::Cancelled when
+/// progress returns false (frames handed over before stay handed over).
+void renderSequence(const Scene& scene, const std::vector<RendererKind>& renderers,
+                    const CameraPath& path, const SequenceOptions& options,
+                    const std::function<void(SequenceFrame&&)>& sink);
+
+}  // namespace splat
