@@ -185,4 +185,12 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
     return image;
 }
 
+/// rasterizeTiles with the compositing policy of the frame's mode.
+template <class Cutter>
+Image rasterizeWithPolicy(const TileInputs& in, const Cutter& cutter, RenderStats* stats) {
+    return withPolicy(
+        in.settings.mode, in.settings.classification, in.scene.transfer,
+        [&](const auto& policy) { return rasterizeTiles(in, policy, cutter, stats); });
+}
+
 }  // namespace splat
