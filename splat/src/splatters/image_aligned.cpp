@@ -207,9 +207,7 @@ class ImageAligned final : public Splatter {
                                   work.last,
                                   in.scene.slabTable(),
                                   in.settings.order == CompositeOrder::FrontToBack};
-        return withPolicy(
-            in.settings.mode, in.settings.classification, in.scene.transfer,
-            [&](const auto& policy) { return rasterizeTiles(in, policy, cutter, stats); });
+        return rasterizeWithPolicy(in, cutter, stats);
     }
 };
 
