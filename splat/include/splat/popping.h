@@ -50,7 +50,8 @@ struct PoppingOptions {
     bool flip = true;             ///< compute the perceptual columns
     int thumbnail = 160;          ///< longest side of the animation frames kept, pixels
     /// Frames rendered at once, each on one thread (0: one per thread for images up to
-    /// 256 x 256, else 1: one frame at a time on every thread). The images are the same.
+    /// 256 x 256 and up to 1M splats, else 1: one frame at a time on every thread). The
+    /// images are the same.
     int parallelFrames = 0;
     ProgressFn progress;  ///< optional; called after every frame
 };

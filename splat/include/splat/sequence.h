@@ -44,7 +44,8 @@ struct CameraPath {
 
 struct SequenceOptions {
     /// Frames rendered at once, each on one thread; 0: one per thread for images up to
-    /// 256 x 256 pixels, else one frame at a time on every thread.
+    /// 256 x 256 pixels and scenes of up to 1M splats, else one frame at a time on
+    /// every thread.
     int parallelFrames = 0;
     ProgressFn progress;  ///< called after every frame (serialised)
     /// Views to leave out (e.g. frames already on disk); null: none.
