@@ -8,13 +8,9 @@
 #include <mutex>
 #include <numeric>
 
+#include "splat/flip.h"
 #include "splat/image_io.h"
 #include "splatters/splatter.h"
-
-#if __has_include("splat/flip.h")
-#include "splat/flip.h"
-#define SPLAT_HAVE_FLIP 1
-#endif
 
 namespace splat {
 
@@ -114,6 +110,7 @@ class Analyzer {
         View prev;
         renderSequence(scene_, kinds_, path, so, [&](SequenceFrame&& f) {
             View cur{std::move(f.images), std::move(f.stats)};
+            if (f.view == 0) setWindow(cur);
             measureView(r, f.view, cur, prev, frameMs);
             prev = std::move(cur);
         });
@@ -279,18 +276,32 @@ class Analyzer {
         if (options_.progress && !options_.progress(done_, totalUnits_, what)) cancelled_ = true;
     }
 
-    /// Mean LDR-FLIP of two frames (display values: linear RGB in [0, 1]).
+    void setWindow(const View& first) {
+        const RenderMode mode = scene_.settings().mode;
+        if (mode == RenderMode::Dvr || mode == RenderMode::Iso) return;
+        float mx = 0;
+        for (const Image& im : first.images)
+            for (const glm::vec4& p : im.pixels)
+                if (std::isfinite(p.r)) mx = std::max(mx, p.r);
+        if (mx > 0) windowScale_ = 1.0f / mx;
+    }
+
+    /// The frame as FLIP sees it: dvr and iso as they are (linear RGB, clamped by FLIP);
+    /// mip and xray scaled to [0, 1] by the sweep's first reference-or-axis frame maximum,
+    /// like the windowed PNGs.
+    Image display(const Image& im) const {
+        if (windowScale_ == 1.0f) return im;
+        Image out = im;
+        for (glm::vec4& p : out.pixels) p *= windowScale_;
+        return out;
+    }
+
+    /// Mean LDR-FLIP of two frames.
     double flip(const Image& test, const Image& reference) const {
-#if defined(SPLAT_HAVE_FLIP)
         if (!options_.flip) return 0;
         FlipOptions fo;
         fo.pixelsPerDegree = options_.pixelsPerDegree;
-        return flipMean(test, reference, fo);
-#else
-        (void)test;
-        (void)reference;
-        return 0;
-#endif
+        return flipMean(display(test), display(reference), fo);
     }
 
     const Scene& scene_;
@@ -300,6 +311,7 @@ class Analyzer {
     int ref_ = -1, axis_ = -1, sheet_ = -1;
     std::size_t done_ = 0, totalUnits_ = 0;
     std::mutex progressMutex_;
+    float windowScale_ = 1.0f;
     std::atomic<bool> cancelled_{false};
 };
 
