@@ -158,12 +158,18 @@ std::vector<unsigned char> unbase64(const std::string& s) {
     int bits = 0;
     for (char c : s) {
         int d;
-        if (c >= 'A' && c <= 'Z') d = c - 'A';
-        else if (c >= 'a' && c <= 'z') d = c - 'a' + 26;
-        else if (c >= '0' && c <= '9') d = c - '0' + 52;
-        else if (c == '+') d = 62;
-        else if (c == '/') d = 63;
-        else break;
+        if (c >= 'A' && c <= 'Z')
+            d = c - 'A';
+        else if (c >= 'a' && c <= 'z')
+            d = c - 'a' + 26;
+        else if (c >= '0' && c <= '9')
+            d = c - '0' + 52;
+        else if (c == '+')
+            d = 62;
+        else if (c == '/')
+            d = 63;
+        else
+            break;
         v = v << 6 | unsigned(d);
         bits += 6;
         if (bits >= 8) {
@@ -248,7 +254,8 @@ TEST_CASE("popping report: the three files", "[report]") {
         const auto rows = lines(test::readTextFile(dir / "metrics.csv"));
         // Header, 3 renderers x 10 intervals, 10 cross-jump rows.
         REQUIRE(rows.size() == 1 + 3 * 10 + 10);
-        CHECK(rows[0] == "renderer,interval,angle_from,angle_to,T,J,flipT,e,flipRef,signal,is_event");
+        CHECK(rows[0] ==
+              "renderer,interval,angle_from,angle_to,T,J,flipT,e,flipRef,signal,is_event");
         int events = 0;
         for (std::size_t i = 1; i < rows.size(); ++i) {
             CHECK(std::count(rows[i].begin(), rows[i].end(), ',') == 10);
@@ -314,8 +321,7 @@ TEST_CASE("popping report: the folder", "[report]") {
         const fs::path dir = base / "busy";
         fs::create_directories(dir);
         std::ofstream(dir / "notes.txt") << "mine";
-        CHECK_THROWS_WITH(writePoppingReport(r, dir.string(), "x"),
-                          Catch::Contains("notes.txt"));
+        CHECK_THROWS_WITH(writePoppingReport(r, dir.string(), "x"), Catch::Contains("notes.txt"));
         CHECK(!fs::exists(dir / "report.html"));
         CHECK(!fs::exists(dir / "summary.json"));
     }
@@ -498,8 +504,9 @@ TEST_CASE("popping report: headless Chromium shows the page", "[.browser]") {
     const char* ci = std::getenv("CI");
     if (chromium.empty()) {
         if (!ci || !*ci) {
-            WARN("SKIPPED: chromium is not installed (apt-get install chromium); the browser "
-                 "test of the popping report did not run. With CI set it fails instead.");
+            WARN(
+                "SKIPPED: chromium is not installed (apt-get install chromium); the browser "
+                "test of the popping report did not run. With CI set it fails instead.");
             return;
         }
         FAIL("chromium is not installed, and CI is set: the browser test must run");
@@ -524,7 +531,8 @@ TEST_CASE("popping report: headless Chromium shows the page", "[.browser]") {
         fs::remove(shot);
         const BrowserRun run = runChromium(
             chromium, dir / "report.html",
-            {"--screenshot=" + shot.string(), "--window-size=1200,3000", "--hide-scrollbars"}, work);
+            {"--screenshot=" + shot.string(), "--window-size=1200,3000", "--hide-scrollbars"},
+            work);
         INFO("chromium stderr:\n" << run.err);
         REQUIRE_FALSE(run.timedOut);
         REQUIRE(fs::is_regular_file(shot));
@@ -555,9 +563,10 @@ TEST_CASE("popping report: headless Chromium shows the page", "[.browser]") {
     SECTION("the checker catches a broken page") {
         const fs::path bad = work / "broken.html";
         std::ofstream(bad) << report::htmlPage(
-            "broken", "<svg class=\"plot\" width=\"10\" height=\"10\"></svg>\n"
-                      "<img class=\"frame\" alt=\"bad\" src=\"data:image/png;base64,AAAA\">\n"
-                      "<script>notAFunction();</script>\n");
+            "broken",
+            "<svg class=\"plot\" width=\"10\" height=\"10\"></svg>\n"
+            "<img class=\"frame\" alt=\"bad\" src=\"data:image/png;base64,AAAA\">\n"
+            "<script>notAFunction();</script>\n");
         const PageCheck c = checkPage(chromium, bad, work);
         INFO("chromium stderr:\n" << c.log);
         CHECK(c.checked);

@@ -8,20 +8,30 @@ std::string escapeHtml(std::string_view text) {
     out.reserve(text.size());
     for (char c : text) {
         switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            case '\'': out += "&#39;"; break;
-            default: out += c;
+            case '&':
+                out += "&amp;";
+                break;
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            case '\'':
+                out += "&#39;";
+                break;
+            default:
+                out += c;
         }
     }
     return out;
 }
 
 std::string base64(const unsigned char* bytes, std::size_t size) {
-    static const char* digits =
-        "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     std::string out;
     out.reserve((size + 2) / 3 * 4);
     std::size_t i = 0;
@@ -56,7 +66,8 @@ std::string dataUrl(std::string_view mime, const std::vector<unsigned char>& byt
 }
 
 std::string imgTag(const std::vector<unsigned char>& bytes, std::string_view mime,
-                   std::string_view cssClass, std::string_view alt, std::string_view title) {
+                   std::string_view cssClass, std::string_view alt, std::string_view title,
+                   int width) {
     std::string out = "<img class=\"";
     out += escapeHtml(cssClass);
     out += "\" alt=\"";
@@ -67,6 +78,7 @@ std::string imgTag(const std::vector<unsigned char>& bytes, std::string_view mim
         out += escapeHtml(title);
         out += '"';
     }
+    if (width > 0) out += " width=\"" + std::to_string(width) + '"';
     out += " src=\"";
     out += dataUrl(mime, bytes);
     out += "\">";

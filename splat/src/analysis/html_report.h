@@ -29,9 +29,11 @@ inline std::string base64(const std::vector<unsigned char>& bytes) {
 }
 /// data:`mime`;base64,...
 std::string dataUrl(std::string_view mime, const std::vector<unsigned char>& bytes);
-/// An <img> embedding `bytes` (PNG or GIF by `mime`), with a class, alt text and a tooltip.
+/// An <img> embedding `bytes` (PNG or GIF by `mime`), with a class, alt text, a tooltip and
+/// a display width in CSS pixels (0: the image's own).
 std::string imgTag(const std::vector<unsigned char>& bytes, std::string_view mime,
-                   std::string_view cssClass, std::string_view alt, std::string_view title = {});
+                   std::string_view cssClass, std::string_view alt, std::string_view title = {},
+                   int width = 0);
 
 /// The inline script described above.
 std::string pageCheckScript();

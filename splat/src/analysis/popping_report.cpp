@@ -11,10 +11,14 @@
 // anything but a previous report's three files (and the hidden temporaries of an
 // interrupted atomic write of them). All three files are built in memory first, so a
 // failure leaves the folder as it was; then each is written atomically.
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -22,9 +26,6 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
-
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 
 #include "analysis/html_report.h"
 #include "analysis/svg_plot.h"
@@ -64,6 +65,14 @@ double median(std::vector<double> v) {
 
 json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+// A float setting as the decimal it was most likely given as (0.35f, not 0.349999994).
+double f32(float v) {
+    if (!std::isfinite(v)) return v;
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.7g", double(v));
+    return std::strtod(buf, nullptr);
+}
+
 std::string csvNumber(double v) {
     if (!std::isfinite(v)) return "";
     char buf[40];
@@ -85,9 +94,12 @@ std::string sheetName(int axis, int sign) {
 
 std::string rendererColor(RendererKind k, std::size_t index) {
     switch (k) {
-        case RendererKind::Axis: return index < 3 ? "#1f77b4" : "#17becf";
-        case RendererKind::Sheet: return index < 3 ? "#d95f02" : "#e7298a";
-        case RendererKind::Reference: return "#222222";
+        case RendererKind::Axis:
+            return index < 3 ? "#1f77b4" : "#17becf";
+        case RendererKind::Sheet:
+            return index < 3 ? "#d95f02" : "#e7298a";
+        case RendererKind::Reference:
+            return "#222222";
     }
     return "#7f7f7f";
 }
@@ -165,8 +177,7 @@ void prepareFolder(const fs::path& dir) {
     for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
         const std::string name = it->path().filename().string();
         std::error_code ec2;
-        if ((isReportFile(name) && it->is_regular_file(ec2)) || isReportTemporary(name))
-            continue;
+        if ((isReportFile(name) && it->is_regular_file(ec2)) || isReportTemporary(name)) continue;
         throw Error(d + ": the folder holds '" + name +
                     "', which is not part of a popping report; write the report into a new "
                     "or empty folder (or one holding only a previous report)");
@@ -200,19 +211,21 @@ json settingsJson(const RenderSettings& s) {
     tf["normalized"] = s.transfer.normalized;
     tf["points"] = json::array();
     for (const TransferPoint& p : s.transfer.points)
-        tf["points"].push_back({p.value, p.rgba.r, p.rgba.g, p.rgba.b, p.rgba.a});
+        tf["points"].push_back(
+            {f32(p.value), f32(p.rgba.r), f32(p.rgba.g), f32(p.rgba.b), f32(p.rgba.a)});
     j["transfer"] = tf;
     j["camera"] = cameraJson(s.camera);
     j["kernel"] = s.kernel;
     j["kernel_sigma"] = s.kernelSigma;
     j["kernel_radius"] = s.kernelRadius;
-    j["background"] = {s.background.r, s.background.g, s.background.b, s.background.a};
+    j["background"] = {f32(s.background.r), f32(s.background.g), f32(s.background.b),
+                       f32(s.background.a)};
     j["iso_level"] = s.isoLevel;
     j["shading"] = {{"enabled", s.shading.enabled},
-                    {"ambient", s.shading.ambient},
-                    {"diffuse", s.shading.diffuse},
-                    {"specular", s.shading.specular},
-                    {"shininess", s.shading.shininess}};
+                    {"ambient", f32(s.shading.ambient)},
+                    {"diffuse", f32(s.shading.diffuse)},
+                    {"specular", f32(s.shading.specular)},
+                    {"shininess", f32(s.shading.shininess)}};
     j["threads"] = s.threads;
     const Quality& q = s.quality;
     j["quality"] = {{"slab", q.slab},
@@ -328,14 +341,12 @@ std::string metricsCsv(const PoppingResult& r) {
               << csvNumber(r.angles[n + 1]) << ',' << csvNumber(at(x.T, n)) << ','
               << csvNumber(at(x.J, n)) << ',' << csvNumber(at(x.flipT, n)) << ','
               << csvNumber(at(x.e, n)) << ',' << csvNumber(at(x.flipRef, n)) << ','
-              << csvNumber(at(x.signal, n)) << ',' << (isEvent(r, &x.renderer, n) ? 1 : 0)
-              << '\n';
+              << csvNumber(at(x.signal, n)) << ',' << (isEvent(r, &x.renderer, n) ? 1 : 0) << '\n';
     if (!r.crossJump.empty())
         for (std::size_t n = 0; n < intervals; ++n)
             s << "axis-sheet," << n << ',' << csvNumber(r.angles[n]) << ','
               << csvNumber(r.angles[n + 1]) << ",," << csvNumber(at(r.crossJump, n)) << ",,,,"
-              << csvNumber(at(r.crossJump, n)) << ',' << (isEvent(r, nullptr, n) ? 1 : 0)
-              << '\n';
+              << csvNumber(at(r.crossJump, n)) << ',' << (isEvent(r, nullptr, n) ? 1 : 0) << '\n';
     return s.str();
 }
 
@@ -395,8 +406,7 @@ std::string heatmapImg(const std::vector<float>& diff, int w, int h, double scal
 
 bool sameSize(const Image& a, const Image& b) {
     return a.width == b.width && a.height == b.height && a.width > 0 && a.height > 0 &&
-           a.pixels.size() == std::size_t(a.width) * a.height &&
-           b.pixels.size() == a.pixels.size();
+           a.pixels.size() == std::size_t(a.width) * a.height && b.pixels.size() == a.pixels.size();
 }
 
 // ---- page sections -------------------------------------------------------------------------
@@ -410,7 +420,8 @@ std::string td(const std::string& s, bool left = false) {
 
 std::vector<double> midpoints(const std::vector<double>& angles) {
     std::vector<double> m;
-    for (std::size_t i = 0; i + 1 < angles.size(); ++i) m.push_back(0.5 * (angles[i] + angles[i + 1]));
+    for (std::size_t i = 0; i + 1 < angles.size(); ++i)
+        m.push_back(0.5 * (angles[i] + angles[i + 1]));
     return m;
 }
 
@@ -421,15 +432,14 @@ std::string headerSection(const PoppingResult& r, const std::string& commandLine
     auto row = [&](const std::string& k, const std::string& v) {
         h << "<tr><td>" << escapeHtml(k) << "</td><td>" << v << "</td></tr>\n";
     };
-    row("scene", escapeHtml(std::string(toString(s.mode)) + ", transfer function " +
-                            s.transfer.name + ", " + toString(s.classification) +
-                            "-classified, kernel " + s.kernel + ", " +
-                            std::to_string(s.camera.width) + "×" +
-                            std::to_string(s.camera.height) + " pixels, " +
-                            toString(s.camera.projection)));
+    row("scene",
+        escapeHtml(std::string(toString(s.mode)) + ", transfer function " + s.transfer.name + ", " +
+                   toString(s.classification) + "-classified, kernel " + s.kernel + ", " +
+                   std::to_string(s.camera.width) + "×" + std::to_string(s.camera.height) +
+                   " pixels, " + toString(s.camera.projection)));
     row("sweep", escapeHtml(std::string(angleName(r.sweep.angle)) + " from " + deg(r.sweep.from) +
-                            " to " + deg(r.sweep.to) + " in steps of " + deg(r.sweep.step) +
-                            " (" + std::to_string(r.angles.size()) + " views)"));
+                            " to " + deg(r.sweep.to) + " in steps of " + deg(r.sweep.step) + " (" +
+                            std::to_string(r.angles.size()) + " views)"));
     std::string names;
     for (std::size_t i = 0; i < r.renderers.size(); ++i)
         names += (i ? ", " : "") + std::string(toString(r.renderers[i]));
@@ -455,8 +465,9 @@ std::string summarySection(const PoppingResult& r) {
       << th("median T") << th("flicker ratio") << th("events") << th("median error")
       << th("threshold") << th("ms / frame") << th("total s") << "</tr>\n";
     for (const RendererSeries& x : r.series) {
-        const auto n = std::count_if(r.events.begin(), r.events.end(),
-                                     [&](const PoppingEvent& e) { return e.renderer == x.renderer; });
+        const auto n = std::count_if(r.events.begin(), r.events.end(), [&](const PoppingEvent& e) {
+            return e.renderer == x.renderer;
+        });
         h << "<tr>" << td(toString(x.renderer), true) << td(formatNumber(x.spikeRatio, 4))
           << td(formatNumber(x.medianT, 4)) << td(formatNumber(x.flickerRatio, 4))
           << td(n ? "<span class=\"event-yes\">" + std::to_string(n) + "</span>" : "0")
@@ -474,9 +485,9 @@ std::string summarySection(const PoppingResult& r) {
 std::string eventsTable(const PoppingResult& r) {
     if (r.events.empty()) return "<p>No events were detected.</p>\n";
     std::ostringstream h;
-    h << "<table>\n<tr>" << th("#") << th("renderer", true) << th("interval", true)
-      << th("signal") << th("refined jump") << th("width") << th("slope") << th("angle")
-      << th("sheet axis", true) << th("predicted", true) << "</tr>\n";
+    h << "<table>\n<tr>" << th("#") << th("renderer", true) << th("interval", true) << th("signal")
+      << th("refined jump") << th("width") << th("slope") << th("angle") << th("sheet axis", true)
+      << th("predicted", true) << "</tr>\n";
     for (std::size_t i = 0; i < r.events.size(); ++i) {
         const PoppingEvent& e = r.events[i];
         h << "<tr>" << td(std::to_string(i + 1)) << td(toString(e.renderer), true)
@@ -512,13 +523,17 @@ std::string plotsSection(const PoppingResult& r) {
         p.yLabel = yLabel;
         p.bands = bands;
         p.markers = markers;
+        if (!r.angles.empty()) {
+            p.xFrom = std::min(r.angles.front(), r.angles.back());
+            p.xTo = std::max(r.angles.front(), r.angles.back());
+        }
         return p;
     };
     auto add = [&](report::LinePlot& p, const RendererSeries& x, std::size_t i,
                    const std::vector<double>& xs, const std::vector<double>& ys) {
         if (ys.empty()) return;
-        p.series.push_back({toString(x.renderer), rendererColor(x.renderer, i), xs, ys,
-                            xs.size() < 40, false});
+        p.series.push_back(
+            {toString(x.renderer), rendererColor(x.renderer, i), xs, ys, xs.size() < 40, false});
     };
     auto figure = [](const report::LinePlot& p, const std::string& caption) {
         return "<figure>\n" + p.svg() + "<figcaption>" + caption + "</figcaption>\n</figure>\n";
@@ -556,14 +571,17 @@ std::string plotsSection(const PoppingResult& r) {
          "<p class=\"note\">Per-interval measures are drawn at the interval's middle, per-view "
          "ones at the view. Shaded bands: detected events; dashed lines: predicted sheet "
          "switches of the axis-aligned splatter.</p>\n";
-    h << figure(pT, "T<sub>X</sub>(n) = RMS(I<sub>X</sub>(θ<sub>n+1</sub>) − "
-                    "I<sub>X</sub>(θ<sub>n</sub>)): how much each renderer's image changes per "
-                    "step.");
-    h << figure(pJ, std::string("J<sub>X</sub>(n) = RMS(D<sub>X</sub>(θ<sub>n+1</sub>) − "
-                                "D<sub>X</sub>(θ<sub>n</sub>)), D<sub>X</sub> = I<sub>X</sub> − "
-                                "I<sub>ref</sub>: the jump of the error") +
-                    (r.crossJump.empty() ? "" : "; C: the jump of I<sub>axis</sub> − I<sub>sheet</sub>") +
-                    (pJ.logY ? " (logarithmic scale)." : "."));
+    h << figure(pT,
+                "T<sub>X</sub>(n) = RMS(I<sub>X</sub>(θ<sub>n+1</sub>) − "
+                "I<sub>X</sub>(θ<sub>n</sub>)): how much each renderer's image changes per "
+                "step.");
+    h << figure(
+        pJ,
+        std::string("J<sub>X</sub>(n) = RMS(D<sub>X</sub>(θ<sub>n+1</sub>) − "
+                    "D<sub>X</sub>(θ<sub>n</sub>)), D<sub>X</sub> = I<sub>X</sub> − "
+                    "I<sub>ref</sub>: the jump of the error") +
+            (r.crossJump.empty() ? "" : "; C: the jump of I<sub>axis</sub> − I<sub>sheet</sub>") +
+            (pJ.logY ? " (logarithmic scale)." : "."));
     h << figure(pE, "e<sub>X</sub>(θ) = RMS(I<sub>X</sub>(θ) − I<sub>ref</sub>(θ)) per view.");
     h << figure(pF, "Mean LDR-ꟻLIP between consecutive frames (perceived change per step).");
     h << figure(pR, "Mean LDR-ꟻLIP against the reference per view.");
@@ -579,9 +597,17 @@ std::string refinementFigure(const PoppingResult& r, const PoppingEvent& e, bool
     p.height = 260;
     for (std::size_t i = 0; i < r.renderers.size(); ++i) {
         report::PlotSeries c{std::string("T ") + toString(r.renderers[i]),
-                             rendererColor(r.renderers[i], i), {}, {}, true, false};
+                             rendererColor(r.renderers[i], i),
+                             {},
+                             {},
+                             true,
+                             false};
         report::PlotSeries j{std::string("J ") + toString(r.renderers[i]),
-                             rendererColor(r.renderers[i], i), {}, {}, true, true};
+                             rendererColor(r.renderers[i], i),
+                             {},
+                             {},
+                             true,
+                             true};
         for (const RefinementStep& st : e.refinement) {
             c.x.push_back(st.width);
             c.y.push_back(at(st.change, i));
@@ -606,13 +632,14 @@ std::string refinementFigure(const PoppingResult& r, const PoppingEvent& e, bool
         p.series.push_back(c);
         if (withJump && r.renderers[i] != RendererKind::Reference) p.series.push_back(j);
     }
-    std::string caption = "Change over the refined interval against its width, per renderer "
-                          "(T solid";
+    std::string caption =
+        "Change over the refined interval against its width, per renderer "
+        "(T solid";
     caption += withJump ? ", J dashed" : "";
     caption += "). " + escapeHtml(toString(e.renderer)) + ": fitted log–log slope " +
                formatNumber(e.refinedSlope, 3) + ", jump " + formatNumber(e.refinedJump, 4) +
-               " at width " + formatNumber(e.refinedWidth, 3) + "° (near " +
-               deg(e.refinedAngle) + "). A slope near 0 is a discontinuity (popping); near 1, "
+               " at width " + formatNumber(e.refinedWidth, 3) + "° (near " + deg(e.refinedAngle) +
+               "). A slope near 0 is a discontinuity (popping); near 1, "
                "continuous change.";
     return "<figure>\n" + p.svg() + "<figcaption>" + caption + "</figcaption>\n</figure>\n";
 }
@@ -621,7 +648,8 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
     std::ostringstream h;
     const std::size_t R = r.renderers.size();
     const auto refIt = std::find(r.renderers.begin(), r.renderers.end(), RendererKind::Reference);
-    const std::size_t ref = refIt == r.renderers.end() ? R : std::size_t(refIt - r.renderers.begin());
+    const std::size_t ref =
+        refIt == r.renderers.end() ? R : std::size_t(refIt - r.renderers.begin());
     const RendererSeries* fired = nullptr;
     for (const RendererSeries& x : r.series)
         if (x.renderer == e.renderer) fired = &x;
@@ -634,8 +662,8 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
     const std::string caption =
         "Event " + std::to_string(index + 1) + ": " + escapeHtml(toString(e.renderer)) + " over [" +
         deg(e.angleFrom) + ", " + deg(e.angleTo) + "], signal " + formatNumber(e.signal, 4) +
-        (fired ? " (threshold " + formatNumber(fired->threshold, 4) + ")" : "") +
-        ", sheet axis " + sheetName(e.sheetAxisBefore, e.sheetSignBefore) + " → " +
+        (fired ? " (threshold " + formatNumber(fired->threshold, 4) + ")" : "") + ", sheet axis " +
+        sheetName(e.sheetAxisBefore, e.sheetSignBefore) + " → " +
         sheetName(e.sheetAxisAfter, e.sheetSignAfter) + ", " + predicted + ".";
     h << "<h3>" << caption << "</h3>\n";
 
@@ -666,7 +694,8 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
                 for (float v : errAfter[i]) errMax = std::max(errMax, double(v));
             }
         }
-        const double changeScale = changeMax > 0 ? changeMax : 1, errScale = errMax > 0 ? errMax : 1;
+        const double changeScale = changeMax > 0 ? changeMax : 1,
+                     errScale = errMax > 0 ? errMax : 1;
         h << "<figure>\n<div class=\"grid\" style=\"grid-template-columns: 7em repeat(" << R
           << ", 1fr)\">\n<div></div>";
         for (std::size_t i = 0; i < R; ++i)
@@ -676,13 +705,20 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
         const std::string name = "event " + std::to_string(index + 1) + " ";
         h << label("before<br>" + deg(e.angleFrom));
         for (std::size_t i = 0; i < R; ++i)
-            h << "<div>" << pngImg(f.before[i], display, "frame", name + toString(r.renderers[i]) + " before") << "</div>";
+            h << "<div>"
+              << pngImg(f.before[i], display, "frame", name + toString(r.renderers[i]) + " before")
+              << "</div>";
         h << '\n' << label("after<br>" + deg(e.angleTo));
         for (std::size_t i = 0; i < R; ++i)
-            h << "<div>" << pngImg(f.after[i], display, "frame", name + toString(r.renderers[i]) + " after") << "</div>";
+            h << "<div>"
+              << pngImg(f.after[i], display, "frame", name + toString(r.renderers[i]) + " after")
+              << "</div>";
         h << '\n' << label("|after − before|");
         for (std::size_t i = 0; i < R; ++i)
-            h << "<div>" << heatmapImg(change[i], w, hgt, changeScale, name + toString(r.renderers[i]) + " |after − before|") << "</div>";
+            h << "<div>"
+              << heatmapImg(change[i], w, hgt, changeScale,
+                            name + toString(r.renderers[i]) + " |after − before|")
+              << "</div>";
         h << '\n';
         if (ref < R) {
             for (int side = 0; side < 2; ++side) {
@@ -692,13 +728,19 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
                         h << "<div class=\"cell\">—</div>";
                         continue;
                     }
-                    h << "<div>" << heatmapImg(side ? errAfter[i] : errBefore[i], w, hgt, errScale, name + toString(r.renderers[i]) + (side ? " |X − ref| after" : " |X − ref| before")) << "</div>";
+                    h << "<div>"
+                      << heatmapImg(side ? errAfter[i] : errBefore[i], w, hgt, errScale,
+                                    name + toString(r.renderers[i]) +
+                                        (side ? " |X − ref| after" : " |X − ref| before"))
+                      << "</div>";
                 }
                 h << '\n';
             }
         }
         h << "</div>\n<figcaption>Frames at both ends of the interval, "
-          << (windowed(r.settings.mode) ? "windowed to [0, " + formatNumber(display.windowHigh, 4) + "]" : std::string("sRGB"))
+          << (windowed(r.settings.mode)
+                  ? "windowed to [0, " + formatNumber(display.windowHigh, 4) + "]"
+                  : std::string("sRGB"))
           << "; heat maps (inferno) of the largest RGB difference, |after − before| scaled to [0, "
           << formatNumber(changeScale, 4) << "]"
           << (ref < R ? ", |X − ref| to [0, " + formatNumber(errScale, 4) + "]" : std::string())
@@ -746,16 +788,19 @@ std::string animationSection(const PoppingResult& r) {
         movie.push_back(std::move(m));
     }
     std::string order;
-    for (int k = 0; k < n; ++k) order += (k ? " | " : "") + std::string(toString(r.series[k].renderer));
+    for (int k = 0; k < n; ++k)
+        order += (k ? " | " : "") + std::string(toString(r.series[k].renderer));
     const int fps = std::clamp(int(frames) / 3, 4, 12);
+    // Small thumbnails are shown enlarged (whole pixels) to about 480 CSS pixels wide.
+    const int scale = std::max(1, 480 / movie[0].width);
     const double first = r.angles.empty() ? r.sweep.from : r.angles.front();
     const double last = frames - 1 < r.angles.size() ? r.angles[frames - 1] : r.sweep.to;
     h << "<figure>\n"
       << report::imgTag(encodeAnimatedGif(movie, display, fps), "image/gif", "animation",
-                        "the sweep: " + order)
+                        "the sweep: " + order, "the sweep: " + order, scale * movie[0].width)
       << "\n<figcaption>Left to right: " << escapeHtml(order) << "; " << frames << " views, "
-      << angleName(r.sweep.angle) << " " << deg(first) << " to " << deg(last)
-      << ", " << fps << " frames per second, looping.</figcaption>\n</figure>\n";
+      << angleName(r.sweep.angle) << " " << deg(first) << " to " << deg(last) << ", " << fps
+      << " frames per second, looping.</figcaption>\n</figure>\n";
     return h.str();
 }
 
@@ -775,7 +820,8 @@ std::string settingsSection(const json& summary) {
     return h.str();
 }
 
-std::string reportHtml(const PoppingResult& r, const std::string& commandLine, const json& summary) {
+std::string reportHtml(const PoppingResult& r, const std::string& commandLine,
+                       const json& summary) {
     std::string body = headerSection(r, commandLine);
     body += summarySection(r);
     body += plotsSection(r);
@@ -787,8 +833,9 @@ std::string reportHtml(const PoppingResult& r, const std::string& commandLine, c
                 std::to_string(kMaxEventFigures) + " events only.</p>\n";
     body += animationSection(r);
     body += settingsSection(summary);
-    body += "<p class=\"note\">Written by splat. The measures per interval are in "
-            "metrics.csv, the summary in summary.json.</p>\n";
+    body +=
+        "<p class=\"note\">Written by splat. The measures per interval are in "
+        "metrics.csv, the summary in summary.json.</p>\n";
     return report::htmlPage("Popping report", body);
 }
 

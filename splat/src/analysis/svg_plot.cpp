@@ -162,10 +162,20 @@ std::string LinePlot::svg() const {
       << "\" fill=\"#fff\"/>\n";
     s << "<text x=\"" << num(kLeft) << "\" y=\"18\" class=\"plot-title\">" << escapeHtml(title)
       << "</text>\n";
+    if (std::isfinite(xFrom) && std::isfinite(xTo) && xFrom < xTo && (!logX || xFrom > 0)) {
+        xs.push_back(xFrom);
+        xs.push_back(xTo);
+    }
+    const bool fixedX = xs.size() >= 2 && std::isfinite(xFrom) && std::isfinite(xTo) &&
+                        xFrom < xTo && (!logX || xFrom > 0);
     if (!any || !fitRange(xa, xs, false) || !fitRange(ya, ys, !logY)) {
         s << "<text x=\"" << num(w / 2) << "\" y=\"" << num(h / 2)
           << "\" text-anchor=\"middle\" class=\"plot-empty\">no data</text>\n</svg>\n";
         return s.str();
+    }
+    if (fixedX) {
+        xa.lo = xFrom;
+        xa.hi = xTo;
     }
 
     // Bands and markers, clipped to the plot area.
@@ -189,26 +199,25 @@ std::string LinePlot::svg() const {
     for (double v : xa.ticks()) {
         const double x = xa.map(v);
         if (x < xa.p0 - 0.5 || x > xa.p1 + 0.5) continue;
-        s << "<line x1=\"" << num(x) << "\" y1=\"" << num(top) << "\" x2=\"" << num(x)
-          << "\" y2=\"" << num(bottom) << "\" stroke=\"#e6e6e6\"/>"
+        s << "<line x1=\"" << num(x) << "\" y1=\"" << num(top) << "\" x2=\"" << num(x) << "\" y2=\""
+          << num(bottom) << "\" stroke=\"#e6e6e6\"/>"
           << "<line x1=\"" << num(x) << "\" y1=\"" << num(bottom) << "\" x2=\"" << num(x)
           << "\" y2=\"" << num(bottom + 4) << "\" stroke=\"#333\"/>"
-          << "<text x=\"" << num(x) << "\" y=\"" << num(bottom + 16)
-          << "\" text-anchor=\"middle\">" << formatNumber(v) << "</text>\n";
+          << "<text x=\"" << num(x) << "\" y=\"" << num(bottom + 16) << "\" text-anchor=\"middle\">"
+          << formatNumber(v) << "</text>\n";
     }
     for (double v : ya.ticks()) {
         const double y = ya.map(v);
         if (y < top - 0.5 || y > bottom + 0.5) continue;
         s << "<line x1=\"" << num(xa.p0) << "\" y1=\"" << num(y) << "\" x2=\"" << num(xa.p1)
           << "\" y2=\"" << num(y) << "\" stroke=\"#e6e6e6\"/>"
-          << "<line x1=\"" << num(xa.p0 - 4) << "\" y1=\"" << num(y) << "\" x2=\""
-          << num(xa.p0) << "\" y2=\"" << num(y) << "\" stroke=\"#333\"/>"
-          << "<text x=\"" << num(xa.p0 - 7) << "\" y=\"" << num(y + 4)
-          << "\" text-anchor=\"end\">" << formatNumber(v, 3) << "</text>\n";
+          << "<line x1=\"" << num(xa.p0 - 4) << "\" y1=\"" << num(y) << "\" x2=\"" << num(xa.p0)
+          << "\" y2=\"" << num(y) << "\" stroke=\"#333\"/>"
+          << "<text x=\"" << num(xa.p0 - 7) << "\" y=\"" << num(y + 4) << "\" text-anchor=\"end\">"
+          << formatNumber(v, 3) << "</text>\n";
     }
-    s << "<rect x=\"" << num(xa.p0) << "\" y=\"" << num(top) << "\" width=\""
-      << num(xa.p1 - xa.p0) << "\" height=\"" << num(bottom - top)
-      << "\" fill=\"none\" stroke=\"#333\"/>\n";
+    s << "<rect x=\"" << num(xa.p0) << "\" y=\"" << num(top) << "\" width=\"" << num(xa.p1 - xa.p0)
+      << "\" height=\"" << num(bottom - top) << "\" fill=\"none\" stroke=\"#333\"/>\n";
     s << "<text x=\"" << num(0.5 * (xa.p0 + xa.p1)) << "\" y=\"" << num(h - 8)
       << "\" text-anchor=\"middle\" font-size=\"12\">" << escapeHtml(xLabel)
       << (logX ? " (log)" : "") << "</text>\n";
@@ -234,8 +243,8 @@ std::string LinePlot::svg() const {
         std::vector<std::pair<double, double>> dots;
         auto flush = [&] {
             if (!points.empty())
-                s << "<polyline stroke-width=\"1.6\" stroke-linejoin=\"round\" points=\""
-                  << points << "\"/>\n";
+                s << "<polyline stroke-width=\"1.6\" stroke-linejoin=\"round\" points=\"" << points
+                  << "\"/>\n";
             points.clear();
         };
         for (std::size_t i = 0; i < std::min(ps.x.size(), ps.y.size()); ++i) {
@@ -263,8 +272,8 @@ std::string LinePlot::svg() const {
         s << "<line x1=\"" << num(lx) << "\" y1=\"" << num(ly) << "\" x2=\"" << num(lx + 22)
           << "\" y2=\"" << num(ly) << "\" stroke=\"" << escapeHtml(ps.color)
           << "\" stroke-width=\"2.5\"" << (ps.dashed ? " stroke-dasharray=\"6 3\"" : "")
-          << "/><text x=\"" << num(lx + 28) << "\" y=\"" << num(ly + 4)
-          << "\">" << escapeHtml(ps.name) << "</text>\n";
+          << "/><text x=\"" << num(lx + 28) << "\" y=\"" << num(ly + 4) << "\">"
+          << escapeHtml(ps.name) << "</text>\n";
         ly += 18;
     }
     if (!bands.empty()) {

@@ -3,6 +3,7 @@
 // labels, linear or logarithmic axes, shaded vertical bands and dashed vertical markers.
 // The SVG is meant to be embedded in an HTML5 page (no xmlns, no external references);
 // the <svg> element carries class="plot".
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,8 @@ struct LinePlot {
     std::string title, xLabel, yLabel;
     int width = 800, height = 260;
     bool logX = false, logY = false;
+    /// The x range when both are finite (else fitted to the data, bands and markers).
+    double xFrom = std::numeric_limits<double>::quiet_NaN(), xTo = xFrom;
     std::vector<PlotSeries> series;
     std::vector<PlotBand> bands;      ///< shaded (events)
     std::vector<PlotMarker> markers;  ///< dashed vertical lines (predicted switches)
