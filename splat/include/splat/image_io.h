@@ -32,6 +32,14 @@ void checkImagePath(const std::string& path);
 void writeAnimatedGif(const std::string& path, const std::vector<Image>& frames,
                       const WriteOptions& options, int fps = 12);
 
+/// The bytes of an 8-bit image file (`ext`: ".png", ".gif" or ".jpg") encoded in memory,
+/// display values as writeImage makes them. Throws splat::Error on failure.
+std::vector<unsigned char> encodeImage(const Image& image, const std::string& ext,
+                                       const WriteOptions& options = {});
+/// The bytes of the looping animated GIF writeAnimatedGif writes, encoded in memory.
+std::vector<unsigned char> encodeAnimatedGif(const std::vector<Image>& frames,
+                                             const WriteOptions& options, int fps = 12);
+
 /// Reads any image OpenImageIO can read as float RGBA (missing alpha becomes 1).
 Image readImage(const std::string& path);
 

@@ -1,6 +1,7 @@
 // Image files through OpenImageIO, written atomically (temporary file, then rename).
 #include "splat/image_io.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imageio.h>
 
@@ -83,37 +84,75 @@ void writeImage(const std::string& path, const Image& image, const WriteOptions&
     file.commit();
 }
 
-void writeAnimatedGif(const std::string& path, const std::vector<Image>& frames,
-                      const WriteOptions& options, int fps) {
-    checkImagePath(path);
-    if (lowerExtension(path) != ".gif") throw Error(path + ": an animation must be a .gif file");
-    if (frames.empty()) throw Error(path + ": no frames to write");
-    AtomicFile file(path);
-    const std::string tmp = file.temporary().string();
-    auto out = OIIO::ImageOutput::create(tmp);
-    if (!out || !out->supports("multiimage"))
-        throw Error(path + ": this OpenImageIO cannot write animated GIFs");
+std::vector<unsigned char> encodeImage(const Image& image, const std::string& ext,
+                                       const WriteOptions& options) {
+    const std::string e = lowerExtension("x" + ext);
+    if (e != ".png" && e != ".gif" && e != ".jpg" && e != ".jpeg")
+        throw Error("cannot encode an image as '" + ext + "' (use .png, .gif or .jpg)");
+    if (image.width < 1 || image.height < 1) throw Error("cannot encode an empty image");
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    const std::string name = "memory" + e;
+    auto out = OIIO::ImageOutput::create(name);
+    if (!out || !out->supports("ioproxy"))
+        throw Error("this OpenImageIO cannot encode '" + e + "' in memory");
+    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+    void* ptr = &proxy;
+    spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &ptr);
+    const std::vector<float> v = displayValues(image, options);
+    bool ok = out->open(name, spec) && out->write_image(OIIO::TypeDesc::FLOAT, v.data());
+    const std::string err = out->geterror();
+    ok = out->close() && ok;
+    if (!ok) throw Error("cannot encode image (" + (err.empty() ? "write failed" : err) + ")");
+    return bytes;
+}
+
+std::vector<unsigned char> encodeAnimatedGif(const std::vector<Image>& frames,
+                                             const WriteOptions& options, int fps) {
+    if (frames.empty()) throw Error("no frames to write");
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    const std::string name = "memory.gif";
+    auto out = OIIO::ImageOutput::create(name);
+    if (!out || !out->supports("multiimage") || !out->supports("ioproxy"))
+        throw Error("this OpenImageIO cannot write animated GIFs");
     OIIO::ImageSpec spec(frames[0].width, frames[0].height, 3, OIIO::TypeDesc::UINT8);
+    void* ptr = &proxy;
+    spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &ptr);
     const int rate[2] = {std::max(fps, 1), 1};
     spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
     spec.attribute("oiio:Movie", 1);
     spec.attribute("oiio:LoopCount", 0);
     std::vector<OIIO::ImageSpec> specs(frames.size(), spec);
-    bool ok = out->open(tmp, int(specs.size()), specs.data());
+    bool ok = out->open(name, int(specs.size()), specs.data());
     for (std::size_t f = 0; ok && f < frames.size(); ++f) {
         if (frames[f].width != spec.width || frames[f].height != spec.height) {
             ok = false;
             break;
         }
-        if (f > 0) ok = out->open(tmp, spec, OIIO::ImageOutput::AppendSubimage);
+        if (f > 0) ok = out->open(name, spec, OIIO::ImageOutput::AppendSubimage);
         const std::vector<float> v = displayValues(frames[f], options);
         ok = ok && out->write_image(OIIO::TypeDesc::FLOAT, v.data());
     }
     const std::string err = out->geterror();
     ok = out->close() && ok;
     if (!ok)
-        throw Error(path + ": cannot write image (" + (err.empty() ? "write failed" : err) + ")");
-    file.commit();
+        throw Error("cannot write the animation (" + (err.empty() ? "write failed" : err) + ")");
+    return bytes;
+}
+
+void writeAnimatedGif(const std::string& path, const std::vector<Image>& frames,
+                      const WriteOptions& options, int fps) {
+    checkImagePath(path);
+    if (lowerExtension(path) != ".gif") throw Error(path + ": an animation must be a .gif file");
+    if (frames.empty()) throw Error(path + ": no frames to write");
+    std::vector<unsigned char> bytes;
+    try {
+        bytes = encodeAnimatedGif(frames, options, fps);
+    } catch (const Error& e) {
+        throw Error(path + ": " + e.what());
+    }
+    writeFileAtomic(path, bytes.data(), bytes.size());
 }
 
 Image readImage(const std::string& path) {
