@@ -34,3 +34,7 @@ $S compare $tmp/sheet.exr $tmp/reference.exr --heatmap $G/error_sheet_45.png --s
 $S render synthetic:phantom:64 --tf ct-soft --azimuth 45 --size 256x256 --renderer reference -o $G/phantom_reference_45.png
 # A small rotation of the phantom as an animated GIF.
 $S rotate synthetic:phantom:96 --tf tools/gallery/phantom-tf.json --renderer sheet --elevation 20 --size 192x192 --frames 24 -o $tmp/frames --gif $G/phantom_rotate.gif
+# Popping: where the axis-aligned splatter's sheets turn (ch2, mri-head, 40..50 degrees): the
+# error-jump plot and the event's frames before/after with their differences.
+$S popping $CH2 --tf mri-head --size 128x128 --from 40 --to 50 --step 0.5 --report $tmp/popping -q
+python3 tools/popping_figures.py $tmp/popping $G/popping_ch2
