@@ -258,8 +258,8 @@ TEST_CASE("extremes: volumes 1x1x1, 1x1x4096 and 4096x1x1", "[extremes]") {
                 INFO(dims.x << "x" << dims.y << "x" << dims.z << " " << toString(r) << " azimuth "
                             << az);
                 REQUIRE(peakOf(exact) > 0.1);
-                // Float accumulation of the footprint tables along 4096 kernels (measured
-                // 1.3e-4 of the peak; 1e-5 for short volumes).
+                // Footprint-table and float error of the ~25 kernels each ray passes near
+                // (measured 1.3e-4 of the peak for the long volumes; 1e-5 for 1x1x1).
                 CHECK(worstAgainst(img, exact, 0) < 3e-4 * peakOf(exact));
             }
     }
@@ -324,7 +324,7 @@ TEST_CASE("extremes: 4096 sheets deep, front-to-back equals back-to-front, no dr
         // Drift: the composited opacity against 1 - exp(-tau) over 4096 sheets.
         s.order = CompositeOrder::FrontToBack;
         const double err = dvrAgainstClosedForm(v, s, 1e-3f);
-        CHECK(err < 1e-4);
+        CHECK(err < 1e-5);  // measured 1.1e-6 (axis), 1.0e-6 (sheet)
         // Tau = 4096 * rho * fp(0) ~ 1.8: the closed form is not trivially 0 or 1.
         CHECK(ftb.at(1, 1).a > 0.5f);
         CHECK(ftb.at(1, 1).a < 0.999f);

@@ -20,7 +20,7 @@ bench() {
     python3 - "$tmp/b.json" "$tmp/mem" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))["runs"][0]
-print(r["splats"], r["median_ms"], int(open(sys.argv[2]).read().split()[-1]) / 1024)
+print(r["splats"], f"{r['median_ms']:.1f}", round(int(open(sys.argv[2]).read().split()[-1]) / 1024))
 PY
 }
 fit() {  # file with "x y" lines -> slope of log y on log x

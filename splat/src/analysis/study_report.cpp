@@ -49,7 +49,7 @@ std::string xmlEscape(const std::string& s) {
 /// Log-log plot frame: maps (ms, rmse) to plot coordinates.
 struct Axes {
     double x0, x1, y0, y1;  ///< log10 ranges
-    double left = 80, right = 20, top = 40, bottom = 60, width = 800, height = 560;
+    double left = 80, right = 170, top = 40, bottom = 60, width = 900, height = 560;
     static Axes of(const std::vector<StudyPoint>& pts) {
         double lx0 = 1e300, lx1 = -1e300, ly0 = 1e300, ly1 = -1e300;
         for (const auto& p : pts) {
@@ -120,8 +120,9 @@ std::string svgPlot(const StudyResult& r) {
         s << "<circle cx='" << x << "' cy='" << y << "' r='" << (p.pareto ? 5 : 3.5) << "' fill='"
           << (p.pareto ? "#d62728" : "#1f77b4") << "'><title>" << xmlEscape(p.label()) << ": "
           << num(p.msMedian) << " ms, rmse " << num(p.rmse) << "</title></circle>\n";
-        s << "<text x='" << x + 7 << "' y='" << y - 5 << "' font-size='10' fill='#444'>"
-          << xmlEscape(p.label()) << "</text>\n";
+        if (p.pareto)  // the others are named by their tooltips and in study.csv
+            s << "<text x='" << x + 7 << "' y='" << y - 5 << "' font-size='10' fill='#444'>"
+              << xmlEscape(p.label()) << "</text>\n";
     }
     s << "</svg>\n";
     return s.str();
@@ -161,7 +162,7 @@ void writePng(const StudyResult& r, const std::filesystem::path& path) {
         if (!(p.msMedian > 0)) continue;
         const int x = int(ax.px(p.msMedian)), y = int(ax.py(p.rmse)), h = p.pareto ? 4 : 3;
         IBA::render_box(buf, x - h, y - h, x + h, y + h, p.pareto ? red : blue, true);
-        label(x + 7, y - 5, p.label(), 10);
+        if (p.pareto) label(x + 7, y - 5, p.label(), 10);  // the others: see study.csv
     }
     AtomicFile out(path);
     if (!buf.write(out.temporary().string()))
