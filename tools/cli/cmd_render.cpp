@@ -42,6 +42,14 @@ void registerRender(CLI::App& app) {
             args->output.c_str(), image.width, image.height, toString(settings.renderer),
             toString(settings.mode), stats.splats, stats.voxels, skipped,
             renderer.splats().bytes() / 1048576.0, stats.milliseconds);
+        // Issue 12: what the frame modelled.
+        std::printf(
+            "modelled: %zu voxels classified away, gradients %s, %s path%s, %zu splats "
+            "early-terminated, %zu footprint pixels\n",
+            stats.voxels - stats.splats, stats.normals ? "computed" : "not computed",
+            stats.perspective ? "perspective" : "orthographic",
+            stats.exactPixels ? " (eye near the volume: exact path for every pixel)" : "",
+            stats.culledSplats, stats.footprintPixels);
     });
 }
 

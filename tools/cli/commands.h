@@ -13,6 +13,7 @@ void registerRotate(CLI::App& app);   // cmd_rotate.cpp
 void registerCompare(CLI::App& app);  // cmd_compare.cpp
 void registerBench(CLI::App& app);    // cmd_bench.cpp
 void registerPopping(CLI::App& app);  // cmd_popping.cpp
+void registerStudy(CLI::App& app);    // cmd_study.cpp
 
 /// The command line as typed (for reports that say how to reproduce them).
 const std::string& commandLine();

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     splat::cli::registerCompare(app);
     splat::cli::registerBench(app);
     splat::cli::registerPopping(app);
+    splat::cli::registerStudy(app);
     splat::cli::setCommandLine(argc, argv);
     try {
         app.parse(argc, argv);

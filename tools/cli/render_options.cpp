@@ -54,6 +54,10 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
         ->capture_default_str();
     cmd.add_flag("--shade", a.shade,
                  "headlight Phong shading from the density gradient (pre-classified dvr)");
+    // Issue 12 (study branch): eye distance, so that views from inside the volume are possible.
+    cmd.add_option("--distance", a.distance,
+                   "perspective: eye distance from the volume centre, world units (0 = fit)")
+        ->capture_default_str();
     cmd.add_option("--scene", a.scene,
                    "scene FILE.json holding any of these options (flags override it)");
 }
@@ -155,6 +159,8 @@ RenderArgs withScene(const RenderArgs& given) {
                 a.tileSize = value.get<int>();
             else if (key == "shade")
                 a.shade = value.get<bool>();
+            else if (key == "distance")  // issue 12
+                a.distance = value.get<double>();
             else
                 throw Error(given.scene + ": unknown scene key '" + key + "'");
         }
@@ -187,6 +193,7 @@ RenderSettings settingsFromArgs(const RenderArgs& given) {
         throw Error("unknown projection '" + a.projection + "' (ortho or perspective)");
     s.camera.pixelSize = a.pixelSize;
     s.camera.fovDeg = a.fov;
+    s.camera.distance = a.distance;  // issue 12
     s.quality.slab = a.slab;
     s.kernel = a.kernel;
     s.kernelSigma = a.sigma;

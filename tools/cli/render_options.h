@@ -18,6 +18,8 @@ struct RenderArgs {
     double earlyTermination = 1.0 / 256.0, isoLevel = 0.5, refStep = 0.25, refTolerance = 1e-4;
     int threads = 0, tileSize = 32;
     bool shade = false;
+    // Issue 12 (study branch): perspective eye distance from the volume centre.
+    double distance = 0;
     CLI::App* cmd = nullptr;
 };
 

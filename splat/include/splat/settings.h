@@ -81,6 +81,14 @@ struct RenderStats {
     /// Stage times, ms: shade, project, order (visiting keys), bin, tiles (cut kernels into
     /// sheets and composite), resolve (background).
     double shadeMs = 0, projectMs = 0, orderMs = 0, binMs = 0, tilesMs = 0;
+    /// What the frame modelled (issue 12: only what the scene needs, visibly).
+    bool perspective = false;         ///< the perspective path ran (per-splat footprints)
+    std::size_t normals = 0;          ///< splat normals held by the Scene (0: no gradients)
+    std::size_t pathScalePixels = 0;  ///< per-pixel perspective path scales allocated
+    /// Pixels handed to the exact path (the reference ray caster of the same model) because
+    /// a kernel straddles or lies behind the perspective near plane (eye inside or within
+    /// two kernel radii of the volume's kernels), where a local-affine footprint is invalid.
+    std::size_t exactPixels = 0;
 };
 
 /// The one enum <-> string table: names as used by the command line and scene files.

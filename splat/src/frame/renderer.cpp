@@ -7,6 +7,7 @@
 // caster renders the same Scene's fields instead (reference/).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <chrono>
 
@@ -95,6 +96,31 @@ Image referenceFrame(const Scene::Impl& scene, const Camera& camera, const Rende
     return renderReference(*scene.volume, field, camera, s, &stats, nullptr);
 }
 
+/// True when a perspective frame has a kernel whose bounding sphere comes within two of its
+/// radii of the eye plane (or behind it): there the local-affine footprint (the Jacobian at
+/// the kernel centre) is no longer a valid approximation, and a kernel straddling the near
+/// plane has no finite footprint at all.
+bool needsExactPath(const Scene::Impl& scene, const Camera& camera) {
+    if (!camera.perspective()) return false;
+    const SplatList& s = scene.splats;
+    const glm::dvec3 sp = scene.volume->spacing;
+    const double bound = scene.kernel.radius() * std::max(sp.x, std::max(sp.y, sp.z));
+    const double nearest = 3.0 * bound;
+    const glm::dvec3 eye = camera.eye, view = camera.view;
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, s.size(), 8192), false,
+        [&](const tbb::blocked_range<std::size_t>& r, bool found) {
+            for (std::size_t n = r.begin(); n != r.end() && !found; ++n) {
+                const glm::dvec3 w(s.x[n], s.y[n], s.z[n]);
+                const double depth = glm::dot(w - eye, view);
+                // Kernels entirely behind the eye contribute nothing to any ray.
+                if (depth > -bound && depth < nearest) found = true;
+            }
+            return found;
+        },
+        [](bool a, bool b) { return a || b; });
+}
+
 }  // namespace
 
 void validateFrame(const RenderSettings& s) {
@@ -124,11 +150,19 @@ Image renderFrame(const Scene::Impl& scene, const RenderSettings& s, RenderStats
     RenderStats local;
     local.splats = scene.splats.size();
     local.voxels = scene.splats.voxels;
+    local.normals = scene.splats.nx.size();
     Image image;
     runOnThreads(s.threads, [&] {
         const Camera camera(s.camera, *scene.volume);
-        image = s.renderer == RendererKind::Reference ? referenceFrame(scene, camera, s, local)
-                                                      : splatFrame(scene, camera, s, local);
+        local.perspective = camera.perspective();
+        if (s.renderer == RendererKind::Reference) {
+            image = referenceFrame(scene, camera, s, local);
+        } else if (needsExactPath(scene, camera)) {
+            image = referenceFrame(scene, camera, s, local);
+            local.exactPixels = std::size_t(camera.width()) * std::size_t(camera.height());
+        } else {
+            image = splatFrame(scene, camera, s, local);
+        }
     });
     local.milliseconds = msSince(start);
     if (stats) *stats = local;

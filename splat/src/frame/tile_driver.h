@@ -173,6 +173,7 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
         acc.resolve(image, ox, oy, in.settings.mode);
     });
     if (stats) {
+        stats->pathScalePixels = pathScale.size();
         stats->tilesMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();

@@ -132,11 +132,13 @@ glm::vec4 TransferFunction::sample(float d) const {
 }
 
 float TransferFunction::extinctionFromOpacity(float alpha) const {
-    // rho = -ln(1 - alpha) / unit distance, with 1 - alpha clamped below so that
-    // alpha = 1 gives a large finite extinction instead of inf.
-    const float transmittance = std::max(1.0f - alpha, kMinTransmittance);
-    if (alpha <= 0.0f) return 0.0f;
-    return float(-std::log(double(transmittance)) / unitDistance);
+    // rho = -ln(1 - alpha) / unit distance, evaluated as -log1p(-alpha) in double: 1 - alpha
+    // in float loses every opacity below 6e-8 (alpha = 1e-9 became rho = 0, and 1e-7 came
+    // out 19% too opaque). 1 - alpha is clamped below so that alpha = 1 gives a large finite
+    // extinction instead of inf; NaN opacities give 0.
+    if (!(alpha > 0.0f)) return 0.0f;
+    const double a = std::min(double(alpha), 1.0 - double(kMinTransmittance));
+    return float(-std::log1p(-a) / unitDistance);
 }
 
 bool TransferFunction::invisibleOver(float lo, float hi) const {

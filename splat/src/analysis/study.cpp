@@ -1,0 +1,540 @@
+// Speed-accuracy studies and convergence orders (see splat/study.h).
+#include "splat/study.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+
+#include "splat/error.h"
+#include "splat/image_io.h"
+#include "splat/metrics.h"
+#include "splat/scene.h"
+
+#if __has_include("splat/flip.h")
+#include "splat/flip.h"
+#define SPLAT_STUDY_HAVE_FLIP 1
+#endif
+
+namespace splat {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double parseNumber(const std::string& knob, const std::string& text) {
+    try {
+        std::size_t used = 0;
+        const double v = std::stod(text, &used);
+        if (used != text.size()) throw std::invalid_argument(text);
+        return v;
+    } catch (const std::exception&) {
+        throw Error("--sweep " + knob + ": '" + text + "' is not a number");
+    }
+}
+
+int parseInt(const std::string& knob, const std::string& text) {
+    const double v = parseNumber(knob, text);
+    if (v != std::floor(v) || std::abs(v) > 1e9)
+        throw Error("--sweep " + knob + ": '" + text + "' is not an integer");
+    return int(v);
+}
+
+/// Peak resident set size since the last reset (Linux /proc; 0 elsewhere), MiB.
+void resetPeakMemory() {
+    std::ofstream clear("/proc/self/clear_refs");
+    if (clear) clear << "5";
+}
+double peakMemoryMiB() {
+    std::ifstream status("/proc/self/status");
+    std::string line;
+    while (std::getline(status, line))
+        if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+    return 0;
+}
+
+#if defined(SPLAT_STUDY_HAVE_FLIP)
+/// Linear RGB in [0, 1] for LDR-FLIP: dvr as composited; mip/xray divided by `peak`.
+Image displayValues(const Image& img, RenderMode mode, float peak) {
+    Image out = img;
+    const float scale =
+        (mode == RenderMode::Dvr || mode == RenderMode::Iso || !(peak > 0)) ? 1.0f : 1.0f / peak;
+    for (auto& p : out.pixels) {
+        for (int c = 0; c < 3; ++c) {
+            const float v = p[c] * scale;
+            p[c] = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+        }
+        p.a = 1.0f;
+    }
+    return out;
+}
+#endif
+
+float peakOf(const Image& img) {
+    float m = 0;
+    for (const auto& p : img.pixels)
+        for (int c = 0; c < 3; ++c)
+            if (std::isfinite(p[c])) m = std::max(m, p[c]);
+    return m;
+}
+
+std::string fmt(double v) {
+    std::ostringstream o;
+    o.precision(6);
+    o << v;
+    return o.str();
+}
+
+/// The settings that define the reference's model and view: key of the reference cache.
+std::string referenceKey(const RenderSettings& s, const StudyOptions& o) {
+    std::ostringstream k;
+    k.precision(10);
+    k << toString(s.mode) << '|' << toString(s.classification) << '|' << s.transfer.name << '|'
+      << s.kernel << '|' << s.kernelSigma << '|' << s.kernelRadius << '|' << s.shading.enabled
+      << '|' << s.camera.width << 'x' << s.camera.height << '|' << s.camera.azimuthDeg << '|'
+      << s.camera.elevationDeg << '|' << toString(s.camera.projection) << '|' << s.camera.pixelSize
+      << '|' << s.camera.fovDeg << '|' << s.camera.distance << '|' << o.referenceStep << '|'
+      << o.referenceTolerance << '|' << s.background.r << ',' << s.background.g << ','
+      << s.background.b << ',' << s.background.a;
+    return k.str();
+}
+
+class Progress {
+  public:
+    Progress(const ProgressFn& fn, std::size_t total) : fn_(fn), total_(total) {}
+    void step(const std::string& what) {
+        ++done_;
+        if (fn_ && !fn_(done_, std::max(total_, done_), what)) throw Cancelled();
+    }
+
+  private:
+    const ProgressFn& fn_;
+    std::size_t total_, done_ = 0;
+};
+
+}  // namespace
+
+std::vector<std::string> studyKnobNames() {
+    return {"renderer",
+            "slab",
+            "early-termination",
+            "size",
+            "order",
+            "classify",
+            "kernel",
+            "sigma",
+            "radius",
+            "footprint-res",
+            "slab-radial-res",
+            "slab-depth-res",
+            "poly-tol"};
+}
+
+bool isSceneKnob(const std::string& n) {
+    return n == "classify" || n == "kernel" || n == "sigma" || n == "radius" ||
+           n == "footprint-res" || n == "slab-radial-res" || n == "slab-depth-res" ||
+           n == "poly-tol";
+}
+
+void applyKnob(RenderSettings& s, const std::string& n, const std::string& v) {
+    Quality& q = s.quality;
+    if (n == "renderer")
+        s.renderer = parseRenderer(v);
+    else if (n == "slab")
+        q.slab = parseNumber(n, v);
+    else if (n == "early-termination")
+        q.earlyTermination = parseNumber(n, v);
+    else if (n == "size") {
+        int w = 0, h = 0;
+        char x = 0;
+        std::istringstream in(v);
+        if (v.find_first_of("xX") == std::string::npos)
+            w = h = parseInt(n, v);
+        else if (!(in >> w >> x >> h))
+            throw Error("--sweep size: '" + v + "' must be N or WxH");
+        if (w < 1 || h < 1) throw Error("--sweep size: '" + v + "' must be positive");
+        s.camera.width = w;
+        s.camera.height = h;
+    } else if (n == "order")
+        s.order = parseOrder(v);
+    else if (n == "classify")
+        s.classification = parseClassification(v);
+    else if (n == "kernel")
+        s.kernel = v;
+    else if (n == "sigma")
+        s.kernelSigma = parseNumber(n, v);
+    else if (n == "radius")
+        s.kernelRadius = parseNumber(n, v);
+    else if (n == "footprint-res")
+        q.footprintResolution = parseInt(n, v);
+    else if (n == "slab-radial-res")
+        q.slabRadialResolution = parseInt(n, v);
+    else if (n == "slab-depth-res")
+        q.slabDepthResolution = parseInt(n, v);
+    else if (n == "poly-tol")
+        q.polynomialTolerance = parseNumber(n, v);
+    else {
+        std::string all;
+        for (const auto& k : studyKnobNames()) all += (all.empty() ? "" : ", ") + k;
+        throw Error("unknown study knob '" + n + "' (knobs: " + all + ")");
+    }
+}
+
+StudyKnob parseKnob(const std::string& text) {
+    const auto eq = text.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 >= text.size())
+        throw Error("--sweep '" + text + "' must look like KNOB=V1,V2,...");
+    StudyKnob k;
+    k.name = text.substr(0, eq);
+    std::stringstream in(text.substr(eq + 1));
+    std::string item;
+    while (std::getline(in, item, ','))
+        if (!item.empty()) k.values.push_back(item);
+    if (k.values.empty()) throw Error("--sweep '" + text + "' has no values");
+    RenderSettings probe;
+    for (const auto& v : k.values) applyKnob(probe, k.name, v);  // refuse bad values early
+    return k;
+}
+
+std::string StudyPoint::label() const {
+    std::string out;
+    for (const auto& [k, v] : knobs) out += (out.empty() ? "" : " ") + k + "=" + v;
+    return out.empty() ? "base" : out;
+}
+
+void markPareto(std::vector<StudyPoint>& points) {
+    for (auto& p : points) {
+        p.pareto = std::isfinite(p.rmse);
+        for (const auto& q : points)
+            if (&q != &p && q.msMedian <= p.msMedian && q.rmse <= p.rmse &&
+                (q.msMedian < p.msMedian || q.rmse < p.rmse)) {
+                p.pareto = false;
+                break;
+            }
+    }
+}
+
+double fitOrder(const std::vector<double>& h, const std::vector<double>& e) {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int n = 0;
+    for (std::size_t i = 0; i < h.size() && i < e.size(); ++i) {
+        if (!(e[i] > 0) || !(h[i] > 0)) continue;
+        const double x = std::log(h[i]), y = std::log(e[i]);
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+        ++n;
+    }
+    const double den = n * sxx - sx * sx;
+    return n >= 2 && den > 0 ? (n * sxy - sx * sy) / den : 0.0;
+}
+
+Image boxDownsample(const Image& img, int f) {
+    if (f <= 1) return img;
+    Image out(img.width / f, img.height / f);
+    const float inv = 1.0f / float(f * f);
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x) {
+            glm::vec4 sum(0.0f);
+            for (int j = 0; j < f; ++j)
+                for (int i = 0; i < f; ++i) sum += img.at(x * f + i, y * f + j);
+            out.at(x, y) = sum * inv;
+        }
+    return out;
+}
+
+StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings& base,
+                     const StudyOptions& options) {
+    const auto start = Clock::now();
+    if (options.repeats < 1 || options.warmup < 0)
+        throw Error("study: repeats must be >= 1 and warm-up >= 0");
+    StudyResult result;
+    result.base = base;
+    result.options = options;
+    result.options.progress = nullptr;
+    result.volume = volume->source;
+#if defined(SPLAT_STUDY_HAVE_FLIP)
+    result.flipAvailable = true;
+#endif
+    for (const auto& k : options.sweeps) (void)parseKnob(k.name + "=" + k.values.front());
+
+    // Every combination: scene knobs outermost, so that each Scene is built once.
+    std::vector<StudyKnob> knobs = options.sweeps;
+    std::stable_partition(knobs.begin(), knobs.end(),
+                          [](const StudyKnob& k) { return isSceneKnob(k.name); });
+    std::vector<std::vector<std::pair<std::string, std::string>>> combos(1);
+    for (const auto& k : knobs) {
+        std::vector<std::vector<std::pair<std::string, std::string>>> next;
+        for (const auto& c : combos)
+            for (const auto& v : k.values) {
+                auto d = c;
+                d.emplace_back(k.name, v);
+                next.push_back(std::move(d));
+            }
+        combos = std::move(next);
+    }
+    // Slab knobs mean nothing to the axis-aligned splatter and the reference: their
+    // settings are measured once (first slab values) and listed without the slab knobs.
+    auto isSlabKnob = [](const std::string& k) {
+        return k == "slab" || k == "slab-radial-res" || k == "slab-depth-res";
+    };
+    auto isSheet = [&](const std::vector<std::pair<std::string, std::string>>& combo) {
+        RenderSettings probe = base;
+        for (const auto& [k, v] : combo)
+            if (k == "renderer") applyKnob(probe, k, v);
+        return probe.renderer == RendererKind::Sheet;
+    };
+    std::erase_if(combos, [&](const auto& combo) {
+        if (isSheet(combo)) return false;
+        for (const auto& [k, v] : combo)
+            if (isSlabKnob(k))
+                for (const auto& sw : knobs)
+                    if (sw.name == k && v != sw.values.front()) return true;
+        return false;
+    });
+    std::vector<CameraParams> views;
+    if (options.views.empty())
+        views.push_back(base.camera);
+    else
+        for (const glm::dvec2& v : options.views) {
+            CameraParams c = base.camera;
+            c.azimuthDeg = v.x;
+            c.elevationDeg = v.y;
+            views.push_back(c);
+        }
+    Progress progress(options.progress,
+                      combos.size() * views.size() * std::size_t(options.repeats + options.warmup));
+
+    // References: the base model (its scene knobs), per view and image size.
+    std::map<std::string, Image> references;
+    std::unique_ptr<Scene> referenceScene;
+    auto referenceFor = [&](const RenderSettings& frame) -> const Image& {
+        RenderSettings r = base;
+        r.renderer = RendererKind::Reference;
+        r.camera = frame.camera;
+        r.quality.referenceStep = options.referenceStep;
+        r.quality.referenceTolerance = options.referenceTolerance;
+        const std::string key = referenceKey(r, options);
+        auto it = references.find(key);
+        if (it != references.end()) return it->second;
+        const std::string file =
+            options.cacheDir.empty()
+                ? std::string()
+                : (std::filesystem::path(options.cacheDir) /
+                   ("reference_" + std::to_string(std::hash<std::string>{}(key + volume->source)) +
+                    ".exr"))
+                      .string();
+        if (!file.empty() && std::filesystem::exists(file)) {
+            Image img = readImage(file);
+            if (img.width == r.camera.width && img.height == r.camera.height)
+                return references[key] = std::move(img);
+        }
+        if (!referenceScene) referenceScene = std::make_unique<Scene>(volume, r);
+        Image img = referenceScene->render(r);
+        if (!file.empty()) {
+            std::filesystem::create_directories(options.cacheDir);
+            WriteOptions wo;
+            writeImage(file, img, wo);
+        }
+        return references[key] = std::move(img);
+    };
+
+    std::unique_ptr<Scene> scene;
+    std::string sceneKey = "?";
+    for (const auto& combo : combos) {
+        RenderSettings s = base;
+        std::string key;
+        for (const auto& [k, v] : combo) {
+            applyKnob(s, k, v);
+            if (isSceneKnob(k)) key += k + "=" + v + ";";
+        }
+        StudyPoint point;
+        point.knobs = combo;
+        if (!isSheet(combo))
+            std::erase_if(point.knobs, [&](const auto& kv) { return isSlabKnob(kv.first); });
+        // Keep the order of the sweeps as given for the label.
+        std::stable_sort(point.knobs.begin(), point.knobs.end(), [&](const auto& a, const auto& b) {
+            auto pos = [&](const std::string& n) {
+                for (std::size_t i = 0; i < options.sweeps.size(); ++i)
+                    if (options.sweeps[i].name == n) return i;
+                return options.sweeps.size();
+            };
+            return pos(a.first) < pos(b.first);
+        });
+        resetPeakMemory();
+        if (key != sceneKey || !scene) {
+            scene.reset();
+            RenderSettings sceneSettings = s;
+            // The Scene is validated against its first renderer (iso: the reference).
+            scene = std::make_unique<Scene>(volume, sceneSettings);
+            sceneKey = key;
+        }
+        RenderSettings frame = scene->settings();
+        frame.renderer = s.renderer;
+        frame.order = s.order;
+        frame.camera = s.camera;
+        frame.background = s.background;
+        frame.threads = s.threads;
+        frame.quality.slab = s.quality.slab;
+        frame.quality.earlyTermination = s.quality.earlyTermination;
+        frame.quality.referenceStep = s.quality.referenceStep;
+        frame.quality.referenceTolerance = s.quality.referenceTolerance;
+        frame.quality.tileSize = s.quality.tileSize;
+        point.settings = frame;
+        std::vector<double> ms;
+        double sumSq = 0, sumMax = 0, sumFlip = 0;
+        for (std::size_t v = 0; v < views.size(); ++v) {
+            frame.camera = views[v];
+            frame.camera.width = s.camera.width;
+            frame.camera.height = s.camera.height;
+            Image img;
+            RenderStats st;
+            for (int r = 0; r < options.warmup + options.repeats; ++r) {
+                img = scene->render(frame, &st);
+                if (r >= options.warmup) ms.push_back(st.milliseconds);
+                progress.step(point.label());
+            }
+            if (v == 0) {
+                point.splats = st.splats;
+                point.footprintPixels = st.footprintPixels;
+            }
+            result.visibleVoxels = std::max(result.visibleVoxels, st.splats);
+            const double peakHere = peakMemoryMiB();
+            point.peakMiB = std::max(point.peakMiB, peakHere);
+            const Image& ref = referenceFor(frame);
+            const ImageMetrics m = compareImages(img, ref);
+            sumSq += m.rmse * m.rmse;
+            sumMax = std::max(sumMax, m.maxAbs);
+#if defined(SPLAT_STUDY_HAVE_FLIP)
+            const float peak = peakOf(ref);
+            FlipOptions fo;
+            fo.pixelsPerDegree = options.pixelsPerDegree;
+            sumFlip += flipMean(displayValues(img, frame.mode, peak),
+                                displayValues(ref, frame.mode, peak), fo);
+#else
+            (void)sumFlip;
+#endif
+        }
+        point.rmse = std::sqrt(sumSq / double(views.size()));
+        point.maxAbs = sumMax;
+        double refPeak = 0;
+        for (const auto& [k, img] : references) refPeak = std::max(refPeak, double(peakOf(img)));
+        point.psnr = 20.0 * std::log10(std::max(refPeak, 1e-12) / std::max(point.rmse, 1e-300));
+#if defined(SPLAT_STUDY_HAVE_FLIP)
+        point.flip = sumFlip / double(views.size());
+#endif
+        point.msMedian = median(ms);
+        point.msMin = *std::min_element(ms.begin(), ms.end());
+        point.msMax = *std::max_element(ms.begin(), ms.end());
+        std::vector<double> dev;
+        for (double t : ms) dev.push_back(std::abs(t - point.msMedian));
+        point.msMad = median(dev);
+        point.footprintPixelRate =
+            point.msMedian > 0 ? double(point.footprintPixels) / (point.msMedian / 1000.0) : 0;
+        result.points.push_back(std::move(point));
+    }
+    markPareto(result.points);
+    result.totalMs = msSince(start);
+    return result;
+}
+
+std::vector<ConvergenceSeries> studyConvergence(std::shared_ptr<const Volume> volume,
+                                                const RenderSettings& base,
+                                                const ConvergenceOptions& o) {
+    std::vector<ConvergenceSeries> out;
+    const std::size_t total =
+        o.slabs.size() + 1 + o.referenceSteps.size() + 3 * o.sizes.size() + o.sizes.size();
+    Progress progress(o.progress, total);
+    RenderSettings ref = base;
+    ref.renderer = RendererKind::Reference;
+    const Scene scene(volume, ref);
+    RenderSettings frame = scene.settings();
+
+    // Slab: the image-aligned splatter against a fine reference.
+    frame.renderer = RendererKind::Reference;
+    frame.quality.referenceStep = 0.0625;
+    frame.quality.referenceTolerance = 1e-6;
+    const Image fine = scene.render(frame);
+    progress.step("reference");
+    if (base.mode == RenderMode::Dvr || base.mode == RenderMode::Mip) {
+        ConvergenceSeries slab{"slab", RendererKind::Sheet, {}, {}, 0};
+        RenderSettings f = scene.settings();
+        f.renderer = RendererKind::Sheet;
+        f.quality.earlyTermination = 0;
+        for (double t : o.slabs) {
+            f.quality.slab = t;
+            slab.h.push_back(t);
+            slab.error.push_back(compareImages(scene.render(f), fine).rmse);
+            progress.step("slab " + fmt(t));
+        }
+        slab.order = fitOrder(slab.h, slab.error);
+        out.push_back(slab);
+    }
+    // Reference step: a fixed step (no refinement: the tolerance is never met) against
+    // the next finer one (Richardson-style differences).
+    {
+        ConvergenceSeries rs{"reference-step", RendererKind::Reference, {}, {}, 0};
+        std::vector<Image> imgs;
+        RenderSettings f = scene.settings();
+        f.renderer = RendererKind::Reference;
+        f.quality.referenceTolerance = 1e30;
+        for (double h : o.referenceSteps) {
+            f.quality.referenceStep = h;
+            imgs.push_back(scene.render(f));
+            progress.step("reference step " + fmt(h));
+        }
+        for (std::size_t i = 0; i + 1 < imgs.size(); ++i) {
+            rs.h.push_back(o.referenceSteps[i]);
+            rs.error.push_back(compareImages(imgs[i], imgs[i + 1]).rmse);
+        }
+        rs.order = fitOrder(rs.h, rs.error);
+        out.push_back(rs);
+    }
+    // Pixel size: each renderer at N pixels against the reference box-filtered from 4N.
+    {
+        const double side = std::min(base.camera.width, base.camera.height);
+        const Camera probe(base.camera, *volume);
+        const double extent = probe.pixelSize * side;  // world size of the image's short side
+        std::vector<Image> truths;
+        for (int n : o.sizes) {
+            RenderSettings f = scene.settings();
+            f.renderer = RendererKind::Reference;
+            f.camera.width = f.camera.height = 4 * n;
+            f.camera.pixelSize = extent / (4.0 * n);
+            truths.push_back(boxDownsample(scene.render(f), 4));
+            progress.step("box-filtered reference " + std::to_string(n));
+        }
+        for (RendererKind r : {RendererKind::Axis, RendererKind::Sheet, RendererKind::Reference}) {
+            if (base.mode == RenderMode::Iso && r != RendererKind::Reference) continue;
+            ConvergenceSeries ps{"pixel-size", r, {}, {}, 0};
+            for (std::size_t i = 0; i < o.sizes.size(); ++i) {
+                RenderSettings f = scene.settings();
+                f.renderer = r;
+                f.camera.width = f.camera.height = o.sizes[i];
+                f.camera.pixelSize = extent / o.sizes[i];
+                ps.h.push_back(f.camera.pixelSize);
+                ps.error.push_back(compareImages(scene.render(f), truths[i]).rmse);
+                progress.step(std::string(toString(r)) + " " + std::to_string(o.sizes[i]));
+            }
+            ps.order = fitOrder(ps.h, ps.error);
+            out.push_back(ps);
+        }
+    }
+    return out;
+}
+
+}  // namespace splat

@@ -1,0 +1,130 @@
+// `splat study VOLUME [render options] --sweep KNOB=V1,V2,... [--sweep ...] --report DIR
+// [--repeats N] [--warmup N] [--views AZ:EL,...] [--convergence]`: the speed-accuracy
+// study of splat/study.h: every combination of the swept knobs, timed and compared with
+// the reference; Pareto-optimal settings marked; study.csv, study.json, pareto.svg and
+// pareto.png in DIR, the reference cached there.
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include "commands.h"
+#include "progress.h"
+#include "render_options.h"
+#include "splat/error.h"
+#include "splat/study.h"
+#include "volume_options.h"
+
+namespace splat::cli {
+
+namespace {
+struct StudyCommand {
+    VolumeArgs volume;
+    RenderArgs render;
+    std::vector<std::string> sweeps;
+    std::string report, views;
+    int repeats = 5, warmup = 1;
+    double truthStep = 0.125, truthTolerance = 1e-5, ppd = 67;
+    bool convergence = false, quiet = false;
+};
+
+std::vector<glm::dvec2> parseViews(const std::string& text) {
+    std::vector<glm::dvec2> out;
+    std::stringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        const auto colon = item.find(':');
+        try {
+            if (colon == std::string::npos)
+                out.emplace_back(std::stod(item), 0.0);
+            else
+                out.emplace_back(std::stod(item.substr(0, colon)),
+                                 std::stod(item.substr(colon + 1)));
+        } catch (const std::exception&) {
+            throw Error("--views '" + text + "' must look like AZ[:EL],AZ[:EL],...");
+        }
+    }
+    return out;
+}
+
+void printTable(const StudyResult& r) {
+    std::printf("%-40s %10s %8s %10s %10s %9s %8s %9s %s\n", "setting", "ms/frame", "spread",
+                "peak MiB", "rmse", "psnr", "max", "flip", "pareto");
+    for (const StudyPoint& p : r.points)
+        std::printf("%-40s %10.2f %8.2f %10.1f %10.3g %9.2f %8.3g %9.4f %s\n", p.label().c_str(),
+                    p.msMedian, p.msMad, p.peakMiB, p.rmse, p.psnr, p.maxAbs, p.flip,
+                    p.pareto ? "*" : "");
+    for (const ConvergenceSeries& c : r.convergence) {
+        std::printf("convergence %-15s %-9s order %.2f  (", c.parameter.c_str(),
+                    toString(c.renderer), c.order);
+        for (std::size_t i = 0; i < c.h.size(); ++i)
+            std::printf("%sh=%.4g: %.3g", i ? ", " : "", c.h[i], c.error[i]);
+        std::printf(")\n");
+    }
+}
+}  // namespace
+
+void registerStudy(CLI::App& app) {
+    auto a = std::make_shared<StudyCommand>();
+    CLI::App* cmd = app.add_subcommand(
+        "study", "speed vs accuracy: sweep quality knobs, time them, compare with the reference");
+    addVolumeOptions(*cmd, a->volume);
+    addRenderOptions(*cmd, a->render);
+    cmd->add_option("--sweep", a->sweeps,
+                    "KNOB=V1,V2,... (repeatable): renderer, slab, early-termination, size, "
+                    "order, classify, kernel, sigma, radius, footprint-res, slab-radial-res, "
+                    "slab-depth-res, poly-tol");
+    cmd->add_option("--report", a->report,
+                    "report folder (study.csv, study.json, pareto.svg, pareto.png; references "
+                    "cached there)")
+        ->required();
+    cmd->add_option("--repeats", a->repeats, "timed frames per setting and view")
+        ->capture_default_str();
+    cmd->add_option("--warmup", a->warmup, "untimed frames before them")->capture_default_str();
+    cmd->add_option("--views", a->views, "views AZ[:EL],... (default: the camera options)");
+    cmd->add_option("--truth-step", a->truthStep, "reference ray caster step for the ground truth")
+        ->capture_default_str();
+    cmd->add_option("--truth-tolerance", a->truthTolerance, "... and its refinement tolerance")
+        ->capture_default_str();
+    cmd->add_option("--ppd", a->ppd, "LDR-FLIP pixels per degree")->capture_default_str();
+    cmd->add_flag("--convergence", a->convergence,
+                  "also fit the observed convergence orders (slab, reference step, pixel size)");
+    cmd->add_flag("-q,--quiet", a->quiet, "no progress output");
+    cmd->callback([a] {
+        const RenderSettings settings = settingsFromArgs(a->render);
+        StudyOptions o;
+        for (const auto& s : a->sweeps) o.sweeps.push_back(parseKnob(s));
+        if (!a->views.empty()) o.views = parseViews(a->views);
+        o.repeats = a->repeats;
+        o.warmup = a->warmup;
+        if (o.repeats < 1 || o.warmup < 0) throw Error("--repeats must be >= 1, --warmup >= 0");
+        o.referenceStep = a->truthStep;
+        o.referenceTolerance = a->truthTolerance;
+        o.pixelsPerDegree = a->ppd;
+        o.cacheDir = a->report + "/cache";
+        auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
+        installInterruptHandler();
+        ProgressReporter progress("frames", a->quiet);
+        o.progress = [&](std::size_t d, std::size_t t, const std::string& w) {
+            return progress(d, t, w);
+        };
+        StudyResult result;
+        try {
+            result = runStudy(volume, settings, o);
+            if (a->convergence) {
+                ConvergenceOptions co;
+                co.progress = o.progress;
+                result.convergence = studyConvergence(volume, settings, co);
+            }
+        } catch (const Cancelled&) {
+            progress.finish();
+            throw Error("interrupted: no report written");
+        }
+        progress.finish();
+        writeStudyReport(result, a->report, commandLine());
+        printTable(result);
+        std::printf("wrote %s/study.csv, study.json, pareto.svg, pareto.png (%.1f s)\n",
+                    a->report.c_str(), result.totalMs / 1000.0);
+    });
+}
+
+}  // namespace splat::cli
