@@ -56,6 +56,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
                  "headlight Phong shading from the density gradient (pre-classified dvr)");
     cmd.add_option("--scene", a.scene,
                    "scene FILE.json holding any of these options (flags override it)");
+    addTechniqueOptions(cmd, a.technique);
 }
 
 glm::ivec2 parseSize(const std::string& text, const std::string& what) {
@@ -155,7 +156,7 @@ RenderArgs withScene(const RenderArgs& given) {
                 a.tileSize = value.get<int>();
             else if (key == "shade")
                 a.shade = value.get<bool>();
-            else
+            else if (!applyTechniqueSceneKey(key, value, a.technique))
                 throw Error(given.scene + ": unknown scene key '" + key + "'");
         }
     } catch (const nlohmann::json::exception& e) {
@@ -202,11 +203,13 @@ RenderSettings settingsFromArgs(const RenderArgs& given) {
     s.quality.referenceStep = a.refStep;
     s.quality.referenceTolerance = a.refTolerance;
     s.shading.enabled = a.shade;
+    applyTechniqueArgs(a.technique, s);
     return s;
 }
 
 WriteOptions displayOptions(const RenderArgs& a, const RenderSettings& s, const Image& image) {
     WriteOptions o;
+    applyTechniqueOutput(a.technique, o);
     if (s.mode == RenderMode::Dvr || s.mode == RenderMode::Iso) return o;
     o.mapping = DisplayMapping::Window;
     if (!a.window.empty()) {

@@ -7,6 +7,7 @@
 
 #include "splat/image_io.h"
 #include "splat/render.h"
+#include "technique_options.h"
 
 namespace splat::cli {
 
@@ -19,6 +20,7 @@ struct RenderArgs {
     int threads = 0, tileSize = 32;
     bool shade = false;
     CLI::App* cmd = nullptr;
+    TechniqueArgs technique;  ///< technique_options.h
 };
 
 void addRenderOptions(CLI::App& cmd, RenderArgs& args);

@@ -23,9 +23,23 @@ struct SplatList {
     /// Unit normals -grad d / |grad d| (central differences in world units), only when
     /// classify() was asked for them (shading); empty otherwise.
     std::vector<float> nx, ny, nz;
+    /// World gradient of d (central differences), only when asked for (post-classified
+    /// shading or edges, iso in the splatters): the sheets splat it with the same kernel.
+    std::vector<float> gx, gy, gz;
+    /// Largest central-difference gradient magnitude of the volume (edge enhancement's G);
+    /// 0 when not computed.
+    float gradientScale = 0;
     std::size_t voxels = 0;  ///< voxels considered
     std::size_t size() const { return x.size(); }
     std::size_t bytes() const;
+};
+
+/// What a scene asks of classification beyond the transfer function.
+struct ClassifyOptions {
+    bool normals = false;    ///< unit normals (pre-classified shading)
+    bool gradients = false;  ///< gx, gy, gz; voxels with d == 0 but a gradient are kept
+    EdgeEnhancement edges;   ///< pre-classified dvr: rho and e scaled per voxel
+    Clipping clipping;       ///< voxels outside are dropped
 };
 
 /// Builds the splat list. `tf` must be resolved (absolute densities). For `Xray` and
@@ -34,8 +48,14 @@ struct SplatList {
 /// Throws splat::Error if a dimension exceeds 65535.
 SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
                    Classification classification, double radius, bool normals = false);
+SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
+                   Classification classification, double radius, const ClassifyOptions& options);
 
-/// Shaded emission of every splat for a view direction (needs normals).
+/// Largest central-difference gradient magnitude (world units) over the volume.
+float maxGradientMagnitude(const Volume& volume);
+
+/// Shaded emission of every splat for a view direction (needs normals): the Blinn-Phong model
+/// of splat/settings.h, e' = e (ambient + diffuse |n.l|) + specular |n.h|^shininess rho.
 void shadeEmission(const SplatList& splats, const Shading& shading, const glm::dvec3& view,
                    std::vector<float>& r, std::vector<float>& g, std::vector<float>& b);
 

@@ -208,17 +208,35 @@ void raySegments(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& 
     }
 }
 
-/// The fields of one classified scene: density f (one channel), or for pre-classified dvr
-/// extinction and premultiplied emission (four channels). Not copyable (the grids point at
+/// Which fields a ReferenceField holds.
+enum class FieldLayout {
+    Density,          ///< f (one channel): post-classified dvr, mip, xray, iso, views
+    Emission,         ///< rho, e_r, e_g, e_b: pre-classified dvr
+    DensityGradient,  ///< f and the reconstructed central-difference gradient g_x, g_y, g_z
+};
+
+/// The fields of one classified scene (see FieldLayout). Not copyable (the grids point at
 /// the kernel table).
 class ReferenceField {
   public:
     ReferenceField(const Volume& volume, const SplatList& splats, const footprint::Kernel& kernel,
-                   bool preClassifiedDvr);
+                   FieldLayout layout);
     ReferenceField(const ReferenceField&) = delete;
     ReferenceField& operator=(const ReferenceField&) = delete;
 
-    bool fourChannels() const { return four_; }
+    FieldLayout layout() const { return layout_; }
+    bool fourChannels() const { return layout_ != FieldLayout::Density; }
+    /// f at a world position (Density and DensityGradient layouts).
+    double density(const Volume& volume, const glm::dvec3& world) const {
+        double v[4];
+        const glm::dvec3 p = (world - volume.origin) / volume.spacing;
+        if (fourChannels()) {
+            grid4_.eval(p, v);
+        } else {
+            grid1_.eval(p, v);
+        }
+        return v[0];
+    }
     const FieldGrid<4>& grid4() const { return grid4_; }
     const FieldGrid<1>& grid1() const { return grid1_; }
     double radius() const { return radius_; }
@@ -226,7 +244,7 @@ class ReferenceField {
   private:
     KernelLut lut_;
     double radius_;
-    bool four_;
+    FieldLayout layout_;
     FieldGrid<4> grid4_;
     FieldGrid<1> grid1_;
 };

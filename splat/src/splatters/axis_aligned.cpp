@@ -125,9 +125,9 @@ class AxisAligned final : public Splatter {
         const WholeFootprints cutter{m == 0 ? s.i : (m == 1 ? s.j : s.k), in.plan.ascending,
                                      in.plan.sheets, in.scene.table,
                                      in.scene.poly ? &*in.scene.poly : nullptr};
-        return withPolicy(
-            in.settings.mode, in.settings.classification, in.scene.transfer,
-            [&](const auto& policy) { return rasterizeTiles(in, policy, cutter, stats); });
+        return withPolicy(in.policy, [&](const auto& policy) {
+            return rasterizeTiles(in, policy, cutter, stats);
+        });
     }
 };
 

@@ -188,9 +188,9 @@ class ImageAligned final : public Splatter {
                                   work.last,
                                   in.scene.slabTable(),
                                   in.settings.order == CompositeOrder::FrontToBack};
-        return withPolicy(
-            in.settings.mode, in.settings.classification, in.scene.transfer,
-            [&](const auto& policy) { return rasterizeTiles(in, policy, cutter, stats); });
+        return withPolicy(in.policy, [&](const auto& policy) {
+            return rasterizeTiles(in, policy, cutter, stats);
+        });
     }
 };
 
