@@ -11,5 +11,8 @@ void registerRender(CLI::App& app);   // cmd_render.cpp
 void registerRotate(CLI::App& app);   // cmd_rotate.cpp
 void registerCompare(CLI::App& app);  // cmd_compare.cpp
 void registerBench(CLI::App& app);    // cmd_bench.cpp
+void registerSlices(CLI::App& app);   // cmd_slices.cpp
+void registerMpr(CLI::App& app);      // cmd_mpr.cpp
+void registerCpr(CLI::App& app);      // cmd_cpr.cpp
 
 }  // namespace splat::cli

@@ -16,6 +16,9 @@ int main(int argc, char** argv) {
     splat::cli::registerRotate(app);
     splat::cli::registerCompare(app);
     splat::cli::registerBench(app);
+    splat::cli::registerSlices(app);
+    splat::cli::registerMpr(app);
+    splat::cli::registerCpr(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
