@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "splat/error.h"
+#include "splat/volume_io.h"
 
 namespace splat::cli {
 
@@ -174,6 +175,16 @@ void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
         s.clipping.boxMax = glm::max(vec3Of(c, 0), vec3Of(c, 3));
     }
     if (a.bitDepth != 8 && a.bitDepth != 16) throw Error("--bit-depth must be 8 or 16");
+    if (!a.labelColors.empty()) {
+        s.labels = Labels::load(a.labelColors, a.labelNames, float(a.labelOpacity));
+        if (!a.labels.empty())
+            for (double d : parseNumbers(a.labels, "--labels"))
+                s.labels.selection.push_back(int(d));
+        if (!a.labelVolume.empty())
+            s.labels.volume = std::make_shared<const Volume>(loadVolume(a.labelVolume));
+    } else if (!a.labelVolume.empty() || !a.labels.empty() || !a.labelNames.empty()) {
+        throw Error("--label-volume, --labels and --label-names need --label-colors FILE");
+    }
 
     // Never silence: every option that does not apply gets a warning line.
     for (const std::string& line : inapplicableSettings(s)) warn(line);

@@ -29,6 +29,9 @@ struct SplatList {
     /// Largest central-difference gradient magnitude of the volume (edge enhancement's G);
     /// 0 when not computed.
     float gradientScale = 0;
+    /// Segmentation labels: the shown label of each splat's voxel (0: background, or not
+    /// shown), only when the scene has labels.
+    std::vector<float> label;
     std::size_t voxels = 0;  ///< voxels considered
     std::size_t size() const { return x.size(); }
     std::size_t bytes() const;
@@ -40,7 +43,14 @@ struct ClassifyOptions {
     bool gradients = false;  ///< gx, gy, gz; voxels with d == 0 but a gradient are kept
     EdgeEnhancement edges;   ///< pre-classified dvr: rho and e scaled per voxel
     Clipping clipping;       ///< voxels outside are dropped
+    /// Labels (enabled): voxels within the kernel radius of a shown label become splats
+    /// carrying their label (so the background competes at region borders); without a label
+    /// volume the scene volume holds the labels and has no intensity part.
+    const Labels* labels = nullptr;
 };
+
+/// The shown label (Labels::shown) of every voxel of the label volume, 0 elsewhere.
+std::vector<std::uint16_t> shownLabels(const Volume& volume, const Labels& labels);
 
 /// Builds the splat list. `tf` must be resolved (absolute densities). For `Xray` and
 /// `Mip` the transfer function is not used: every voxel with d != 0 is a splat. `radius`

@@ -4,6 +4,7 @@
 // trade speed for accuracy. Every such knob lives in Quality, so that a speed/accuracy
 // study can move any of them; defaults are the figures the README's tables are made with.
 #include <glm/glm.hpp>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -45,6 +46,27 @@ struct EdgeEnhancement {
 struct ClipPlane {
     glm::dvec3 point{0.0}, normal{0.0, 0.0, 1.0};  ///< keeps (x - point) . normal <= 0
 };
+/// Segmentation labels (splat/DESIGN.md "Labels"): a label volume on the scene volume's grid
+/// rendered with a colour and opacity per label, never interpolated: each sheet pixel takes
+/// the label of the voxel whose kernel weighs most there (nearest-label classification; the
+/// reference: the nearest voxel), so only colours of the table appear. With an intensity
+/// volume (the scene's volume) its pre-classified emission is composited with the labels.
+struct Labels {
+    bool enabled = false;
+    /// The labels; null: the scene's volume itself holds them (no intensity part).
+    std::shared_ptr<const Volume> volume;
+    /// Colour and opacity per unit distance, indexed by label (label 0: background).
+    std::vector<glm::vec4> table;
+    std::vector<std::string> names;
+    std::vector<int> selection;  ///< shown labels; empty: all non-zero labels in the table
+    /// The table's entry for `label`, or transparent (unselected, unknown, background).
+    glm::vec4 shown(int label) const;
+    /// From a mricron .lut (256 x RGB, planar bytes) and optional .txt (index name) or a
+    /// JSON table {"labels": [{"index": 1, "name": "...", "color": [r, g, b], "opacity": a}]}
+    /// (colours in [0, 1]); `opacity` for tables without their own.
+    static Labels load(const std::string& colours, const std::string& names, float opacity);
+};
+
 struct Clipping {
     std::vector<ClipPlane> planes;
     bool cropBox = false;
@@ -88,6 +110,7 @@ struct RenderSettings {
     Shading shading;                           ///< dvr (pre and post) and iso
     EdgeEnhancement edges;                     ///< dvr (pre and post)
     Clipping clipping;                         ///< every mode and renderer
+    Labels labels;                             ///< dvr: segmentation labels
     int threads = 0;                           ///< every stage of a frame; 0: all cores
     Quality quality;
 };

@@ -114,7 +114,12 @@ enum class SheetSource {
     Emission,         ///< (rho, e_r, e_g, e_b): pre-classified dvr
     Density,          ///< (d): post-classified dvr, mip, xray
     DensityGradient,  ///< (d, g_x, g_y, g_z): post-classified shading / edges, iso
+    Labels,  ///< (rho, e_r, e_g, e_b) of the intensity, then (weight, label) selected by max
 };
+
+/// Sheets of the label policy: four additive channels, then the largest kernel weight seen at
+/// the pixel and its label (a select, not a sum: labels are never interpolated).
+inline constexpr int kLabelChannels = 6;
 
 /// Everything a policy may need of the frame (built once per frame by frame/renderer.cpp).
 struct PolicyContext {
@@ -130,6 +135,8 @@ struct PolicyContext {
     float invGradientScale = 0;  ///< 1 / G (edge enhancement)
     float isoLevel = 0.5f;
     glm::vec3 isoColour{1.0f};
+    /// Labels: colour and extinction (in a) per shown label; null without labels.
+    const std::vector<glm::vec4>* labelTable = nullptr;
 };
 
 /// Pre-classified dvr: optical depth and emission, alpha = 1 - exp(-tau), C = E a / tau.
@@ -210,6 +217,33 @@ struct IsoPolicy {
     }
 };
 
+/// Segmentation labels (nearest-label classification per sheet pixel): the label whose kernel
+/// weighs most at the pixel fills the ray's path through the sheet with its colour and
+/// extinction, added to the intensity's pre-classified optical depth and emission.
+struct LabelPolicy {
+    static constexpr int kChannels = kLabelChannels;
+    static constexpr bool kTerminates = true;
+    static constexpr SheetSource kSource = SheetSource::Labels;
+    const PolicyContext* ctx;
+    void operator()(TileAccumulator& acc, int p, const float* v, std::size_t plane,
+                    float len) const {
+        float tau = v[0], er = v[plane], eg = v[2 * plane], eb = v[3 * plane];
+        if (v[4 * plane] > 0.0f) {
+            const std::size_t label = std::size_t(v[5 * plane]);
+            const std::vector<glm::vec4>& table = *ctx->labelTable;
+            if (label < table.size() && table[label].a > 0.0f) {
+                const glm::vec4 c = table[label];
+                const float t = c.a * len;
+                tau += t;
+                er += c.r * t;
+                eg += c.g * t;
+                eb += c.b * t;
+            }
+        }
+        if (tau > 0.0f) acc.composite(p, sampleFromOpticalDepth(tau, er, eg, eb));
+    }
+};
+
 /// MIP: the maximum over sheets of the mean of f over the ray's path through each.
 struct MipPolicy {
     static constexpr int kChannels = 1;
@@ -241,6 +275,7 @@ decltype(auto) withPolicy(const PolicyContext& ctx, F&& f) {
         case RenderMode::Iso:
             return f(IsoPolicy{&ctx});
         default:
+            if (ctx.labelTable) return f(LabelPolicy{&ctx});
             if (ctx.classification == Classification::Pre) return f(DvrPrePolicy{});
             if (ctx.gradients) return f(DvrPostGradientPolicy{&ctx});
             return f(DvrPostPolicy{ctx.transfer});

@@ -86,6 +86,8 @@ PolicyContext policyContext(const Scene::Impl& scene, const Camera& camera,
     ctx.invGradientScale = g > 0.0f ? 1.0f / g : 0.0f;
     ctx.isoLevel = float(s.isoLevel);
     ctx.isoColour = glm::vec3(s.transfer.sample(float(s.isoLevel)));
+    if (s.mode == RenderMode::Dvr && scene.settings.labels.enabled)
+        ctx.labelTable = &scene.labelTable;
     return ctx;
 }
 
@@ -144,16 +146,25 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
     return image;
 }
 
+/// The reference's nearest-voxel label lookup (null without labels).
+const LabelLookup* labelLookup(const Scene::Impl& scene) {
+    if (!scene.settings.labels.enabled) return nullptr;
+    thread_local LabelLookup lookup;
+    lookup = {scene.volume->dims, &scene.labelGrid, &scene.labelTable};
+    return &lookup;
+}
+
 Image referenceFrame(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
                      RenderStats& stats, Image* depth) {
     if (!scene.shaded())
         return renderReference(*scene.volume, scene.referenceField(), camera, s, &stats, depth,
-                               scene.splats.gradientScale);
+                               scene.splats.gradientScale, labelLookup(scene));
     // Shaded emission depends on the view: the field is made for this frame.
     SplatList lit = scene.splats;
     shadeEmission(scene.splats, scene.settings.shading, camera.view, lit.r, lit.g, lit.b);
     const ReferenceField field(*scene.volume, lit, scene.kernel, FieldLayout::Emission);
-    return renderReference(*scene.volume, field, camera, s, &stats, depth);
+    return renderReference(*scene.volume, field, camera, s, &stats, depth,
+                           scene.splats.gradientScale, labelLookup(scene));
 }
 
 }  // namespace

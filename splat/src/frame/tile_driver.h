@@ -91,6 +91,13 @@ inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Polic
         v[1] = in.er[id];
         v[2] = in.eg[id];
         v[3] = in.eb[id];
+    } else if constexpr (Policy::kSource == SheetSource::Labels) {
+        v[0] = s.extinction[id];
+        v[1] = in.er[id];
+        v[2] = in.eg[id];
+        v[3] = in.eb[id];
+        v[4] = 1.0f;  // every splat competes for the pixel's label, the background too
+        v[5] = s.label[id];
     } else if constexpr (Policy::kSource == SheetSource::DensityGradient) {
         v[0] = s.density[id];
         v[1] = s.gx[id];

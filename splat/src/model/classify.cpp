@@ -92,6 +92,50 @@ void shadeEmission(const SplatList& s, const Shading& sh, const glm::dvec3& view
                       });
 }
 
+std::vector<std::uint16_t> shownLabels(const Volume& volume, const Labels& labels) {
+    const Volume& lv = labels.volume ? *labels.volume : volume;
+    if (lv.dims != volume.dims)
+        throw Error("the label volume's dimensions differ from the volume's");
+    std::vector<std::uint16_t> out(lv.voxelCount(), 0);
+    for (std::size_t n = 0; n < out.size(); ++n) {
+        const float d = lv.data[n];
+        const int label = d >= 0.0f && d < 65536.0f ? int(std::lround(d)) : 0;
+        if (labels.shown(label).a > 0.0f) out[n] = std::uint16_t(label);
+    }
+    return out;
+}
+
+namespace {
+// Voxels within `r` (box) of a shown label: separable dilation of the label mask.
+std::vector<std::uint8_t> nearLabels(const Volume& v, const std::vector<std::uint16_t>& shown,
+                                     int r) {
+    std::vector<std::uint8_t> m(shown.size()), t(shown.size());
+    for (std::size_t n = 0; n < shown.size(); ++n) m[n] = shown[n] != 0;
+    const glm::ivec3 d = v.dims;
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::size_t stride =
+            axis == 0 ? 1 : (axis == 1 ? std::size_t(d.x) : std::size_t(d.x) * d.y);
+        tbb::parallel_for(0, d.z, [&](int k) {
+            for (int j = 0; j < d.y; ++j)
+                for (int i = 0; i < d.x; ++i) {
+                    const int p[3] = {i, j, k};
+                    const std::size_t n = v.index(i, j, k);
+                    std::uint8_t any = 0;
+                    for (int o = -r; o <= r && !any; ++o) {
+                        const int q = p[axis] + o;
+                        if (q < 0 || q >= d[axis]) continue;
+                        any = m[std::size_t(std::int64_t(n) +
+                                            std::int64_t(o) * std::int64_t(stride))];
+                    }
+                    t[n] = any;
+                }
+        });
+        std::swap(m, t);
+    }
+    return m;
+}
+}  // namespace
+
 float maxGradientMagnitude(const Volume& v) {
     return tbb::parallel_reduce(
         tbb::blocked_range<int>(0, v.dims.z), 0.0f,
@@ -141,8 +185,20 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                           float(glm::length(gradientAt(volume, i, j, k))) * invMaxGradient);
     };
     const bool clips = options.clipping.enabled();
+    const bool labelled = options.labels && options.labels->enabled;
+    const bool intensity = !labelled || options.labels->volume != nullptr;
+    std::vector<std::uint16_t> shown;
+    std::vector<std::uint8_t> near;
+    if (labelled) {
+        shown = shownLabels(volume, *options.labels);
+        near = nearLabels(volume, shown, int(std::ceil(radius)));
+    }
     auto keep = [&](int i, int j, int k, float value) {
         if (clips && !options.clipping.keeps(volume.world(glm::dvec3(i, j, k)))) return false;
+        if (labelled) {
+            if (near[volume.index(i, j, k)]) return true;
+            if (!intensity) return false;
+        }
         if (pre) return tf.extinction(value) > 0.0f && (!edges || edgeOf(i, j, k) > 0.0f);
         if (value == 0.0f && !(gradients && glm::length(gradientAt(volume, i, j, k)) > 0.0))
             return false;
@@ -171,6 +227,7 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
         for (auto* a : {&s.nx, &s.ny, &s.nz}) a->resize(n);
     if (gradients)
         for (auto* a : {&s.gx, &s.gy, &s.gz}) a->resize(n);
+    if (labelled) s.label.resize(n);
     tbb::parallel_for(0, d.z, [&](int k) {
         std::size_t o = count[std::size_t(k)];
         for (int j = 0; j < d.y; ++j)
@@ -185,7 +242,8 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                 s.j[o] = std::uint16_t(j);
                 s.k[o] = std::uint16_t(k);
                 s.density[o] = value;
-                if (usesTf) {
+                if (labelled) s.label[o] = float(shown[volume.index(i, j, k)]);
+                if (usesTf && intensity) {
                     const glm::vec4 c = tf.sample(value);
                     float rho = tf.extinctionFromOpacity(c.a);
                     if (edges) rho *= edgeOf(i, j, k);

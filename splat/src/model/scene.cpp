@@ -44,7 +44,7 @@ bool sameScenePart(const RenderSettings& a, const RenderSettings& b) {
            a.shading.enabled == b.shading.enabled && a.edges.gain == b.edges.gain &&
            a.edges.exponent == b.edges.exponent &&
            a.clipping.planes.size() == b.clipping.planes.size() &&
-           a.clipping.cropBox == b.clipping.cropBox &&
+           a.clipping.cropBox == b.clipping.cropBox && a.labels.enabled == b.labels.enabled &&
            a.quality.footprintResolution == b.quality.footprintResolution &&
            a.quality.slabRadialResolution == b.quality.slabRadialResolution &&
            a.quality.slabDepthResolution == b.quality.slabDepthResolution &&
@@ -93,6 +93,19 @@ Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
     options.gradients = needsGradients();
     if (s.mode == RenderMode::Dvr) options.edges = s.edges;
     options.clipping = s.clipping;
+    if (s.labels.enabled) {
+        if (s.mode != RenderMode::Dvr || s.classification != Classification::Pre)
+            throw Error(
+                "labels are rendered in dvr mode with pre-classified intensity "
+                "(--mode dvr --classify pre)");
+        options.labels = &settings.labels;
+        labelGrid = shownLabels(*volume, settings.labels);
+        labelTable.resize(settings.labels.table.size());
+        for (std::size_t n = 0; n < labelTable.size(); ++n) {
+            const glm::vec4 c = settings.labels.shown(int(n));
+            labelTable[n] = glm::vec4(glm::vec3(c), settings.transfer.extinctionFromOpacity(c.a));
+        }
+    }
     splats =
         classify(*volume, settings.transfer, s.mode, s.classification, kernel.radius(), options);
     transfer = TransferTable(settings.transfer);
@@ -194,6 +207,7 @@ RenderSettings Scene::frameSettings(const RenderSettings& frame) const {
     s.shading = impl_->settings.shading;
     s.edges = impl_->settings.edges;
     s.clipping = impl_->settings.clipping;
+    s.labels = impl_->settings.labels;
     if (s.isoNormalized) {
         s.isoLevel = impl_->minValue + s.isoLevel * (impl_->maxValue - impl_->minValue);
         s.isoNormalized = false;

@@ -42,6 +42,10 @@ struct Scene::Impl {
     Impl(std::shared_ptr<const Volume> v, const RenderSettings& s);
 
     float minValue = 0, maxValue = 0;  ///< of the volume (normalized iso levels)
+    /// Labels: colour and extinction (a) per label as shown, and the shown label of every
+    /// voxel (the reference's nearest-voxel lookup); empty without labels.
+    std::vector<glm::vec4> labelTable;
+    std::vector<std::uint16_t> labelGrid;
 
     /// Pre-classified shading: the view's emission is shaded per splat (stage "shade").
     bool shaded() const {

@@ -107,7 +107,8 @@ struct FieldGrid {
 
 template <int C>
 FieldGrid<C> buildGrid(const Volume& volume, const SplatList& splats, const KernelLut& lut,
-                       double radius, const std::array<const std::vector<float>*, C>& channels) {
+                       double radius, const std::array<const std::vector<float>*, C>& channels,
+                       const std::vector<float>* alsoMark = nullptr) {
     FieldGrid<C> g;
     g.dims = volume.dims;
     g.radius = radius;
@@ -130,6 +131,8 @@ FieldGrid<C> buildGrid(const Volume& volume, const SplatList& splats, const Kern
             g.values[g.index(i, j, k) + c] = v;
             any = any || v != 0.0f;
         }
+        // Labels live outside the channels: their voxels' bricks are marked too.
+        if (alsoMark && s < alsoMark->size() && (*alsoMark)[s] != 0.0f) any = true;
         if (!any) continue;
         // Points within R of voxel p lie in [p - R, p + R]: bricks floor(p / B) ..
         // floor((p + 2R) / B) in the brick frame that starts at -R.
@@ -207,6 +210,28 @@ void raySegments(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& 
         if (cell[axis] < 0 || cell[axis] >= g.nb[axis]) break;
     }
 }
+
+/// Segmentation labels for the reference: the shown label of every voxel and colour and
+/// extinction (a) per label; a point takes the label of its nearest voxel.
+struct LabelLookup {
+    glm::ivec3 dims{0};
+    const std::vector<std::uint16_t>* shown = nullptr;
+    const std::vector<glm::vec4>* table = nullptr;
+    /// Adds the label's (rho, e) at index-space point p to out[0..3].
+    void add(const glm::dvec3& p, float* out) const {
+        const glm::ivec3 q(glm::round(p));
+        if (q.x < 0 || q.y < 0 || q.z < 0 || q.x >= dims.x || q.y >= dims.y || q.z >= dims.z)
+            return;
+        const std::size_t label =
+            (*shown)[(std::size_t(q.z) * dims.y + std::size_t(q.y)) * dims.x + std::size_t(q.x)];
+        if (label == 0 || label >= table->size()) return;
+        const glm::vec4 c = (*table)[label];
+        out[0] += c.a;
+        out[1] += c.r * c.a;
+        out[2] += c.g * c.a;
+        out[3] += c.b * c.a;
+    }
+};
 
 /// Which fields a ReferenceField holds.
 enum class FieldLayout {

@@ -83,6 +83,7 @@ class Caster {
     }
     /// 1 / G for edge enhancement (the splat list's gradient scale).
     void setGradientScale(float g) { invGradientScale_ = g > 0.0f ? 1.0f / g : 0.0f; }
+    void setLabels(const LabelLookup* labels) { labels_ = labels; }
 
     Image render(RenderStats* stats, Image* depth) {
         const int w = camera_.width(), h = camera_.height();
@@ -124,6 +125,7 @@ class Caster {
         g.eval(p0 + t * v, val);
         if constexpr (C == 4) {
             for (int c = 0; c < 4; ++c) out[c] = float(val[c]);
+            if (labels_) labels_->add(p0 + t * v, out);
         } else {
             out[0] = float(val[0]);
         }
@@ -398,6 +400,7 @@ class Caster {
     bool shadePost_ = false, edgesPost_ = false;
     LightFrame light_;
     float invGradientScale_ = 0;
+    const LabelLookup* labels_ = nullptr;
 };
 
 }  // namespace
@@ -409,9 +412,10 @@ void validateReferenceKernel(const footprint::Kernel& kernel) {
 
 Image renderReference(const Volume& volume, const ReferenceField& field, const Camera& camera,
                       const RenderSettings& settings, RenderStats* stats, Image* depth,
-                      float gradientScale) {
+                      float gradientScale, const LabelLookup* labels) {
     Caster caster(volume, field, camera, settings);
     caster.setGradientScale(gradientScale);
+    caster.setLabels(labels);
     return caster.render(stats, depth);
 }
 

@@ -24,7 +24,7 @@ inline FieldLayout fieldLayout(const RenderSettings& s, const SplatList& splats)
 /// `gradientScale`: the splat list's G (edge enhancement).
 Image renderReference(const Volume& volume, const ReferenceField& field, const Camera& camera,
                       const RenderSettings& settings, RenderStats* stats, Image* depth,
-                      float gradientScale = 0);
+                      float gradientScale = 0, const LabelLookup* labels = nullptr);
 
 void validateReferenceKernel(const footprint::Kernel& kernel);
 

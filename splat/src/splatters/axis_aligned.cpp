@@ -29,47 +29,48 @@ int splatFootprint(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx
                    const footprint::EllipticalFootprint& e, const PixelRect& rect,
                    const footprint::FootprintTable& table, const footprint::FootprintPoly* poly) {
 #if defined(FOOTPRINT_HAVE_LANES)
-    const int ox = sheet.originX(), oy = sheet.originY();
-    const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
-    sheet.markDirty(x0, x1, y0, y1);
-    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
-    const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
-    const __m256 vMax = _mm256_set1_ps(table.r2Max()), zero = _mm256_setzero_ps();
-    const footprint::FootprintLanes footprintOf(table, poly);
-    __m256 vv[NCh];
-    for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
-    for (int y = y0; y <= y1; ++y) {
-        const float dy = float(y + oy) + 0.5f - sy;
-        // r^2 = a (dx + beta dy)^2 + gamma dy^2 (EllipticalFootprint::r2).
-        const float gyy = e.gamma * dy * dy, shift = e.beta * dy;
-        const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(shift);
-        const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
-        const __m256 firstX = _mm256_set1_ps(float(x0) - 0.5f);
-        for (int x = x0 & ~7; x <= x1; x += 8) {
-            const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
-            const __m256 q =
-                _mm256_add_ps(_mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx)), vshift);
-            const __m256 r2 = _mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy);
-            const __m256 inside =
-                _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
-                              _mm256_and_ps(_mm256_cmp_ps(px, lastX, _CMP_LT_OQ),
-                                            _mm256_cmp_ps(px, firstX, _CMP_GT_OQ)));
-            const __m256 fp = footprintOf(_mm256_max_ps(r2, zero));
-            const __m256 w = _mm256_and_ps(inside, _mm256_mul_ps(fp, vScale));
-            for (int c = 0; c < NCh; ++c) {
-                float* p = sheet.row(c, y) + x;
-                _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
+    if constexpr (NCh != kLabelChannels) {  // labels select by max: the scalar loop below
+        const int ox = sheet.originX(), oy = sheet.originY();
+        const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
+        sheet.markDirty(x0, x1, y0, y1);
+        const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
+        const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
+        const __m256 vMax = _mm256_set1_ps(table.r2Max()), zero = _mm256_setzero_ps();
+        const footprint::FootprintLanes footprintOf(table, poly);
+        __m256 vv[NCh];
+        for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+        for (int y = y0; y <= y1; ++y) {
+            const float dy = float(y + oy) + 0.5f - sy;
+            // r^2 = a (dx + beta dy)^2 + gamma dy^2 (EllipticalFootprint::r2).
+            const float gyy = e.gamma * dy * dy, shift = e.beta * dy;
+            const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(shift);
+            const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
+            const __m256 firstX = _mm256_set1_ps(float(x0) - 0.5f);
+            for (int x = x0 & ~7; x <= x1; x += 8) {
+                const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
+                const __m256 q =
+                    _mm256_add_ps(_mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx)), vshift);
+                const __m256 r2 = _mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy);
+                const __m256 inside =
+                    _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
+                                  _mm256_and_ps(_mm256_cmp_ps(px, lastX, _CMP_LT_OQ),
+                                                _mm256_cmp_ps(px, firstX, _CMP_GT_OQ)));
+                const __m256 fp = footprintOf(_mm256_max_ps(r2, zero));
+                const __m256 w = _mm256_and_ps(inside, _mm256_mul_ps(fp, vScale));
+                for (int c = 0; c < NCh; ++c) {
+                    float* p = sheet.row(c, y) + x;
+                    _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
+                }
             }
         }
+        return (x1 - x0 + 1) * (y1 - y0 + 1);
     }
-    return (x1 - x0 + 1) * (y1 - y0 + 1);
-#else
+#endif
     // Without AVX2 the table's own lookup is as fast as the polynomial and exact.
     (void)poly;
     const float scale = e.scale;
     return sheet.splat(values, sx, sy, e, rect,
                        [&](float r2, float, float) { return table.lookup(r2) * scale; });
-#endif
 }
 
 /// Each splat lies in the one sheet of its slice along the major axis.

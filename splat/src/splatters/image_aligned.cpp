@@ -34,54 +34,58 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
                   const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
                   const float* tb) {
 #if defined(FOOTPRINT_HAVE_LANES)
-    const footprint::FootprintTable& fpTable = table.footprint();
-    const int ox = sheets[0]->originX(), oy = sheets[0]->originY();
-    const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
-    for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
-    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), zero = _mm256_setzero_ps();
-    const __m256 signBit = _mm256_set1_ps(-0.0f);
-    const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
-    const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
-    const footprint::FootprintLanes footprintOf(fpTable, poly);
-    const footprint::FractionLanes fraction(table);
-    const __m256 vds = _mm256_set1_ps(e.depthScale), vtx = _mm256_set1_ps(e.tx);
-    __m256 vv[NCh];
-    for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
-    for (int y = y0; y <= y1; ++y) {
-        const float dy = float(y + oy) + 0.5f - sy;
-        const __m256 vgyy = _mm256_set1_ps(e.gamma * dy * dy), vshift = _mm256_set1_ps(e.beta * dy);
-        const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
-        const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
-        for (int x = x0; x <= x1; x += 8) {
-            const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
-            const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
-            const __m256 q = _mm256_add_ps(dx, vshift);
-            const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), zero);
-            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
-                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
-            const __m256 weight = _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vScale));
-            const footprint::FractionLanes::Radial radial = fraction.radial(r2);
-            const __m256 tc = _mm256_fmadd_ps(vtx, dx, vtyy);
-            // Kernel-space depth of boundary b along these rays: z = depthScale (t - tc).
-            auto depth = [&](int b) {
-                return _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc));
-            };
-            __m256 below = fraction(radial, depth(0));
-            for (int j = 0; j < n; ++j) {
-                const __m256 above = fraction(radial, depth(j + 1));
-                // |F(above) - F(below)|: the boundaries run back to front when compositing is.
-                const __m256 w =
-                    _mm256_mul_ps(weight, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
-                below = above;
-                for (int c = 0; c < NCh; ++c) {
-                    float* p = sheets[j]->row(c, y) + x;
-                    _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
+    if constexpr (NCh != kLabelChannels) {  // labels select by max: the scalar loop below
+        const footprint::FootprintTable& fpTable = table.footprint();
+        const int ox = sheets[0]->originX(), oy = sheets[0]->originY();
+        const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
+        for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
+        const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), zero = _mm256_setzero_ps();
+        const __m256 signBit = _mm256_set1_ps(-0.0f);
+        const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
+        const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
+        const footprint::FootprintLanes footprintOf(fpTable, poly);
+        const footprint::FractionLanes fraction(table);
+        const __m256 vds = _mm256_set1_ps(e.depthScale), vtx = _mm256_set1_ps(e.tx);
+        __m256 vv[NCh];
+        for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+        for (int y = y0; y <= y1; ++y) {
+            const float dy = float(y + oy) + 0.5f - sy;
+            const __m256 vgyy = _mm256_set1_ps(e.gamma * dy * dy),
+                         vshift = _mm256_set1_ps(e.beta * dy);
+            const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
+            const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
+            for (int x = x0; x <= x1; x += 8) {
+                const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
+                const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
+                const __m256 q = _mm256_add_ps(dx, vshift);
+                const __m256 r2 =
+                    _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), zero);
+                const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
+                                                    _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
+                const __m256 weight = _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vScale));
+                const footprint::FractionLanes::Radial radial = fraction.radial(r2);
+                const __m256 tc = _mm256_fmadd_ps(vtx, dx, vtyy);
+                // Kernel-space depth of boundary b along these rays: z = depthScale (t - tc).
+                auto depth = [&](int b) {
+                    return _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc));
+                };
+                __m256 below = fraction(radial, depth(0));
+                for (int j = 0; j < n; ++j) {
+                    const __m256 above = fraction(radial, depth(j + 1));
+                    // |F(above) - F(below)|: the boundaries run back to front when compositing is.
+                    const __m256 w = _mm256_mul_ps(
+                        weight, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
+                    below = above;
+                    for (int c = 0; c < NCh; ++c) {
+                        float* p = sheets[j]->row(c, y) + x;
+                        _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
+                    }
                 }
             }
         }
+        return n * (x1 - x0 + 1) * (y1 - y0 + 1);
     }
-    return n * (x1 - x0 + 1) * (y1 - y0 + 1);
-#else
+#endif
     (void)poly;
     int visited = 0;
     const float ds = e.depthScale, tx = e.tx, ty = e.ty, scale = e.scale;
@@ -93,7 +97,6 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
         });
     }
     return visited;
-#endif
 }
 
 /// Each splat is cut into the slabs first..last it crosses.
