@@ -100,7 +100,7 @@ TEST_CASE("render refuses bad options and outputs with one line and no file", "[
     };
     const Bad cases[] = {
         {{"--renderer", "magic"}, "unknown renderer 'magic'"},
-        {{"--mode", "iso"}, "reference"},
+        {{"--bit-depth", "12"}, "--bit-depth"},
         {{"--slab", "0", "--renderer", "sheet"}, "slab thickness"},
         {{"--size", "0x10"}, "--size"},
         {{"--size", "banana"}, "--size"},

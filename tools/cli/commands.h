@@ -18,5 +18,8 @@ void registerStudy(CLI::App& app);    // cmd_study.cpp
 /// The command line as typed (for reports that say how to reproduce them).
 const std::string& commandLine();
 void setCommandLine(int argc, char** argv);
+void registerSlices(CLI::App& app);   // cmd_slices.cpp
+void registerMpr(CLI::App& app);      // cmd_mpr.cpp
+void registerCpr(CLI::App& app);      // cmd_cpr.cpp
 
 }  // namespace splat::cli

@@ -19,6 +19,9 @@ int main(int argc, char** argv) {
     splat::cli::registerPopping(app);
     splat::cli::registerStudy(app);
     splat::cli::setCommandLine(argc, argv);
+    splat::cli::registerSlices(app);
+    splat::cli::registerMpr(app);
+    splat::cli::registerCpr(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -60,6 +60,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
         ->capture_default_str();
     cmd.add_option("--scene", a.scene,
                    "scene FILE.json holding any of these options (flags override it)");
+    addTechniqueOptions(cmd, a.technique);
 }
 
 glm::ivec2 parseSize(const std::string& text, const std::string& what) {
@@ -161,7 +162,7 @@ RenderArgs withScene(const RenderArgs& given) {
                 a.shade = value.get<bool>();
             else if (key == "distance")  // issue 12
                 a.distance = value.get<double>();
-            else
+            else if (!applyTechniqueSceneKey(key, value, a.technique))
                 throw Error(given.scene + ": unknown scene key '" + key + "'");
         }
     } catch (const nlohmann::json::exception& e) {
@@ -209,11 +210,13 @@ RenderSettings settingsFromArgs(const RenderArgs& given) {
     s.quality.referenceStep = a.refStep;
     s.quality.referenceTolerance = a.refTolerance;
     s.shading.enabled = a.shade;
+    applyTechniqueArgs(a.technique, s);
     return s;
 }
 
 WriteOptions displayOptions(const RenderArgs& a, const RenderSettings& s, const Image& image) {
     WriteOptions o;
+    applyTechniqueOutput(a.technique, o);
     if (s.mode == RenderMode::Dvr || s.mode == RenderMode::Iso) return o;
     o.mapping = DisplayMapping::Window;
     if (!a.window.empty()) {

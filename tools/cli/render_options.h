@@ -7,6 +7,7 @@
 
 #include "splat/image_io.h"
 #include "splat/render.h"
+#include "technique_options.h"
 
 namespace splat::cli {
 
@@ -21,6 +22,7 @@ struct RenderArgs {
     // Issue 12 (study branch): perspective eye distance from the volume centre.
     double distance = 0;
     CLI::App* cmd = nullptr;
+    TechniqueArgs technique;  ///< technique_options.h
 };
 
 void addRenderOptions(CLI::App& cmd, RenderArgs& args);

@@ -23,10 +23,34 @@ struct SplatList {
     /// Unit normals -grad d / |grad d| (central differences in world units), only when
     /// classify() was asked for them (shading); empty otherwise.
     std::vector<float> nx, ny, nz;
+    /// World gradient of d (central differences), only when asked for (post-classified
+    /// shading or edges, iso in the splatters): the sheets splat it with the same kernel.
+    std::vector<float> gx, gy, gz;
+    /// Largest central-difference gradient magnitude of the volume (edge enhancement's G);
+    /// 0 when not computed.
+    float gradientScale = 0;
+    /// Segmentation labels: the shown label of each splat's voxel (0: background, or not
+    /// shown), only when the scene has labels.
+    std::vector<float> label;
     std::size_t voxels = 0;  ///< voxels considered
     std::size_t size() const { return x.size(); }
     std::size_t bytes() const;
 };
+
+/// What a scene asks of classification beyond the transfer function.
+struct ClassifyOptions {
+    bool normals = false;    ///< unit normals (pre-classified shading)
+    bool gradients = false;  ///< gx, gy, gz; voxels with d == 0 but a gradient are kept
+    EdgeEnhancement edges;   ///< pre-classified dvr: rho and e scaled per voxel
+    Clipping clipping;       ///< voxels outside are dropped
+    /// Labels (enabled): voxels within the kernel radius of a shown label become splats
+    /// carrying their label (so the background competes at region borders); without a label
+    /// volume the scene volume holds the labels and has no intensity part.
+    const Labels* labels = nullptr;
+};
+
+/// The shown label (Labels::shown) of every voxel of the label volume, 0 elsewhere.
+std::vector<std::uint16_t> shownLabels(const Volume& volume, const Labels& labels);
 
 /// Builds the splat list. `tf` must be resolved (absolute densities). For `Xray` and
 /// `Mip` the transfer function is not used: every voxel with d != 0 is a splat. `radius`
@@ -34,8 +58,14 @@ struct SplatList {
 /// Throws splat::Error if a dimension exceeds 65535.
 SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
                    Classification classification, double radius, bool normals = false);
+SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
+                   Classification classification, double radius, const ClassifyOptions& options);
 
-/// Shaded emission of every splat for a view direction (needs normals).
+/// Largest central-difference gradient magnitude (world units) over the volume.
+float maxGradientMagnitude(const Volume& volume);
+
+/// Shaded emission of every splat for a view direction (needs normals): the Blinn-Phong model
+/// of splat/settings.h, e' = e (ambient + diffuse |n.l|) + specular |n.h|^shininess rho.
 void shadeEmission(const SplatList& splats, const Shading& shading, const glm::dvec3& view,
                    std::vector<float>& r, std::vector<float>& g, std::vector<float>& b);
 

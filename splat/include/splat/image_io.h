@@ -18,6 +18,11 @@ enum class DisplayMapping {
 struct WriteOptions {
     DisplayMapping mapping = DisplayMapping::Srgb;
     float windowLow = 0.0f, windowHigh = 1.0f;
+    /// .png: 8 or 16 bits per channel.
+    int bitDepth = 8;
+    /// .png: an alpha channel (the image's alpha; a transparent background stays
+    /// transparent). Colour is written un-premultiplied, as PNG expects.
+    bool alpha = false;
 };
 
 /// Writes `.png`, `.gif`, `.jpg` (8-bit display values, RGB) or `.exr`, `.tif`/`.tiff`

@@ -33,6 +33,9 @@ class Scene {
     /// and tolerance, tile size); its scene part (mode, classification, kernel, shading,
     /// table resolutions) must equal the Scene's, or splat::Error is thrown.
     Image render(const RenderSettings& frame, RenderStats* stats = nullptr) const;
+    /// Iso mode, any renderer: per pixel the world distance along the ray from Camera::ray's
+    /// origin to the first hit of f = level in r (alpha 1), (0, 0, 0, 0) where the ray misses.
+    Image renderIsoDepth(const RenderSettings& frame, RenderStats* stats = nullptr) const;
     /// The Scene's settings with another renderer and camera.
     Image render(RendererKind renderer, const CameraParams& camera,
                  RenderStats* stats = nullptr) const;
@@ -47,6 +50,7 @@ class Scene {
     const Impl& impl() const { return *impl_; }
 
   private:
+    RenderSettings frameSettings(const RenderSettings& frame) const;
     std::unique_ptr<Impl> impl_;
 };
 

@@ -4,6 +4,7 @@
 // trade speed for accuracy. Every such knob lives in Quality, so that a speed/accuracy
 // study can move any of them; defaults are the figures the README's tables are made with.
 #include <glm/glm.hpp>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,13 +19,60 @@ enum class RenderMode { Dvr, Mip, Xray, Iso };
 enum class Classification { Pre, Post };
 enum class CompositeOrder { FrontToBack, BackToFront };
 
-/// Headlight Blinn-Phong style shading of pre-classified emission (DESIGN: modelled only
-/// when asked for): e' = e (ambient + diffuse |n.l|) + specular |n.l|^shininess rho, with
-/// the light at the eye (l = -view), two-sided. The reference's iso surfaces use the same
-/// ambient and diffuse terms.
+/// Blinn-Phong shading, one model for every renderer and mode (splat/DESIGN.md "Shading"):
+///   c' = c (ambient + diffuse |n.l|) + specular |n.h|^shininess
+/// for a colour c and unit normal n (two-sided), l the direction towards the light and h the
+/// half vector between l and the direction towards the eye. Pre-classified dvr shades the
+/// premultiplied emission (e' = e (ambient + diffuse |n.l|) + specular |n.h|^s rho), post-
+/// classified dvr each sample's colour, iso the surface colour. The light is fixed to the
+/// camera (headlight: l = h = -view) or given as a world direction towards the light.
 struct Shading {
     bool enabled = false;
     float ambient = 0.35f, diffuse = 0.65f, specular = 0.25f, shininess = 24.0f;
+    bool headlight = true;              ///< light at the eye; else `light` (world)
+    glm::vec3 light{0.0f, 0.0f, 1.0f};  ///< world direction towards the light (normalised)
+};
+
+/// Edge enhancement (Levoy's gradient-magnitude opacity): rho' = rho max(0, 1 + gain (m^exponent
+/// - 1)) with m = |grad d| / G, G the volume's largest central-difference gradient magnitude.
+/// gain 0 is the plain render, gain 1 rho m^exponent.
+struct EdgeEnhancement {
+    float gain = 0.0f, exponent = 1.0f;
+    bool enabled() const { return gain != 0.0f; }
+};
+
+/// Clipping in world units, applied to the voxels (a voxel outside is not a splat, in every
+/// renderer: the cut face shows the data up to the cut, blurred by the kernel).
+struct ClipPlane {
+    glm::dvec3 point{0.0}, normal{0.0, 0.0, 1.0};  ///< keeps (x - point) . normal <= 0
+};
+/// Segmentation labels (splat/DESIGN.md "Labels"): a label volume on the scene volume's grid
+/// rendered with a colour and opacity per label, never interpolated: each sheet pixel takes
+/// the label of the voxel whose kernel weighs most there (nearest-label classification; the
+/// reference: the nearest voxel), so only colours of the table appear. With an intensity
+/// volume (the scene's volume) its pre-classified emission is composited with the labels.
+struct Labels {
+    bool enabled = false;
+    /// The labels; null: the scene's volume itself holds them (no intensity part).
+    std::shared_ptr<const Volume> volume;
+    /// Colour and opacity per unit distance, indexed by label (label 0: background).
+    std::vector<glm::vec4> table;
+    std::vector<std::string> names;
+    std::vector<int> selection;  ///< shown labels; empty: all non-zero labels in the table
+    /// The table's entry for `label`, or transparent (unselected, unknown, background).
+    glm::vec4 shown(int label) const;
+    /// From a mricron .lut (256 x RGB, planar bytes) and optional .txt (index name) or a
+    /// JSON table {"labels": [{"index": 1, "name": "...", "color": [r, g, b], "opacity": a}]}
+    /// (colours in [0, 1]); `opacity` for tables without their own.
+    static Labels load(const std::string& colours, const std::string& names, float opacity);
+};
+
+struct Clipping {
+    std::vector<ClipPlane> planes;
+    bool cropBox = false;
+    glm::dvec3 boxMin{0.0}, boxMax{0.0};  ///< world, inclusive
+    bool enabled() const { return cropBox || !planes.empty(); }
+    bool keeps(const glm::dvec3& x) const;
 };
 
 /// Every knob that trades speed for accuracy.
@@ -58,7 +106,11 @@ struct RenderSettings {
     double kernelSigma = 0, kernelRadius = 0;  ///< 0: the kernel's defaults
     glm::vec4 background{0.0f};                ///< premultiplied RGBA behind the volume
     double isoLevel = 0.5;                     ///< iso mode: level of f (absolute density)
-    Shading shading;                           ///< pre-classified dvr
+    bool isoNormalized = false;                ///< isoLevel is a fraction of [min, max]
+    Shading shading;                           ///< dvr (pre and post) and iso
+    EdgeEnhancement edges;                     ///< dvr (pre and post)
+    Clipping clipping;                         ///< every mode and renderer
+    Labels labels;                             ///< dvr: segmentation labels
     int threads = 0;                           ///< every stage of a frame; 0: all cores
     Quality quality;
 };
@@ -103,5 +155,9 @@ RenderMode parseMode(std::string_view);
 Classification parseClassification(std::string_view);
 CompositeOrder parseOrder(std::string_view);
 Projection parseProjection(std::string_view);
+
+/// One line per setting that does not apply to the chosen mode/classification (e.g.
+/// shading in xray): the command line prints them as warnings.
+std::vector<std::string> inapplicableSettings(const RenderSettings&);
 
 }  // namespace splat

@@ -12,7 +12,7 @@ constexpr int kBlock = 4;  // early-termination granularity, pixels (64 blocks p
 }
 
 TileAccumulator::TileAccumulator(int width, int height, CompositeOrder order,
-                                 double earlyTermination)
+                                 double earlyTermination, bool surface)
     : w_(width),
       h_(height),
       order_(order),
@@ -28,6 +28,20 @@ TileAccumulator::TileAccumulator(int width, int height, CompositeOrder order,
     g_.assign(n, 0.0f);
     b_.assign(n, 0.0f);
     a_.assign(n, 0.0f);
+    if (surface) {
+        prev_.assign(n, 0.0f);
+        pos_.assign(n, -1.0f);
+    }
+}
+
+void TileAccumulator::resolvePositions(Image& image, int ox, int oy) const {
+    for (int y = 0; y < h_; ++y)
+        for (int x = 0; x < w_; ++x) {
+            const int p = y * w_ + x;
+            const bool hit = !pos_.empty() && a_[p] >= 1.0f;
+            image.at(ox + x, oy + y) =
+                glm::vec4(hit ? pos_[p] : 0.0f, 0.0f, 0.0f, hit ? 1.0f : 0.0f);
+        }
 }
 
 bool TileAccumulator::rectOpaque(int x0, int y0, int x1, int y1) const {
@@ -60,14 +74,14 @@ void TileAccumulator::resolve(Image& image, int ox, int oy, RenderMode mode) con
     for (int y = 0; y < h_; ++y)
         for (int x = 0; x < w_; ++x) {
             const int p = y * w_ + x;
-            image.at(ox + x, oy + y) = mode == RenderMode::Dvr
+            image.at(ox + x, oy + y) = mode == RenderMode::Dvr || mode == RenderMode::Iso
                                            ? glm::vec4(r_[p], g_[p], b_[p], a_[p])
                                            : glm::vec4(r_[p], r_[p], r_[p], 1.0f);
         }
 }
 
 void applyBackground(Image& image, RenderMode mode, const glm::vec4& bg) {
-    if (mode != RenderMode::Dvr) return;
+    if (mode != RenderMode::Dvr && mode != RenderMode::Iso) return;
     for (glm::vec4& out : image.pixels) out = out + (1.0f - out.a) * bg;
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "frame/transfer_table.h"
+#include "model/shading_model.h"
 #include "splat/image.h"
 #include "splat/settings.h"
 
@@ -29,7 +30,9 @@ inline Sample sampleFromOpticalDepth(float tau, float er, float eg, float eb) {
 /// dvr; for mip the running maximum and for xray the running sum, both in r.
 class TileAccumulator {
   public:
-    TileAccumulator(int width, int height, CompositeOrder order, double earlyTermination);
+    /// `surface`: iso compositing, which keeps the previous sample and the hit position.
+    TileAccumulator(int width, int height, CompositeOrder order, double earlyTermination,
+                    bool surface = false);
 
     int width() const { return w_; }
     int height() const { return h_; }
@@ -53,6 +56,24 @@ class TileAccumulator {
     void maximum(int p, float v) { r_[p] = std::max(r_[p], v); }
     void add(int p, float v) { r_[p] += v; }
 
+    /// The sheet being flushed, in visiting order (set by the tile sweep).
+    void setSheet(std::uint32_t k) { sheet_ = k; }
+    std::uint32_t sheet() const { return sheet_; }
+    /// Iso: hit already? the previous sheet's value; record a hit (shaded colour, opaque) at
+    /// the fractional sheet position `position` (sheet centres at integers).
+    bool hit(int p) const { return a_[p] >= 1.0f; }
+    float previous(int p) const { return prev_[p]; }
+    void setPrevious(int p, float v) { prev_[p] = v; }
+    void surfaceHit(int p, const glm::vec3& c, float position) {
+        r_[p] = c.r;
+        g_[p] = c.g;
+        b_[p] = c.b;
+        a_[p] = 1.0f;
+        pos_[p] = position;
+    }
+    /// Iso: writes the hit positions (r; alpha 1 where hit, 0 where not) at (ox, oy).
+    void resolvePositions(Image& image, int ox, int oy) const;
+
     /// Early termination (front-to-back dvr only): true when every pixel of the tile, or
     /// of the 4x4 blocks overlapping the tile-local inclusive rectangle, is opaque.
     bool terminates() const { return terminates_; }
@@ -73,23 +94,56 @@ class TileAccumulator {
     float threshold_;
     int blocksX_, blocksY_;
     std::uint64_t opaqueBlocks_ = 0, allBlocks_ = 0;
+    std::uint32_t sheet_ = 0;
     std::vector<float> r_, g_, b_, a_;
+    std::vector<float> prev_, pos_;  // iso only
 };
 
-/// The last step of a frame: dvr pixels are composited over the background,
+/// The last step of a frame: dvr and iso pixels are composited over the background,
 /// I = C + (1 - a) I_bg; other modes have none.
 void applyBackground(Image& image, RenderMode mode, const glm::vec4& background);
 
 // ---- compositing policies: one home per render mode -------------------------------
-// A policy says how many channels a sheet pixel holds, how a sheet pixel becomes a
-// compositing sample (sheet -> sample) and how it is accumulated. `v` points at the
-// pixel's first channel, channels `plane` floats apart; `len` is the world length of the
-// pixel's ray through the sheet.
+// A policy says how many channels a sheet pixel holds and where they come from (kSource),
+// how a sheet pixel becomes a compositing sample (sheet -> sample) and how it is
+// accumulated. `v` points at the pixel's first channel, channels `plane` floats apart;
+// `len` is the world length of the pixel's ray through the sheet.
+
+/// What a splat contributes to a sheet's channels.
+enum class SheetSource {
+    Emission,         ///< (rho, e_r, e_g, e_b): pre-classified dvr
+    Density,          ///< (d): post-classified dvr, mip, xray
+    DensityGradient,  ///< (d, g_x, g_y, g_z): post-classified shading / edges, iso
+    Labels,  ///< (rho, e_r, e_g, e_b) of the intensity, then (weight, label) selected by max
+};
+
+/// Sheets of the label policy: four additive channels, then the largest kernel weight seen at
+/// the pixel and its label (a select, not a sum: labels are never interpolated).
+inline constexpr int kLabelChannels = 6;
+
+/// Everything a policy may need of the frame (built once per frame by frame/renderer.cpp).
+struct PolicyContext {
+    RenderMode mode = RenderMode::Dvr;
+    Classification classification = Classification::Pre;
+    const TransferTable* transfer = nullptr;
+    /// Post-classified dvr carries gradient channels (shading or edges on).
+    bool gradients = false;
+    bool shade = false;  ///< post-classified dvr: shade each sample
+    Shading shading;
+    LightFrame light;
+    EdgeEnhancement edges;
+    float invGradientScale = 0;  ///< 1 / G (edge enhancement)
+    float isoLevel = 0.5f;
+    glm::vec3 isoColour{1.0f};
+    /// Labels: colour and extinction (in a) per shown label; null without labels.
+    const std::vector<glm::vec4>* labelTable = nullptr;
+};
 
 /// Pre-classified dvr: optical depth and emission, alpha = 1 - exp(-tau), C = E a / tau.
 struct DvrPrePolicy {
     static constexpr int kChannels = 4;
     static constexpr bool kTerminates = true;
+    static constexpr SheetSource kSource = SheetSource::Emission;
     void operator()(TileAccumulator& acc, int p, const float* v, std::size_t plane, float) const {
         acc.composite(p, sampleFromOpticalDepth(v[0], v[plane], v[2 * plane], v[3 * plane]));
     }
@@ -100,6 +154,7 @@ struct DvrPrePolicy {
 struct DvrPostPolicy {
     static constexpr int kChannels = 1;
     static constexpr bool kTerminates = true;
+    static constexpr SheetSource kSource = SheetSource::Density;
     const TransferTable* transfer;
     void operator()(TileAccumulator& acc, int p, const float* v, std::size_t, float len) const {
         float rho, r, g, b;
@@ -109,10 +164,91 @@ struct DvrPostPolicy {
     }
 };
 
+/// Post-classified dvr with gradient channels: the mean density is classified, its opacity
+/// scaled by the edge factor of the mean gradient's magnitude and its colour shaded with the
+/// mean gradient as the normal (the one model of model/shading_model.h).
+struct DvrPostGradientPolicy {
+    static constexpr int kChannels = 4;
+    static constexpr bool kTerminates = true;
+    static constexpr SheetSource kSource = SheetSource::DensityGradient;
+    const PolicyContext* ctx;
+    void operator()(TileAccumulator& acc, int p, const float* v, std::size_t plane,
+                    float len) const {
+        const float inv = 1.0f / len;
+        float rho, r, g, b;
+        ctx->transfer->lookup(v[0] * inv, rho, r, g, b);
+        const float gx = v[plane] * inv, gy = v[2 * plane] * inv, gz = v[3 * plane] * inv;
+        if (ctx->edges.enabled())
+            rho *= edgeFactor(ctx->edges,
+                              std::sqrt(gx * gx + gy * gy + gz * gz) * ctx->invGradientScale);
+        if (ctx->shade) {
+            const LightTerms t = blinnPhongGradient(ctx->shading, ctx->light, gx, gy, gz);
+            r = r * t.diffuse + t.specular;
+            g = g * t.diffuse + t.specular;
+            b = b * t.diffuse + t.specular;
+        }
+        const float alpha = -std::expm1(-rho * len);
+        acc.composite(p, {alpha, r * alpha, g * alpha, b * alpha});
+    }
+};
+
+/// Iso surface through the sheets (front to back): the first sheet whose mean density
+/// reaches the level after one below it is the hit; its position is interpolated linearly
+/// between the two sheet centres and the surface is shaded with the sheet's mean gradient.
+struct IsoPolicy {
+    static constexpr int kChannels = 4;
+    static constexpr bool kTerminates = true;
+    static constexpr SheetSource kSource = SheetSource::DensityGradient;
+    const PolicyContext* ctx;
+    void operator()(TileAccumulator& acc, int p, const float* v, std::size_t plane,
+                    float len) const {
+        if (acc.hit(p)) return;
+        const float inv = 1.0f / len;
+        const float f = v[0] * inv, prev = acc.previous(p), level = ctx->isoLevel;
+        if (f >= level && prev < level) {
+            const float t = (level - prev) / (f - prev);
+            const LightTerms l = blinnPhongGradient(ctx->shading, ctx->light, v[plane] * inv,
+                                                    v[2 * plane] * inv, v[3 * plane] * inv);
+            const float spec = ctx->shading.enabled ? l.specular : 0.0f;
+            acc.surfaceHit(p, ctx->isoColour * l.diffuse + spec, float(acc.sheet()) - 1.0f + t);
+        } else {
+            acc.setPrevious(p, f);
+        }
+    }
+};
+
+/// Segmentation labels (nearest-label classification per sheet pixel): the label whose kernel
+/// weighs most at the pixel fills the ray's path through the sheet with its colour and
+/// extinction, added to the intensity's pre-classified optical depth and emission.
+struct LabelPolicy {
+    static constexpr int kChannels = kLabelChannels;
+    static constexpr bool kTerminates = true;
+    static constexpr SheetSource kSource = SheetSource::Labels;
+    const PolicyContext* ctx;
+    void operator()(TileAccumulator& acc, int p, const float* v, std::size_t plane,
+                    float len) const {
+        float tau = v[0], er = v[plane], eg = v[2 * plane], eb = v[3 * plane];
+        if (v[4 * plane] > 0.0f) {
+            const std::size_t label = std::size_t(v[5 * plane]);
+            const std::vector<glm::vec4>& table = *ctx->labelTable;
+            if (label < table.size() && table[label].a > 0.0f) {
+                const glm::vec4 c = table[label];
+                const float t = c.a * len;
+                tau += t;
+                er += c.r * t;
+                eg += c.g * t;
+                eb += c.b * t;
+            }
+        }
+        if (tau > 0.0f) acc.composite(p, sampleFromOpticalDepth(tau, er, eg, eb));
+    }
+};
+
 /// MIP: the maximum over sheets of the mean of f over the ray's path through each.
 struct MipPolicy {
     static constexpr int kChannels = 1;
     static constexpr bool kTerminates = false;
+    static constexpr SheetSource kSource = SheetSource::Density;
     void operator()(TileAccumulator& acc, int p, const float* v, std::size_t, float len) const {
         acc.maximum(p, v[0] / len);
     }
@@ -122,24 +258,27 @@ struct MipPolicy {
 struct XrayPolicy {
     static constexpr int kChannels = 1;
     static constexpr bool kTerminates = false;
+    static constexpr SheetSource kSource = SheetSource::Density;
     void operator()(TileAccumulator& acc, int p, const float* v, std::size_t, float) const {
         acc.add(p, v[0]);
     }
 };
 
-/// Calls f(policy) with the compositing policy of `mode` and `classification` (iso has
-/// none: the splatters do not render it).
+/// Calls f(policy) with the compositing policy of the frame's mode and classification.
 template <class F>
-decltype(auto) withPolicy(RenderMode mode, Classification classification,
-                          const TransferTable& transfer, F&& f) {
-    switch (mode) {
+decltype(auto) withPolicy(const PolicyContext& ctx, F&& f) {
+    switch (ctx.mode) {
         case RenderMode::Mip:
             return f(MipPolicy{});
         case RenderMode::Xray:
             return f(XrayPolicy{});
+        case RenderMode::Iso:
+            return f(IsoPolicy{&ctx});
         default:
-            return classification == Classification::Pre ? f(DvrPrePolicy{})
-                                                         : f(DvrPostPolicy{&transfer});
+            if (ctx.labelTable) return f(LabelPolicy{&ctx});
+            if (ctx.classification == Classification::Pre) return f(DvrPrePolicy{});
+            if (ctx.gradients) return f(DvrPostGradientPolicy{&ctx});
+            return f(DvrPostPolicy{ctx.transfer});
     }
 }
 

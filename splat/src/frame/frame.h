@@ -9,6 +9,8 @@ void validateFrame(const RenderSettings& settings);
 
 /// Renders `settings.renderer`'s frame of `scene`; every stage runs on at most
 /// settings.threads threads.
-Image renderFrame(const Scene::Impl& scene, const RenderSettings& settings, RenderStats* stats);
+/// With `depth` (iso only): the hit depths as well (Scene::renderIsoDepth).
+Image renderFrame(const Scene::Impl& scene, const RenderSettings& settings, RenderStats* stats,
+                  Image* depth = nullptr);
 
 }  // namespace splat

@@ -70,8 +70,56 @@ void bin(const Camera& camera, const RenderSettings& s, FrameWorkspace& work, Re
     stats.binMs = msSince(start);
 }
 
+/// The compositing policy's parameters for this frame.
+PolicyContext policyContext(const Scene::Impl& scene, const Camera& camera,
+                            const RenderSettings& s) {
+    PolicyContext ctx;
+    ctx.mode = s.mode;
+    ctx.classification = s.classification;
+    ctx.transfer = &scene.transfer;
+    const bool postDvr = s.mode == RenderMode::Dvr && s.classification == Classification::Post;
+    ctx.gradients = postDvr && scene.needsGradients();
+    ctx.shade = postDvr && s.shading.enabled;
+    ctx.shading = s.shading;
+    ctx.light = lightFrame(s.shading, camera.view);
+    if (postDvr) ctx.edges = s.edges;
+    const float g = scene.splats.gradientScale;
+    ctx.invGradientScale = g > 0.0f ? 1.0f / g : 0.0f;
+    ctx.isoLevel = float(s.isoLevel);
+    ctx.isoColour = glm::vec3(s.transfer.sample(float(s.isoLevel)));
+    if (s.mode == RenderMode::Dvr && scene.settings.labels.enabled)
+        ctx.labelTable = &scene.labelTable;
+    return ctx;
+}
+
+/// Iso: the hit positions (fractional sheets in visiting order) as world distances along
+/// each pixel's ray from Camera::ray's origin.
+Image isoDepthFromSheets(const Image& positions, const SheetPlan& plan, const Camera& camera,
+                         const Volume& volume) {
+    Image depth(positions.width, positions.height);
+    for (int y = 0; y < positions.height; ++y)
+        for (int x = 0; x < positions.width; ++x) {
+            const glm::vec4 p = positions.at(x, y);
+            if (p.a == 0.0f) continue;
+            const Ray ray = camera.ray(x + 0.5, y + 0.5);
+            double t;
+            if (plan.axis >= 0) {  // axis-aligned: the slice plane index = sigma
+                const int m = plan.axis;
+                const double sigma = plan.ascending ? p.r : double(plan.sheets) - 1.0 - p.r;
+                const double p0 = (ray.origin[m] - volume.origin[m]) / volume.spacing[m];
+                t = (sigma - p0) / (ray.dir[m] / volume.spacing[m]);
+            } else {  // image-aligned: slab centres
+                const double d = plan.depthOrigin + (double(p.r) + 0.5) * plan.thickness;
+                t = d / glm::dot(ray.dir, camera.view) -
+                    glm::dot(ray.origin - camera.eye, camera.view);
+            }
+            depth.at(x, y) = glm::vec4(glm::vec3(float(t)), 1.0f);
+        }
+    return depth;
+}
+
 Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
-                 RenderStats& stats) {
+                 RenderStats& stats, Image* depth) {
     const Splatter& splatter =
         s.renderer == RendererKind::Axis ? axisAlignedSplatter() : imageAlignedSplatter();
     const WorkspaceLease work(scene);
@@ -79,21 +127,45 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
     project(scene, camera, *work, stats);
     const SheetPlan plan = order(splatter, scene, camera, s, *work, stats);
     bin(camera, s, *work, stats);
-    const TileInputs in{scene, camera, s, work->proj, work->bins, plan, e.r, e.g, e.b};
+    const PolicyContext ctx = policyContext(scene, camera, s);
+    Image positions;
+    if (depth) positions = Image(camera.width(), camera.height());
+    const TileInputs in{scene,
+                        camera,
+                        s,
+                        work->proj,
+                        work->bins,
+                        plan,
+                        e.r,
+                        e.g,
+                        e.b,
+                        ctx,
+                        depth ? &positions : nullptr};
     Image image = splatter.rasterize(in, *work, &stats);
     applyBackground(image, s.mode, s.background);
+    if (depth) *depth = isoDepthFromSheets(positions, plan, camera, *scene.volume);
     return image;
 }
 
+/// The reference's nearest-voxel label lookup (null without labels).
+const LabelLookup* labelLookup(const Scene::Impl& scene) {
+    if (!scene.settings.labels.enabled) return nullptr;
+    thread_local LabelLookup lookup;
+    lookup = {scene.volume->dims, &scene.labelGrid, &scene.labelTable};
+    return &lookup;
+}
+
 Image referenceFrame(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
-                     RenderStats& stats) {
+                     RenderStats& stats, Image* depth) {
     if (!scene.shaded())
-        return renderReference(*scene.volume, scene.referenceField(), camera, s, &stats, nullptr);
+        return renderReference(*scene.volume, scene.referenceField(), camera, s, &stats, depth,
+                               scene.splats.gradientScale, labelLookup(scene));
     // Shaded emission depends on the view: the field is made for this frame.
     SplatList lit = scene.splats;
     shadeEmission(scene.splats, scene.settings.shading, camera.view, lit.r, lit.g, lit.b);
-    const ReferenceField field(*scene.volume, lit, scene.kernel, true);
-    return renderReference(*scene.volume, field, camera, s, &stats, nullptr);
+    const ReferenceField field(*scene.volume, lit, scene.kernel, FieldLayout::Emission);
+    return renderReference(*scene.volume, field, camera, s, &stats, depth,
+                           scene.splats.gradientScale, labelLookup(scene));
 }
 
 /// True when a perspective frame has a kernel whose bounding sphere comes within two of its
@@ -125,8 +197,6 @@ bool needsExactPath(const Scene::Impl& scene, const Camera& camera) {
 
 void validateFrame(const RenderSettings& s) {
     const Quality& q = s.quality;
-    if (s.renderer != RendererKind::Reference && s.mode == RenderMode::Iso)
-        throw Error("iso mode is rendered by the reference ray caster only (--renderer reference)");
     if (!(q.slab > 0) || !std::isfinite(q.slab) || q.slab > 1e4)
         throw Error("slab thickness must be a positive number of voxels (got " +
                     std::to_string(q.slab) + ")");
@@ -144,9 +214,13 @@ void validateFrame(const RenderSettings& s) {
             throw Error("background must be in [0, 1]");
 }
 
-Image renderFrame(const Scene::Impl& scene, const RenderSettings& s, RenderStats* stats) {
+Image renderFrame(const Scene::Impl& scene, const RenderSettings& given, RenderStats* stats,
+                  Image* depth) {
     const auto start = Clock::now();
-    validateFrame(s);
+    validateFrame(given);
+    RenderSettings s = given;
+    // Iso in the splatters is the first hit front to back (inapplicableSettings warns).
+    if (s.mode == RenderMode::Iso) s.order = CompositeOrder::FrontToBack;
     RenderStats local;
     local.splats = scene.splats.size();
     local.voxels = scene.splats.voxels;
@@ -156,12 +230,12 @@ Image renderFrame(const Scene::Impl& scene, const RenderSettings& s, RenderStats
         const Camera camera(s.camera, *scene.volume);
         local.perspective = camera.perspective();
         if (s.renderer == RendererKind::Reference) {
-            image = referenceFrame(scene, camera, s, local);
+            image = referenceFrame(scene, camera, s, local, depth);
         } else if (needsExactPath(scene, camera)) {
-            image = referenceFrame(scene, camera, s, local);
+            image = referenceFrame(scene, camera, s, local, depth);
             local.exactPixels = std::size_t(camera.width()) * std::size_t(camera.height());
         } else {
-            image = splatFrame(scene, camera, s, local);
+            image = splatFrame(scene, camera, s, local, depth);
         }
     });
     local.milliseconds = msSince(start);

@@ -52,7 +52,16 @@ class SheetBuffer {
                 const float q = dx + shift;
                 const float r2 = e.a * q * q + gyy;
                 const float wgt = weight(r2, dx, dy);
-                for (int c = 0; c < NCh; ++c) row[c * plane_ + x] += values[c] * wgt;
+                if constexpr (NCh == kLabelChannels) {
+                    for (int c = 0; c < 4; ++c) row[c * plane_ + x] += values[c] * wgt;
+                    const float w = values[4] * wgt;
+                    if (w > row[4 * plane_ + x]) {
+                        row[4 * plane_ + x] = w;
+                        row[5 * plane_ + x] = values[5];
+                    }
+                } else {
+                    for (int c = 0; c < NCh; ++c) row[c * plane_ + x] += values[c] * wgt;
+                }
             }
         }
         return (x1 - x0 + 1) * (y1 - y0 + 1);

@@ -17,6 +17,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "frame/compositing.h"
@@ -54,7 +55,9 @@ struct TileInputs {
     const ProjectedSplats& proj;
     const TileBins& bins;
     const SheetPlan& plan;
-    const float *er, *eg, *eb;  ///< emission to splat: the list's own or this view's shaded
+    const float *er, *eg, *eb;      ///< emission to splat: the list's own or this view's shaded
+    const PolicyContext& policy;    ///< the frame's compositing policy and its parameters
+    Image* isoPositions = nullptr;  ///< iso: per pixel, the hit's fractional sheet position
 };
 
 /// Per-tile counters, summed into RenderStats.
@@ -79,16 +82,29 @@ class DenormalsAreZero {
 /// |view . axis| / |dir . axis|; empty for orthographic views.
 std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& axis);
 
-/// The values a splat contributes to a sheet: (rho, e_r, e_g, e_b) or (density).
-template <int NCh>
-inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[NCh]) {
-    if constexpr (NCh == 4) {
-        v[0] = in.scene.splats.extinction[id];
+/// The values a splat contributes to a sheet, in the channels of the policy's source.
+template <class Policy>
+inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Policy::kChannels]) {
+    const SplatList& s = in.scene.splats;
+    if constexpr (Policy::kSource == SheetSource::Emission) {
+        v[0] = s.extinction[id];
         v[1] = in.er[id];
         v[2] = in.eg[id];
         v[3] = in.eb[id];
+    } else if constexpr (Policy::kSource == SheetSource::Labels) {
+        v[0] = s.extinction[id];
+        v[1] = in.er[id];
+        v[2] = in.eg[id];
+        v[3] = in.eb[id];
+        v[4] = 1.0f;  // every splat competes for the pixel's label, the background too
+        v[5] = s.label[id];
+    } else if constexpr (Policy::kSource == SheetSource::DensityGradient) {
+        v[0] = s.density[id];
+        v[1] = s.gx[id];
+        v[2] = s.gy[id];
+        v[3] = s.gz[id];
     } else {
-        v[0] = in.scene.splats.density[id];
+        v[0] = s.density[id];
     }
 }
 
@@ -123,7 +139,7 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
             const std::uint32_t n = cutter.span(id);
             for (std::uint32_t j = 0; j < n; ++j) target[j] = &sheets[(step + j) % ring];
             float v[NCh];
-            splatValues<NCh>(in, id, v);
+            splatValues<Policy>(in, id, v);
             cnt.footprintPixels += cutter.cut(target.data(), id, v, in.proj.sx[id], in.proj.sy[id],
                                               in.proj.ellipse(id), r);
             pendingEnd = std::max(pendingEnd, step + n - 1);
@@ -131,6 +147,7 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
         }
         SheetBuffer<NCh>& sheet = sheets[step % ring];
         if (sheet.dirty()) {
+            acc.setSheet(step);
             sheet.flush(acc, policy, in.plan.pathLength, tileScale);
             ++cnt.sheets;
         }
@@ -157,8 +174,10 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
         const DenormalsAreZero ftz;  // footprint tails must not hit slow denormal paths
         const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
         const int w = std::min(g.tileSize, g.width - ox), h = std::min(g.tileSize, g.height - oy);
+        constexpr bool surface = std::is_same_v<Policy, IsoPolicy>;
         TileAccumulator acc(w, h, in.settings.order,
-                            Policy::kTerminates ? in.settings.quality.earlyTermination : 0.0);
+                            Policy::kTerminates ? in.settings.quality.earlyTermination : 0.0,
+                            surface);
         if (in.bins.begin[t] != in.bins.begin[t + 1]) {
             std::vector<float> tileScale;
             if (!pathScale.empty()) {
@@ -171,6 +190,7 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
                       counters[t]);
         }
         acc.resolve(image, ox, oy, in.settings.mode);
+        if (surface && in.isoPositions) acc.resolvePositions(*in.isoPositions, ox, oy);
     });
     if (stats) {
         stats->pathScalePixels = pathScale.size();
@@ -189,9 +209,8 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
 /// rasterizeTiles with the compositing policy of the frame's mode.
 template <class Cutter>
 Image rasterizeWithPolicy(const TileInputs& in, const Cutter& cutter, RenderStats* stats) {
-    return withPolicy(
-        in.settings.mode, in.settings.classification, in.scene.transfer,
-        [&](const auto& policy) { return rasterizeTiles(in, policy, cutter, stats); });
+    return withPolicy(in.policy,
+                      [&](const auto& policy) { return rasterizeTiles(in, policy, cutter, stats); });
 }
 
 }  // namespace splat

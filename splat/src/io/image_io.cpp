@@ -24,11 +24,14 @@ float srgbEncode(float x) {
 
 namespace {
 
-std::vector<float> displayValues(const Image& image, const WriteOptions& o) {
-    std::vector<float> out(std::size_t(image.width) * image.height * 3);
+std::vector<float> displayValues(const Image& image, const WriteOptions& o, int channels = 3) {
+    std::vector<float> out(std::size_t(image.width) * image.height * channels);
     const float span = o.windowHigh > o.windowLow ? o.windowHigh - o.windowLow : 1.0f;
     for (std::size_t n = 0; n < image.pixels.size(); ++n) {
-        const glm::vec4 c = image.pixels[n];
+        glm::vec4 c = image.pixels[n];
+        // With alpha, colour is stored un-premultiplied (PNG convention).
+        if (channels == 4 && o.mapping == DisplayMapping::Srgb && c.a > 0.0f && c.a < 1.0f)
+            c = glm::vec4(glm::vec3(c) / c.a, c.a);
         for (int ch = 0; ch < 3; ++ch) {
             float v;
             if (o.mapping == DisplayMapping::Window)
@@ -37,8 +40,10 @@ std::vector<float> displayValues(const Image& image, const WriteOptions& o) {
                 v = std::clamp(std::isfinite(c[ch]) ? c[ch] : 0.0f, 0.0f, 1.0f);
             else
                 v = srgbEncode(std::isfinite(c[ch]) ? c[ch] : 0.0f);
-            out[n * 3 + ch] = v;
+            out[n * channels + ch] = v;
         }
+        if (channels == 4)
+            out[n * channels + 3] = std::clamp(std::isfinite(c.a) ? c.a : 0.0f, 0.0f, 1.0f);
     }
     return out;
 }
@@ -73,8 +78,16 @@ void writeImage(const std::string& path, const Image& image, const WriteOptions&
         spec.alpha_channel = 3;
         ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
     } else {
-        const std::vector<float> v = displayValues(image, options);
-        OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+        const bool png = ext == ".png";
+        if (options.bitDepth != 8 && !(png && options.bitDepth == 16))
+            throw Error(path + ": bit depth " + std::to_string(options.bitDepth) +
+                        " is not supported (8, or 16 for .png)");
+        const int channels = png && options.alpha ? 4 : 3;
+        const std::vector<float> v = displayValues(image, options, channels);
+        OIIO::ImageSpec spec(
+            image.width, image.height, channels,
+            options.bitDepth == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
+        if (channels == 4) spec.alpha_channel = 3;
         ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, v.data());
     }
     const std::string err = out->geterror();

@@ -3,11 +3,13 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
+#include "model/shading_model.h"
 #include "splat/error.h"
 
 namespace splat {
@@ -46,7 +48,7 @@ std::vector<char> neededBricks(const Volume& v, const TransferFunction& tf, int 
 
 // -grad d / |grad d| by central differences (one-sided at the border), in world units; 0
 // where the gradient vanishes.
-glm::dvec3 normalAt(const Volume& v, int i, int j, int k) {
+glm::dvec3 gradientAt(const Volume& v, int i, int j, int k) {
     glm::dvec3 g(0.0);
     const int p[3] = {i, j, k};
     for (int a = 0; a < 3; ++a) {
@@ -57,6 +59,11 @@ glm::dvec3 normalAt(const Volume& v, int i, int j, int k) {
         g[a] = (double(v.at(hi[0], hi[1], hi[2])) - v.at(lo[0], lo[1], lo[2])) /
                ((hi[a] - lo[a]) * v.spacing[a]);
     }
+    return g;
+}
+
+glm::dvec3 normalAt(const Volume& v, int i, int j, int k) {
+    const glm::dvec3 g = gradientAt(v, i, j, k);
     const double len = glm::length(g);
     return len > 0 ? -g / len : glm::dvec3(0.0);
 }
@@ -69,23 +76,77 @@ void shadeEmission(const SplatList& s, const Shading& sh, const glm::dvec3& view
     r.resize(n);
     g.resize(n);
     b.resize(n);
-    const glm::vec3 l = -glm::vec3(view);
+    const LightFrame light = lightFrame(sh, view);
     const bool hasNormals = s.nx.size() == n;
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, n, 8192),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t q = range.begin(); q != range.end(); ++q) {
-                const float c =
-                    hasNormals ? std::abs(s.nx[q] * l.x + s.ny[q] * l.y + s.nz[q] * l.z) : 1.0f;
-                const float diffuse = sh.ambient + sh.diffuse * c;
-                const float spec =
-                    c > 0.0f ? sh.specular * std::exp(sh.shininess * std::log(c)) * s.extinction[q]
-                             : 0.0f;
-                r[q] = s.r[q] * diffuse + spec;
-                g[q] = s.g[q] * diffuse + spec;
-                b[q] = s.b[q] * diffuse + spec;
-            }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t q = range.begin(); q != range.end(); ++q) {
+                              const LightTerms t =
+                                  hasNormals ? blinnPhong(sh, light, s.nx[q], s.ny[q], s.nz[q])
+                                             : LightTerms{sh.ambient + sh.diffuse, sh.specular};
+                              const float spec = t.specular * s.extinction[q];
+                              r[q] = s.r[q] * t.diffuse + spec;
+                              g[q] = s.g[q] * t.diffuse + spec;
+                              b[q] = s.b[q] * t.diffuse + spec;
+                          }
+                      });
+}
+
+std::vector<std::uint16_t> shownLabels(const Volume& volume, const Labels& labels) {
+    const Volume& lv = labels.volume ? *labels.volume : volume;
+    if (lv.dims != volume.dims)
+        throw Error("the label volume's dimensions differ from the volume's");
+    std::vector<std::uint16_t> out(lv.voxelCount(), 0);
+    for (std::size_t n = 0; n < out.size(); ++n) {
+        const float d = lv.data[n];
+        const int label = d >= 0.0f && d < 65536.0f ? int(std::lround(d)) : 0;
+        if (labels.shown(label).a > 0.0f) out[n] = std::uint16_t(label);
+    }
+    return out;
+}
+
+namespace {
+// Voxels within `r` (box) of a shown label: separable dilation of the label mask.
+std::vector<std::uint8_t> nearLabels(const Volume& v, const std::vector<std::uint16_t>& shown,
+                                     int r) {
+    std::vector<std::uint8_t> m(shown.size()), t(shown.size());
+    for (std::size_t n = 0; n < shown.size(); ++n) m[n] = shown[n] != 0;
+    const glm::ivec3 d = v.dims;
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::size_t stride =
+            axis == 0 ? 1 : (axis == 1 ? std::size_t(d.x) : std::size_t(d.x) * d.y);
+        tbb::parallel_for(0, d.z, [&](int k) {
+            for (int j = 0; j < d.y; ++j)
+                for (int i = 0; i < d.x; ++i) {
+                    const int p[3] = {i, j, k};
+                    const std::size_t n = v.index(i, j, k);
+                    std::uint8_t any = 0;
+                    for (int o = -r; o <= r && !any; ++o) {
+                        const int q = p[axis] + o;
+                        if (q < 0 || q >= d[axis]) continue;
+                        any = m[std::size_t(std::int64_t(n) +
+                                            std::int64_t(o) * std::int64_t(stride))];
+                    }
+                    t[n] = any;
+                }
         });
+        std::swap(m, t);
+    }
+    return m;
+}
+}  // namespace
+
+float maxGradientMagnitude(const Volume& v) {
+    return tbb::parallel_reduce(
+        tbb::blocked_range<int>(0, v.dims.z), 0.0f,
+        [&](const tbb::blocked_range<int>& ks, float m) {
+            for (int k = ks.begin(); k != ks.end(); ++k)
+                for (int j = 0; j < v.dims.y; ++j)
+                    for (int i = 0; i < v.dims.x; ++i)
+                        m = std::max(m, float(glm::length(gradientAt(v, i, j, k))));
+            return m;
+        },
+        [](float a, float b) { return std::max(a, b); });
 }
 
 std::size_t SplatList::bytes() const {
@@ -94,6 +155,14 @@ std::size_t SplatList::bytes() const {
 
 SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
                    Classification classification, double radius, bool normals) {
+    ClassifyOptions o;
+    o.normals = normals;
+    return classify(volume, tf, mode, classification, radius, o);
+}
+
+SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
+                   Classification classification, double radius, const ClassifyOptions& options) {
+    const bool normals = options.normals;
     const glm::ivec3 d = volume.dims;
     if (d.x > 65535 || d.y > 65535 || d.z > 65535)
         throw Error("volume dimension above 65535 is not supported by the splat list");
@@ -106,9 +175,33 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
     std::vector<char> need;
     if (usesTf && !pre) need = neededBricks(volume, tf, int(std::ceil(radius)), bricks);
 
+    const bool edges = pre && options.edges.enabled();
+    const bool gradients = options.gradients;
+    const float maxGradient = edges || gradients ? maxGradientMagnitude(volume) : 0.0f;
+    const float invMaxGradient = maxGradient > 0.0f ? 1.0f / maxGradient : 0.0f;
+    // Edge enhancement of pre-classified opacity: the factor of voxel (i, j, k).
+    auto edgeOf = [&](int i, int j, int k) {
+        return edgeFactor(options.edges,
+                          float(glm::length(gradientAt(volume, i, j, k))) * invMaxGradient);
+    };
+    const bool clips = options.clipping.enabled();
+    const bool labelled = options.labels && options.labels->enabled;
+    const bool intensity = !labelled || options.labels->volume != nullptr;
+    std::vector<std::uint16_t> shown;
+    std::vector<std::uint8_t> near;
+    if (labelled) {
+        shown = shownLabels(volume, *options.labels);
+        near = nearLabels(volume, shown, int(std::ceil(radius)));
+    }
     auto keep = [&](int i, int j, int k, float value) {
-        if (pre) return tf.extinction(value) > 0.0f;
-        if (value == 0.0f) return false;
+        if (clips && !options.clipping.keeps(volume.world(glm::dvec3(i, j, k)))) return false;
+        if (labelled) {
+            if (near[volume.index(i, j, k)]) return true;
+            if (!intensity) return false;
+        }
+        if (pre) return tf.extinction(value) > 0.0f && (!edges || edgeOf(i, j, k) > 0.0f);
+        if (value == 0.0f && !(gradients && glm::length(gradientAt(volume, i, j, k)) > 0.0))
+            return false;
         if (need.empty()) return true;
         return need[(std::size_t(k / kBrick) * bricks.y + j / kBrick) * bricks.x + i / kBrick] != 0;
     };
@@ -125,12 +218,16 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
     for (int k = 0; k < d.z; ++k) count[std::size_t(k) + 1] += count[std::size_t(k)];
 
     SplatList s;
+    s.gradientScale = maxGradient;
     const std::size_t n = count.back();
     s.voxels = volume.voxelCount();
     for (auto* a : {&s.x, &s.y, &s.z, &s.density, &s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
     for (auto* a : {&s.i, &s.j, &s.k}) a->resize(n);
     if (normals)
         for (auto* a : {&s.nx, &s.ny, &s.nz}) a->resize(n);
+    if (gradients)
+        for (auto* a : {&s.gx, &s.gy, &s.gz}) a->resize(n);
+    if (labelled) s.label.resize(n);
     tbb::parallel_for(0, d.z, [&](int k) {
         std::size_t o = count[std::size_t(k)];
         for (int j = 0; j < d.y; ++j)
@@ -145,9 +242,11 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                 s.j[o] = std::uint16_t(j);
                 s.k[o] = std::uint16_t(k);
                 s.density[o] = value;
-                if (usesTf) {
+                if (labelled) s.label[o] = float(shown[volume.index(i, j, k)]);
+                if (usesTf && intensity) {
                     const glm::vec4 c = tf.sample(value);
-                    const float rho = tf.extinctionFromOpacity(c.a);
+                    float rho = tf.extinctionFromOpacity(c.a);
+                    if (edges) rho *= edgeOf(i, j, k);
                     s.extinction[o] = rho;
                     s.r[o] = c.r * rho;
                     s.g[o] = c.g * rho;
@@ -160,6 +259,12 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                     s.nx[o] = float(n.x);
                     s.ny[o] = float(n.y);
                     s.nz[o] = float(n.z);
+                }
+                if (gradients) {
+                    const glm::dvec3 g = gradientAt(volume, i, j, k);
+                    s.gx[o] = float(g.x);
+                    s.gy[o] = float(g.y);
+                    s.gz[o] = float(g.z);
                 }
                 ++o;
             }

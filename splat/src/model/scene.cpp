@@ -41,7 +41,10 @@ void validateScene(const Volume& v, const RenderSettings& s) {
 bool sameScenePart(const RenderSettings& a, const RenderSettings& b) {
     return a.mode == b.mode && a.classification == b.classification && a.kernel == b.kernel &&
            a.kernelSigma == b.kernelSigma && a.kernelRadius == b.kernelRadius &&
-           a.shading.enabled == b.shading.enabled &&
+           a.shading.enabled == b.shading.enabled && a.edges.gain == b.edges.gain &&
+           a.edges.exponent == b.edges.exponent &&
+           a.clipping.planes.size() == b.clipping.planes.size() &&
+           a.clipping.cropBox == b.clipping.cropBox && a.labels.enabled == b.labels.enabled &&
            a.quality.footprintResolution == b.quality.footprintResolution &&
            a.quality.slabRadialResolution == b.quality.slabRadialResolution &&
            a.quality.slabDepthResolution == b.quality.slabDepthResolution &&
@@ -79,8 +82,32 @@ Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
       table(makeTable(kernel, s.quality)) {
     const VolumeStats st = volumeStats(*volume, 1);
     settings.transfer = s.transfer.resolved(st.minValue, st.maxValue);
+    minValue = st.minValue;
+    maxValue = st.maxValue;
+    if (settings.isoNormalized) {
+        settings.isoLevel = minValue + settings.isoLevel * (maxValue - minValue);
+        settings.isoNormalized = false;
+    }
+    ClassifyOptions options;
+    options.normals = shaded();
+    options.gradients = needsGradients();
+    if (s.mode == RenderMode::Dvr) options.edges = s.edges;
+    options.clipping = s.clipping;
+    if (s.labels.enabled) {
+        if (s.mode != RenderMode::Dvr || s.classification != Classification::Pre)
+            throw Error(
+                "labels are rendered in dvr mode with pre-classified intensity "
+                "(--mode dvr --classify pre)");
+        options.labels = &settings.labels;
+        labelGrid = shownLabels(*volume, settings.labels);
+        labelTable.resize(settings.labels.table.size());
+        for (std::size_t n = 0; n < labelTable.size(); ++n) {
+            const glm::vec4 c = settings.labels.shown(int(n));
+            labelTable[n] = glm::vec4(glm::vec3(c), settings.transfer.extinctionFromOpacity(c.a));
+        }
+    }
     splats =
-        classify(*volume, settings.transfer, s.mode, s.classification, kernel.radius(), shaded());
+        classify(*volume, settings.transfer, s.mode, s.classification, kernel.radius(), options);
     transfer = TransferTable(settings.transfer);
     if (s.quality.polynomialTolerance > 0) {
         poly.emplace(table);
@@ -124,8 +151,8 @@ const ReferenceField& Scene::Impl::referenceField() const {
     std::lock_guard<std::mutex> lock(lazyMutex_);
     if (!field_) {
         validateReferenceKernel(kernel);
-        field_ =
-            std::make_shared<ReferenceField>(*volume, splats, kernel, isPreClassifiedDvr(settings));
+        field_ = std::make_shared<ReferenceField>(*volume, splats, kernel,
+                                                  fieldLayout(settings, splats));
     }
     return *field_;
 }
@@ -167,10 +194,33 @@ Image Scene::render(const RenderSettings& frame, RenderStats* stats) const {
         throw Error(
             "scene: a frame cannot change the mode, classification, kernel, shading or table "
             "resolutions; build a new Scene for those");
+    return renderFrame(*impl_, frameSettings(frame), stats);
+}
+
+RenderSettings Scene::frameSettings(const RenderSettings& frame) const {
+    if (!sameScenePart(frame, impl_->settings))
+        throw Error(
+            "scene: a frame cannot change the mode, classification, kernel, shading or table "
+            "resolutions; build a new Scene for those");
     RenderSettings s = frame;
     s.transfer = impl_->settings.transfer;
     s.shading = impl_->settings.shading;
-    return renderFrame(*impl_, s, stats);
+    s.edges = impl_->settings.edges;
+    s.clipping = impl_->settings.clipping;
+    s.labels = impl_->settings.labels;
+    if (s.isoNormalized) {
+        s.isoLevel = impl_->minValue + s.isoLevel * (impl_->maxValue - impl_->minValue);
+        s.isoNormalized = false;
+    }
+    return s;
+}
+
+Image Scene::renderIsoDepth(const RenderSettings& frame, RenderStats* stats) const {
+    const RenderSettings s = frameSettings(frame);
+    if (s.mode != RenderMode::Iso) throw Error("scene: hit depths exist only in iso mode");
+    Image depth;
+    renderFrame(*impl_, s, stats, &depth);
+    return depth;
 }
 
 Image Scene::render(RendererKind renderer, const CameraParams& camera, RenderStats* stats) const {

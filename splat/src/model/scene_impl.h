@@ -41,10 +41,24 @@ struct Scene::Impl {
 
     Impl(std::shared_ptr<const Volume> v, const RenderSettings& s);
 
-    /// Shading is modelled only where it applies: pre-classified dvr.
+    float minValue = 0, maxValue = 0;  ///< of the volume (normalized iso levels)
+    /// Labels: colour and extinction (a) per label as shown, and the shown label of every
+    /// voxel (the reference's nearest-voxel lookup); empty without labels.
+    std::vector<glm::vec4> labelTable;
+    std::vector<std::uint16_t> labelGrid;
+
+    /// Pre-classified shading: the view's emission is shaded per splat (stage "shade").
     bool shaded() const {
         return settings.shading.enabled && settings.mode == RenderMode::Dvr &&
                settings.classification == Classification::Pre;
+    }
+    /// The sheets carry gradient channels: post-classified dvr with shading or edges, and
+    /// iso (always shaded). Computed only then (DESIGN: gradients only when asked for).
+    bool needsGradients() const {
+        if (settings.mode == RenderMode::Iso) return true;
+        return settings.mode == RenderMode::Dvr &&
+               settings.classification == Classification::Post &&
+               (settings.shading.enabled || settings.edges.enabled());
     }
     /// Splat indices ordered (stably) by slice index along `axis`, made on first use.
     const std::vector<std::uint32_t>& sliceOrder(int axis) const;

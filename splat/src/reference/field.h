@@ -107,7 +107,8 @@ struct FieldGrid {
 
 template <int C>
 FieldGrid<C> buildGrid(const Volume& volume, const SplatList& splats, const KernelLut& lut,
-                       double radius, const std::array<const std::vector<float>*, C>& channels) {
+                       double radius, const std::array<const std::vector<float>*, C>& channels,
+                       const std::vector<float>* alsoMark = nullptr) {
     FieldGrid<C> g;
     g.dims = volume.dims;
     g.radius = radius;
@@ -130,6 +131,8 @@ FieldGrid<C> buildGrid(const Volume& volume, const SplatList& splats, const Kern
             g.values[g.index(i, j, k) + c] = v;
             any = any || v != 0.0f;
         }
+        // Labels live outside the channels: their voxels' bricks are marked too.
+        if (alsoMark && s < alsoMark->size() && (*alsoMark)[s] != 0.0f) any = true;
         if (!any) continue;
         // Points within R of voxel p lie in [p - R, p + R]: bricks floor(p / B) ..
         // floor((p + 2R) / B) in the brick frame that starts at -R.
@@ -208,17 +211,57 @@ void raySegments(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& 
     }
 }
 
-/// The fields of one classified scene: density f (one channel), or for pre-classified dvr
-/// extinction and premultiplied emission (four channels). Not copyable (the grids point at
+/// Segmentation labels for the reference: the shown label of every voxel and colour and
+/// extinction (a) per label; a point takes the label of its nearest voxel.
+struct LabelLookup {
+    glm::ivec3 dims{0};
+    const std::vector<std::uint16_t>* shown = nullptr;
+    const std::vector<glm::vec4>* table = nullptr;
+    /// Adds the label's (rho, e) at index-space point p to out[0..3].
+    void add(const glm::dvec3& p, float* out) const {
+        const glm::ivec3 q(glm::round(p));
+        if (q.x < 0 || q.y < 0 || q.z < 0 || q.x >= dims.x || q.y >= dims.y || q.z >= dims.z)
+            return;
+        const std::size_t label =
+            (*shown)[(std::size_t(q.z) * dims.y + std::size_t(q.y)) * dims.x + std::size_t(q.x)];
+        if (label == 0 || label >= table->size()) return;
+        const glm::vec4 c = (*table)[label];
+        out[0] += c.a;
+        out[1] += c.r * c.a;
+        out[2] += c.g * c.a;
+        out[3] += c.b * c.a;
+    }
+};
+
+/// Which fields a ReferenceField holds.
+enum class FieldLayout {
+    Density,          ///< f (one channel): post-classified dvr, mip, xray, iso, views
+    Emission,         ///< rho, e_r, e_g, e_b: pre-classified dvr
+    DensityGradient,  ///< f and the reconstructed central-difference gradient g_x, g_y, g_z
+};
+
+/// The fields of one classified scene (see FieldLayout). Not copyable (the grids point at
 /// the kernel table).
 class ReferenceField {
   public:
     ReferenceField(const Volume& volume, const SplatList& splats, const footprint::Kernel& kernel,
-                   bool preClassifiedDvr);
+                   FieldLayout layout);
     ReferenceField(const ReferenceField&) = delete;
     ReferenceField& operator=(const ReferenceField&) = delete;
 
-    bool fourChannels() const { return four_; }
+    FieldLayout layout() const { return layout_; }
+    bool fourChannels() const { return layout_ != FieldLayout::Density; }
+    /// f at a world position (Density and DensityGradient layouts).
+    double density(const Volume& volume, const glm::dvec3& world) const {
+        double v[4];
+        const glm::dvec3 p = (world - volume.origin) / volume.spacing;
+        if (fourChannels()) {
+            grid4_.eval(p, v);
+        } else {
+            grid1_.eval(p, v);
+        }
+        return v[0];
+    }
     const FieldGrid<4>& grid4() const { return grid4_; }
     const FieldGrid<1>& grid1() const { return grid1_; }
     double radius() const { return radius_; }
@@ -226,7 +269,7 @@ class ReferenceField {
   private:
     KernelLut lut_;
     double radius_;
-    bool four_;
+    FieldLayout layout_;
     FieldGrid<4> grid4_;
     FieldGrid<1> grid1_;
 };

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "model/scene_impl.h"
+#include "model/shading_model.h"
 #include "reference/field.h"
 #include "reference/reference_frame.h"
 #include "splat/error.h"
@@ -73,7 +74,16 @@ class Caster {
         invSpacing_ = 1.0 / volume.spacing;
         stepWorld_ = q.referenceStep * volume.minSpacing();
         preDvr_ = field.fourChannels();
+        layout_ = field.layout();
+        const bool post =
+            settings.mode == RenderMode::Dvr && settings.classification == Classification::Post;
+        shadePost_ = post && layout_ == FieldLayout::DensityGradient && settings.shading.enabled;
+        edgesPost_ = post && layout_ == FieldLayout::DensityGradient && settings.edges.enabled();
+        light_ = lightFrame(settings.shading, camera.view);
     }
+    /// 1 / G for edge enhancement (the splat list's gradient scale).
+    void setGradientScale(float g) { invGradientScale_ = g > 0.0f ? 1.0f / g : 0.0f; }
+    void setLabels(const LabelLookup* labels) { labels_ = labels; }
 
     Image render(RenderStats* stats, Image* depth) {
         const int w = camera_.width(), h = camera_.height();
@@ -115,6 +125,7 @@ class Caster {
         g.eval(p0 + t * v, val);
         if constexpr (C == 4) {
             for (int c = 0; c < 4; ++c) out[c] = float(val[c]);
+            if (labels_) labels_->add(p0 + t * v, out);
         } else {
             out[0] = float(val[0]);
         }
@@ -122,9 +133,26 @@ class Caster {
 
     // rho and emission of one post-classified / pre-classified sample.
     void dvrQuantities(const float* s, int channels, double& rho, glm::dvec3& e) const {
-        if (channels == 4) {
+        if (channels == 4 && layout_ == FieldLayout::Emission) {
             rho = s[0];
             e = glm::dvec3(s[1], s[2], s[3]);
+        } else if (channels == 4) {  // density and gradient: post-classified, shaded / edges
+            const glm::vec4 c = settings_.transfer.sample(s[0]);
+            float r = c.r, g = c.g, b = c.b;
+            float rhoF = settings_.transfer.extinctionFromOpacity(c.a);
+            if (edgesPost_)
+                rhoF *=
+                    edgeFactor(settings_.edges, std::sqrt(s[1] * s[1] + s[2] * s[2] + s[3] * s[3]) *
+                                                    invGradientScale_);
+            if (shadePost_) {
+                const LightTerms t =
+                    blinnPhongGradient(settings_.shading, light_, s[1], s[2], s[3]);
+                r = r * t.diffuse + t.specular;
+                g = g * t.diffuse + t.specular;
+                b = b * t.diffuse + t.specular;
+            }
+            rho = rhoF;
+            e = glm::dvec3(r, g, b) * rho;
         } else {
             const glm::vec4 c = settings_.transfer.sample(s[0]);
             rho = settings_.transfer.extinctionFromOpacity(c.a);
@@ -350,13 +378,15 @@ class Caster {
         }
         const glm::dvec3 colour(settings_.transfer.sample(float(settings_.isoLevel)));
         const double len = glm::length(grad);
-        double diffuse = 1.0;
-        if (len > 0) {
-            const glm::dvec3 dir = glm::normalize(v * volume_.spacing);  // world ray direction
-            diffuse = std::abs(glm::dot(grad / len, dir));
-        }
-        return colour *
-               double(settings_.shading.ambient + settings_.shading.diffuse * float(diffuse));
+        const Shading& sh = settings_.shading;
+        if (!(len > 0)) return colour * double(sh.ambient + sh.diffuse);
+        // The one shading model; the headlight follows each (perspective) ray. The highlight
+        // is added when shading is asked for (the default iso image is ambient + diffuse).
+        const glm::dvec3 dir = glm::normalize(v * volume_.spacing);  // world ray direction
+        const glm::dvec3 n = grad / len;
+        const LightTerms lt =
+            blinnPhong(sh, lightFrame(sh, dir), float(n.x), float(n.y), float(n.z));
+        return colour * double(lt.diffuse) + (sh.enabled ? double(lt.specular) : 0.0);
     }
 
     const Volume& volume_;
@@ -366,6 +396,11 @@ class Caster {
     glm::dvec3 invSpacing_{1.0};
     double stepWorld_ = 1;
     bool preDvr_ = false;
+    FieldLayout layout_ = FieldLayout::Density;
+    bool shadePost_ = false, edgesPost_ = false;
+    LightFrame light_;
+    float invGradientScale_ = 0;
+    const LabelLookup* labels_ = nullptr;
 };
 
 }  // namespace
@@ -376,8 +411,11 @@ void validateReferenceKernel(const footprint::Kernel& kernel) {
 }
 
 Image renderReference(const Volume& volume, const ReferenceField& field, const Camera& camera,
-                      const RenderSettings& settings, RenderStats* stats, Image* depth) {
+                      const RenderSettings& settings, RenderStats* stats, Image* depth,
+                      float gradientScale, const LabelLookup* labels) {
     Caster caster(volume, field, camera, settings);
+    caster.setGradientScale(gradientScale);
+    caster.setLabels(labels);
     return caster.render(stats, depth);
 }
 
@@ -386,10 +424,12 @@ Image renderReference(const Volume& volume, const SplatList& splats,
                       const RenderSettings& settings, RenderStats* stats) {
     const auto start = std::chrono::steady_clock::now();
     validateReferenceKernel(kernel);
-    const ReferenceField field(volume, splats, kernel, isPreClassifiedDvr(settings));
+    const ReferenceField field(volume, splats, kernel, fieldLayout(settings, splats));
     Image image;
-    runOnThreads(settings.threads,
-                 [&] { image = renderReference(volume, field, camera, settings, stats, nullptr); });
+    runOnThreads(settings.threads, [&] {
+        image =
+            renderReference(volume, field, camera, settings, stats, nullptr, splats.gradientScale);
+    });
     if (stats) {
         stats->splats = splats.size();
         stats->voxels = splats.voxels;
@@ -406,7 +446,7 @@ Image renderReferenceDepth(const Volume& volume, const SplatList& splats,
     if (settings.mode != RenderMode::Iso)
         throw Error("reference: hit depths exist only in iso mode");
     validateReferenceKernel(kernel);
-    const ReferenceField field(volume, splats, kernel, false);
+    const ReferenceField field(volume, splats, kernel, FieldLayout::Density);
     Image depth;
     runOnThreads(settings.threads,
                  [&] { renderReference(volume, field, camera, settings, stats, &depth); });

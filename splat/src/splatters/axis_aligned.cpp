@@ -84,8 +84,9 @@ int splatFootprint(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx
                    const footprint::EllipticalFootprint& e, const PixelRect& rect,
                    const footprint::FootprintTable& table, const footprint::FootprintPoly* poly) {
 #if defined(FOOTPRINT_HAVE_LANES)
-    if (footprint::cpuHasLanes())
-        return splatFootprintLanes(sheet, values, sx, sy, e, rect, table, poly);
+    if constexpr (NCh != kLabelChannels)  // labels select by max: the scalar loop
+        if (footprint::cpuHasLanes())
+            return splatFootprintLanes(sheet, values, sx, sy, e, rect, table, poly);
 #endif
     return splatFootprintScalar(sheet, values, sx, sy, e, rect, table, poly);
 }

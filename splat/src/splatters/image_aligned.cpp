@@ -109,8 +109,9 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
                   const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
                   const float* tb) {
 #if defined(FOOTPRINT_HAVE_LANES)
-    if (footprint::cpuHasLanes())
-        return splatSectionsLanes(sheets, n, values, sx, sy, e, rect, table, poly, tb);
+    if constexpr (NCh != kLabelChannels)  // labels select by max: the scalar loop
+        if (footprint::cpuHasLanes())
+            return splatSectionsLanes(sheets, n, values, sx, sy, e, rect, table, poly, tb);
 #endif
     return splatSectionsScalar(sheets, n, values, sx, sy, e, rect, table, poly, tb);
 }

@@ -1,0 +1,82 @@
+// Options and output of the volume-viewing commands (see view_options.h).
+#include "view_options.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "splat/error.h"
+#include "splat/image_io.h"
+#include "technique_options.h"
+
+namespace splat::cli {
+
+void addViewOptions(CLI::App& cmd, ViewArgs& a) {
+    cmd.add_option("--window", a.window, "display window LO,HI (data units)");
+    cmd.add_option("--window-preset", a.windowPreset,
+                   "display window: full (min..max, default), ct-brain (L40 W80), ct-soft "
+                   "(L50 W400), ct-bone (L500 W2000), ct-lung (L-600 W1500)");
+    cmd.add_option("--scale-bar", a.scaleBar, "draw a scale bar of this many world units (mm)");
+    cmd.add_option("--kernel", a.kernel, "reconstruction kernel: gaussian | bspline")
+        ->capture_default_str();
+    cmd.add_option("--sigma", a.sigma, "Gaussian sigma in voxels (0 = default)");
+    cmd.add_option("--radius", a.radius, "kernel radius in voxels (0 = default)");
+    cmd.add_option("--threads", a.threads, "worker threads (0 = all cores)");
+    cmd.add_option("--bit-depth", a.bitDepth, "PNG bits per channel: 8 or 16")
+        ->capture_default_str();
+}
+
+glm::dvec3 parseVec3(const std::string& text, const std::string& what) {
+    const std::vector<double> v = parseNumbers(text, what);
+    if (v.size() != 3) throw Error(what + " '" + text + "' needs three numbers X,Y,Z");
+    return {v[0], v[1], v[2]};
+}
+
+void writeView(const std::string& path, Image image, const ViewArgs& a, const Volume& volume,
+               double pixelSize) {
+    WriteOptions o;
+    o.mapping = DisplayMapping::Window;
+    if (a.bitDepth != 8 && a.bitDepth != 16) throw Error("--bit-depth must be 8 or 16");
+    o.bitDepth = a.bitDepth;
+    if (!a.window.empty()) {
+        const std::vector<double> w = parseNumbers(a.window, "--window");
+        if (w.size() != 2 || !(w[1] > w[0])) throw Error("--window needs LO,HI with HI > LO");
+        o.windowLow = float(w[0]);
+        o.windowHigh = float(w[1]);
+    } else {
+        const std::string p = a.windowPreset.empty() ? "full" : a.windowPreset;
+        double level, width;
+        if (p == "full") {
+            const VolumeStats st = volumeStats(volume, 1);
+            level = 0.5 * (st.minValue + st.maxValue);
+            width = std::max(1e-6, double(st.maxValue - st.minValue));
+        } else if (p == "ct-brain") {
+            level = 40, width = 80;
+        } else if (p == "ct-soft") {
+            level = 50, width = 400;
+        } else if (p == "ct-bone") {
+            level = 500, width = 2000;
+        } else if (p == "ct-lung") {
+            level = -600, width = 1500;
+        } else {
+            throw Error("unknown window preset '" + p +
+                        "' (full, ct-brain, ct-soft, ct-bone, ct-lung)");
+        }
+        o.windowLow = float(level - 0.5 * width);
+        o.windowHigh = float(level + 0.5 * width);
+    }
+    if (a.scaleBar > 0) {
+        // A bar of scaleBar world units, 3 pixels high, 8 pixels from the bottom-left corner,
+        // drawn at the window's top value (white), outlined in its bottom value.
+        const int len = int(std::lround(a.scaleBar / pixelSize));
+        const int x0 = 8, y1 = image.height - 8;
+        for (int y = y1 - 4; y <= y1; ++y)
+            for (int x = x0 - 1; x <= x0 + len; ++x) {
+                if (x < 0 || y < 0 || x >= image.width || y >= image.height) continue;
+                const bool inner = y > y1 - 4 && y < y1 && x >= x0 && x < x0 + len;
+                image.at(x, y) = glm::vec4(glm::vec3(inner ? o.windowHigh : o.windowLow), 1.0f);
+            }
+    }
+    writeImage(path, image, o);
+}
+
+}  // namespace splat::cli
