@@ -98,10 +98,10 @@ void renderSequence(const Scene& scene, const std::vector<RendererKind>& rendere
                     const CameraPath& path, const SequenceOptions& options,
                     const std::function<void(SequenceFrame&&)>& sink) {
     if (renderers.empty()) throw Error("sequence: no renderer");
-    std::vector<std::size_t> todo;
+    std::vector<std::size_t> views;
     for (std::size_t v = 0; v < path.views.size(); ++v)
-        if (!options.skip || !options.skip(v)) todo.push_back(v);
-    const std::size_t total = todo.size() * renderers.size();
+        if (!options.skip || !options.skip(v)) views.push_back(v);
+    const std::size_t total = views.size() * renderers.size();
     std::size_t done = 0;
     std::mutex progressMutex;
     std::atomic<bool> cancelled{false};
@@ -137,14 +137,14 @@ void renderSequence(const Scene& scene, const std::vector<RendererKind>& rendere
         if (std::int64_t(c.width) * c.height <= 256 * 256)
             batch = std::size_t(std::max(threads, 1));
     }
-    for (std::size_t n0 = 0; n0 < todo.size(); n0 += batch) {
-        const std::size_t n1 = std::min(todo.size(), n0 + batch);
+    for (std::size_t n0 = 0; n0 < views.size(); n0 += batch) {
+        const std::size_t n1 = std::min(views.size(), n0 + batch);
         std::vector<SequenceFrame> frames(n1 - n0);
         if (batch == 1)
-            frames[0] = renderView(todo[n0], 0);
+            frames[0] = renderView(views[n0], 0);
         else
             tbb::parallel_for(n0, n1,
-                              [&](std::size_t n) { frames[n - n0] = renderView(todo[n], 1); });
+                              [&](std::size_t n) { frames[n - n0] = renderView(views[n], 1); });
         if (cancelled) throw Cancelled();
         for (SequenceFrame& f : frames) sink(std::move(f));
     }
