@@ -73,7 +73,7 @@ for R in axis sheet; do
         [ "$V" != "$CH2" ] || [ -f "$CH2" ] || continue
         read -r _ ms1 _ < <(bench "$V" 512x512 $R 1)
         read -r _ msall _ < <(bench "$V" 512x512 $R "$ALL")
-        python3 -c "print(f'$R speed-up 1 -> $ALL threads ($(basename "$V"), 512x512): {$ms1 / $msall:.2f}x ($ms1 ms -> $msall ms)')"
+        python3 -c "print(f'- $R speed-up 1 -> $ALL threads ($(basename "$V"), 512x512): {$ms1 / $msall:.2f}x ($ms1 ms -> $msall ms)')"
     done
     echo
 done
