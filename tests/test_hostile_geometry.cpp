@@ -80,3 +80,25 @@ TEST_CASE("a reference step of 1e-9 voxels is refused, not coarsened", "[hostile
     ok.quality.referenceTolerance = 1e9;
     CHECK_NOTHROW(scene.render(ok));
 }
+
+TEST_CASE("render refuses absurd spacings with one line and nothing written",
+          "[hostile][render][cli]") {
+    auto dir = testTmpDir("hostile_geometry_cli");
+    const std::string raw = (dir / "v_6x6x6_uint8.raw").string();
+    writeBytes(raw, std::string(216, '\x40'));
+    const std::string out = (dir / "out.png").string();
+    for (const auto& extra : std::vector<std::vector<std::string>>{
+             {"--spacing", "1e-30,1,1", "--renderer", "sheet"},
+             {"--spacing", "1e-6,1,1e6", "--elevation", "90", "--renderer", "sheet"},
+             {"--spacing", "1e-30,1,1", "--renderer", "axis"}}) {
+        std::vector<std::string> args{"render", raw, "--size", "16x16", "-o", out};
+        args.insert(args.end(), extra.begin(), extra.end());
+        RunResult r = runSplat(args);
+        INFO(r.err);
+        CHECK(r.status == 1);
+        REQUIRE(r.errLines().size() >= 1);
+        CHECK_THAT(r.errLines().back(), Catch::StartsWith("splat: error: ") &&
+                                            Catch::Contains("exceeds 10000:1"));
+        CHECK_FALSE(std::filesystem::exists(out));
+    }
+}
