@@ -5,13 +5,13 @@
 #include <nifti/nifti1.h>
 #include <nifti/nifti2.h>
 #include <sys/stat.h>
-#include <zlib.h>
 
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
 #include <limits>
 
+#include "deflate_util.h"
 #include "splat/volume_io.h"
 #include "test_volume_util.h"
 
@@ -25,20 +25,6 @@ std::string loadError(const std::string& spec, const LoadOptions& o = {}) {
     std::string msg = errorOf([&] { loadVolume(spec, o); });
     CHECK(msg.find('\n') == std::string::npos);  // always one line
     return msg;
-}
-
-std::string gzipBytes(const std::string& in) {
-    z_stream zs{};
-    deflateInit2(&zs, 9, Z_DEFLATED, 15 + 16, 9, Z_DEFAULT_STRATEGY);
-    std::string out(deflateBound(&zs, uLong(in.size())) + 64, '\0');
-    zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data()));
-    zs.avail_in = uInt(in.size());
-    zs.next_out = reinterpret_cast<Bytef*>(out.data());
-    zs.avail_out = uInt(out.size());
-    deflate(&zs, Z_FINISH);
-    out.resize(zs.total_out);
-    deflateEnd(&zs);
-    return out;
 }
 
 // A NIfTI-1 header: 2 x 2 x 2 int16, pixdim 1, vox_offset 352, no transform.
@@ -183,7 +169,7 @@ TEST_CASE("NIfTI-2 and ANALYZE 7.5", "[volume][hostile]") {
         CHECK(v.origin == glm::dvec3(0, 0, -7));
         CHECK(v.data[23] == 2.0f * 23 + 1);
         CHECK_THAT(v.source, Catch::Contains("NIfTI-2 int16"));
-        writeBytes(dir / "v2.nii.gz", gzipBytes(bytes));
+        writeBytes(dir / "v2.nii.gz", deflateBytes(bytes, true));
         CHECK(loadVolume((dir / "v2.nii.gz").string()).data == v.data);
     }
     SECTION("ANALYZE 7.5 .hdr/.img pair, big-endian") {
@@ -242,12 +228,12 @@ TEST_CASE("hostile raw: header bytes that wrap, .raw.gz", "[volume][hostile]") {
     CHECK_THAT(r.err, Catch::Contains("--header-bytes"));
 
     // .raw.gz: by name, with a header inside the compressed stream, capped inflation.
-    writeBytes(dir / "g_4x3x2_int16.raw.gz", gzipBytes(samples<std::int16_t>(ramp(24))));
+    writeBytes(dir / "g_4x3x2_int16.raw.gz", deflateBytes(samples<std::int16_t>(ramp(24)), true));
     Volume g = loadVolume((dir / "g_4x3x2_int16.raw.gz").string());
     REQUIRE(g.dims == glm::ivec3(4, 3, 2));
     CHECK(g.data[23] == 23.0f);
     CHECK_THAT(g.source, Catch::Contains("gzip"));
-    writeBytes(dir / "bomb_2x2x2_uint8.raw.gz", gzipBytes(std::string(50'000'000, '\0')));
+    writeBytes(dir / "bomb_2x2x2_uint8.raw.gz", deflateBytes(std::string(50'000'000, '\0'), true));
     CHECK_THAT(loadError((dir / "bomb_2x2x2_uint8.raw.gz").string()),
                Catch::Contains("more data than the header declares (8 bytes)"));
 }
@@ -273,7 +259,7 @@ TEST_CASE("hostile NRRD and MetaImage: data checked before allocating", "[volume
         }
     }
     SECTION("gzip inflation stops at the declared size") {
-        const std::string bomb = gzipBytes(std::string(100'000'000, '\0'));  // ~100 kB
+        const std::string bomb = deflateBytes(std::string(100'000'000, '\0'), true);  // ~100 kB
         writeBytes(path("bomb.nrrd"),
                    "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\n"
                    "encoding: gzip\n\n" +

@@ -45,7 +45,12 @@ if [[ ! -f "$build/CMakeCache.txt" ]]; then
   CC=clang-14 CXX=clang++-14 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DSPLAT_FUZZ=ON -DSPLAT_BUILD_TESTS=OFF "${launcher[@]}" >/dev/null
 fi
-nice -n 19 cmake --build "$build" -j"${SPLAT_FUZZ_BUILD_JOBS:-2}" --target fuzz_all >/dev/null
+if ! nice -n 19 cmake --build "$build" -j"${SPLAT_FUZZ_BUILD_JOBS:-2}" --target fuzz_all \
+  >"$build/build.log" 2>&1; then
+  tail -30 "$build/build.log" >&2
+  echo "fuzz.sh: building the fuzz targets failed ($build/build.log)" >&2
+  exit 1
+fi
 
 seeds="$build/seeds"
 rm -rf "$seeds"

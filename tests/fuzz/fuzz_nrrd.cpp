@@ -5,14 +5,8 @@
 #include "splat/volume_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    std::string_view in(reinterpret_cast<const char*>(data), size), header, payload;
-    std::filesystem::path p;
-    if (splat::fuzz::splitData(in, header, payload)) {
-        splat::fuzz::writeFile("data.raw", payload);
-        p = splat::fuzz::writeFile("in.nhdr", header);
-    } else {
-        p = splat::fuzz::writeFile("in.nrrd", in);
-    }
+    const auto p = splat::fuzz::writeHeaderAndData(
+        std::string_view(reinterpret_cast<const char*>(data), size), "in.nrrd", "in.nhdr");
     splat::fuzz::expectOnlySplatErrors([&] { splat::loadVolume(p.string()); });
     return 0;
 }

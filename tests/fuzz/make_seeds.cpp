@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "../deflate_util.h"
 #include "../dicom_util.h"
 #include "fuzz_util.h"
 #include "splat/volume_io.h"
@@ -34,19 +35,7 @@ std::string readAll(const fs::path& p) {
     return s.str();
 }
 
-std::string gzip(const std::string& in) {
-    z_stream zs{};
-    deflateInit2(&zs, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY);
-    std::string o(deflateBound(&zs, uLong(in.size())) + 32, '\0');
-    zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data()));
-    zs.avail_in = uInt(in.size());
-    zs.next_out = reinterpret_cast<Bytef*>(o.data());
-    zs.avail_out = uInt(o.size());
-    deflate(&zs, Z_FINISH);
-    o.resize(zs.total_out);
-    deflateEnd(&zs);
-    return o;
-}
+std::string gzip(const std::string& in) { return splat::test::deflateBytes(in, true); }
 
 template <typename T>
 std::string ramp(int n, T scale = T(1)) {

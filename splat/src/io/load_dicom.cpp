@@ -105,7 +105,21 @@ int intOf(const std::optional<std::vector<double>>& v, int fallback, const std::
     return int(d);
 }
 
-SliceInfo readInfo(const fs::path& p) {
+/// GDCM reports some problems by throwing (gdcm::Exception is a std::exception): they
+/// become splat::Error naming the file, like every other problem.
+template <typename F>
+auto guarded(const fs::path& p, F f) {
+    try {
+        return f();
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(displayName(p) + ": not a readable DICOM file (" +
+                    std::string(e.what()).substr(0, 120) + ")");
+    }
+}
+
+SliceInfo readInfoUnguarded(const fs::path& p) {
     const std::string name = displayName(p);
     const std::uint64_t fileSize = regularFileSize(p);
     gdcm::Reader reader;
@@ -151,6 +165,10 @@ SliceInfo readInfo(const fs::path& p) {
     return s;
 }
 
+SliceInfo readInfo(const fs::path& p) {
+    return guarded(p, [&] { return readInfoUnguarded(p); });
+}
+
 std::optional<SampleType> gdcmSampleType(const gdcm::PixelFormat& pf) {
     switch (pf.GetScalarType()) {
         case gdcm::PixelFormat::UINT8:
@@ -175,7 +193,15 @@ std::optional<SampleType> gdcmSampleType(const gdcm::PixelFormat& pf) {
 }
 
 /// Reads the pixels of one single-frame slice into `out` (columns x rows floats, rescaled).
+void readPixelsUnguarded(const SliceInfo& s, float* out);
 void readPixels(const SliceInfo& s, float* out) {
+    guarded(s.path, [&] {
+        readPixelsUnguarded(s, out);
+        return 0;
+    });
+}
+
+void readPixelsUnguarded(const SliceInfo& s, float* out) {
     const std::string name = displayName(s.path);
     gdcm::ImageReader reader;
     reader.SetFileName(s.path.string().c_str());

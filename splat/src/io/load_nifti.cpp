@@ -81,6 +81,39 @@ std::string readStart(const fs::path& p, std::size_t n, const std::string& name)
     return buf;
 }
 
+// The fields NIfTI-1, NIfTI-2 and ANALYZE 7.5 share (types differ: short/float vs
+// int64/double).
+template <typename H>
+void copyDims(const H& n, Header& h) {
+    for (int d = 0; d < 8; ++d) {
+        h.dim[d] = n.dim[d];
+        h.pixdim[d] = n.pixdim[d];
+    }
+    h.datatype = n.datatype;
+    h.bitpix = n.bitpix;
+    h.voxOffset = double(n.vox_offset);
+}
+
+// Scaling and both transforms (NIfTI-1 and NIfTI-2 only).
+template <typename H>
+void copyTransforms(const H& n, Header& h) {
+    h.sclSlope = n.scl_slope;
+    h.sclInter = n.scl_inter;
+    h.qformCode = n.qform_code;
+    h.sformCode = n.sform_code;
+    const double q[6] = {n.quatern_b, n.quatern_c, n.quatern_d,
+                         n.qoffset_x, n.qoffset_y, n.qoffset_z};
+    for (int i = 0; i < 3; ++i) {
+        h.quatern[i] = q[i];
+        h.qoffset[i] = q[i + 3];
+    }
+    for (int i = 0; i < 4; ++i) {
+        h.srow[0][i] = n.srow_x[i];
+        h.srow[1][i] = n.srow_y[i];
+        h.srow[2][i] = n.srow_z[i];
+    }
+}
+
 Header parseHeader(const std::string& bytes, const std::string& name) {
     Header h;
     if (bytes.size() < 4) throw Error(name + ": not a NIfTI/ANALYZE file (too short)");
@@ -101,29 +134,8 @@ Header parseHeader(const std::string& bytes, const std::string& name) {
             h.singleFile = false;
         else
             throw Error(name + ": not a readable NIfTI-2 file (magic is not n+2 or ni2)");
-        for (int d = 0; d < 8; ++d) {
-            h.dim[d] = n2.dim[d];
-            h.pixdim[d] = n2.pixdim[d];
-        }
-        h.datatype = n2.datatype;
-        h.bitpix = n2.bitpix;
-        h.voxOffset = double(n2.vox_offset);
-        h.sclSlope = n2.scl_slope;
-        h.sclInter = n2.scl_inter;
-        h.qformCode = n2.qform_code;
-        h.sformCode = n2.sform_code;
-        const double q[6] = {n2.quatern_b, n2.quatern_c, n2.quatern_d,
-                             n2.qoffset_x, n2.qoffset_y, n2.qoffset_z};
-        for (int i = 0; i < 3; ++i) {
-            h.quatern[i] = q[i];
-            h.qoffset[i] = q[i + 3];
-            h.srow[0][i] = n2.srow_x[i];
-            h.srow[1][i] = n2.srow_y[i];
-            h.srow[2][i] = n2.srow_z[i];
-        }
-        h.srow[0][3] = n2.srow_x[3];
-        h.srow[1][3] = n2.srow_y[3];
-        h.srow[2][3] = n2.srow_z[3];
+        copyDims(n2, h);
+        copyTransforms(n2, h);
         return h;
     }
     if (size != 348 && swappedSize != 348)
@@ -147,30 +159,8 @@ Header parseHeader(const std::string& bytes, const std::string& name) {
         h.version = 0;
         h.singleFile = false;
     }
-    for (int d = 0; d < 8; ++d) {
-        h.dim[d] = n1.dim[d];
-        h.pixdim[d] = n1.pixdim[d];
-    }
-    h.datatype = n1.datatype;
-    h.bitpix = n1.bitpix;
-    h.voxOffset = n1.vox_offset;
-    if (h.version == 1) {
-        h.sclSlope = n1.scl_slope;
-        h.sclInter = n1.scl_inter;
-        h.qformCode = n1.qform_code;
-        h.sformCode = n1.sform_code;
-        const float q[6] = {n1.quatern_b, n1.quatern_c, n1.quatern_d,
-                            n1.qoffset_x, n1.qoffset_y, n1.qoffset_z};
-        for (int i = 0; i < 3; ++i) {
-            h.quatern[i] = q[i];
-            h.qoffset[i] = q[i + 3];
-        }
-        for (int i = 0; i < 4; ++i) {
-            h.srow[0][i] = n1.srow_x[i];
-            h.srow[1][i] = n1.srow_y[i];
-            h.srow[2][i] = n1.srow_z[i];
-        }
-    }
+    copyDims(n1, h);
+    if (h.version == 1) copyTransforms(n1, h);  // ANALYZE has other fields there
     return h;
 }
 
