@@ -67,8 +67,8 @@ class Caster {
            const RenderSettings& settings)
         : volume_(volume), camera_(camera), settings_(settings), field_(field) {
         const Quality& q = settings.quality;
-        if (!(q.referenceStep > 0) || !std::isfinite(q.referenceStep))
-            throw Error("reference: referenceStep must be > 0 voxels");
+        if (!(q.referenceStep >= 1e-3) || !std::isfinite(q.referenceStep))
+            throw Error("reference: referenceStep must be finite and >= 0.001 voxels");
         if (!(q.referenceTolerance > 0)) throw Error("reference: referenceTolerance must be > 0");
         if (volume.voxelCount() == 0) throw Error("reference: empty volume");
         invSpacing_ = 1.0 / volume.spacing;
@@ -191,7 +191,10 @@ class Caster {
         sc.cur.resize(ns);
         for (std::size_t s = 0; s < ns; ++s) {
             const double len = sc.segments[s].b - sc.segments[s].a;
-            sc.baseN[s] = 2 * std::max(1, int(std::ceil(len / (2.0 * stepWorld_))));
+            const double half = std::ceil(len / (2.0 * stepWorld_));
+            if (!(half <= double(1 << 28)))  // also NaN: never an unchecked float -> int
+                throw Error("reference: a ray needs more than 2^29 steps; use a larger step");
+            sc.baseN[s] = 2 * std::max(1, int(half));
             sc.old[s].clear();
             sc.cur[s].clear();
         }
