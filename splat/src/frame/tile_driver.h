@@ -174,10 +174,11 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
         const DenormalsAreZero ftz;  // footprint tails must not hit slow denormal paths
         const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
         const int w = std::min(g.tileSize, g.width - ox), h = std::min(g.tileSize, g.height - oy);
-        constexpr bool surface = std::is_same_v<Policy, IsoPolicy>;
+        constexpr bool surface = kSurfacePolicy<Policy>;  // issue 13: also when clipped
         TileAccumulator acc(w, h, in.settings.order,
                             Policy::kTerminates ? in.settings.quality.earlyTermination : 0.0,
                             surface);
+        acc.setOrigin(ox, oy, g.width);  // issue 13: per-pixel clip cut
         if (in.bins.begin[t] != in.bins.begin[t + 1]) {
             std::vector<float> tileScale;
             if (!pathScale.empty()) {
