@@ -18,7 +18,11 @@ struct VolumeArgs {
 /// Adds VOLUME and --dims/--type/--spacing/--big-endian/--header-bytes/--nan-policy.
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args);
 
-/// Parses the options and loads the volume; throws splat::Error on bad input.
+/// Parses the options (UsageError on malformed ones).
+LoadOptions loadOptionsFromArgs(const VolumeArgs& args);
+
+/// Parses the options and loads the volume; throws splat::Error on bad input. Prints the
+/// volume's note (what the loader assumed or changed) as warning lines.
 Volume loadVolumeFromArgs(const VolumeArgs& args);
 
 }  // namespace splat::cli
