@@ -49,7 +49,7 @@ std::string bashScript(const CLI::App& app) {
             for (const std::string& l : o->get_lnames()) {
                 if (l == "help") continue;
                 opts += " --" + l;
-                if (o->get_type_size() != 0) valued.insert("--" + l);
+                if (!o->get_type_name().empty()) valued.insert("--" + l);
             }
             for (const std::string& sn : o->get_snames()) opts += " -" + sn;
         }
@@ -57,8 +57,8 @@ std::string bashScript(const CLI::App& app) {
     }
     std::string values;
     for (const auto& [flag, list] : choices())
-        values += "        " + flag + ") COMPREPLY=($(compgen -W \"" + list +
-                  "\" -- \"$cur\")); return ;;\n";
+        values += "        " + flag + ") COMPREPLY=($(compgen -W \"" + list + "\" -- \"$cur\")" +
+                  (flag == "--tf" ? " $(compgen -f -- \"$cur\")" : "") + "); return ;;\n";
     std::string files;
     for (const std::string& v : valued)
         if (!choices().count(v)) files += (files.empty() ? "" : "|") + v;
