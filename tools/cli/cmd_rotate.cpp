@@ -92,7 +92,7 @@ nlohmann::json manifestOf(const RotateCommand& a, const RenderSettings& s) {
             {"renderer", toString(s.renderer)},
             {"mode", toString(s.mode)},
             {"classify", toString(s.classification)},
-            {"tf", a.render.tf},
+            {"tf", a.render.tfInline.is_null() ? nlohmann::json(a.render.tf) : a.render.tfInline},
             {"size", a.render.size},
             {"azimuth", s.camera.azimuthDeg},
             {"elevation", s.camera.elevationDeg},

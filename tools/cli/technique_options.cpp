@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "diagnostics.h"
 #include "scene_file.h"
 #include "splat/error.h"
 #include "splat/volume_io.h"
@@ -129,8 +130,11 @@ void loadTechniqueFiles(const TechniqueArgs& a, RenderSettings& s) {
     s.labels = Labels::load(a.labelColors, a.labelNames, float(a.labelOpacity));
     if (!a.labels.empty())
         for (double d : parseNumbers(a.labels, "--labels")) s.labels.selection.push_back(int(d));
-    if (!a.labelVolume.empty())
-        s.labels.volume = std::make_shared<const Volume>(loadVolume(a.labelVolume));
+    if (!a.labelVolume.empty()) {
+        auto labels = std::make_shared<const Volume>(loadVolume(a.labelVolume));
+        if (!labels->note.empty()) warn(a.labelVolume + ": " + labels->note);
+        s.labels.volume = labels;
+    }
 }
 
 void applyTechniqueOutput(const TechniqueArgs& a, WriteOptions& o) {
