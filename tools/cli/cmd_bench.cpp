@@ -2,6 +2,7 @@
 // chosen renderer at several thread counts, and reports footprint-pixel throughput.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -9,7 +10,9 @@
 #include <thread>
 
 #include "commands.h"
+#include "diagnostics.h"
 #include "render_options.h"
+#include "scene_file.h"
 #include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "volume_options.h"
@@ -46,17 +49,33 @@ void registerBench(CLI::App& app) {
     CLI::App* cmd =
         app.add_subcommand("bench", "time rendering (median of repeats) per thread count");
     addVolumeOptions(*cmd, a->volume);
-    addRenderOptions(*cmd, a->render);
-    cmd->add_option("--repeats", a->repeats, "timed frames per configuration")
-        ->capture_default_str();
-    cmd->add_option("--thread-list", a->threadList, "thread counts to time, e.g. 1,2")
-        ->capture_default_str();
-    cmd->add_option("--json", a->json, "write the results as JSON");
-    cmd->callback([a] {
-        if (a->repeats < 1 || a->repeats > 1000)
-            throw Error("--repeats must be between 1 and 1000");
-        const std::vector<int> threads = parseThreads(a->threadList);
-        RenderSettings settings = settingsFromArgs(a->render);
+    addRenderOptions(*cmd, a->render, false);
+    addOption(*cmd, "--repeats", a->repeats, "timed frames per configuration", "Benchmark");
+    addOption(*cmd, "--thread-list", a->threadList, "thread counts to time, e.g. 1,2", "Benchmark");
+    addOption(*cmd, "--json", a->json, "write the results as JSON", "Output", PathKind::Output);
+    cmd->footer(
+        "Examples:\n"
+        "  splat bench synthetic:phantom:64 --renderer sheet --thread-list 1,2,4\n"
+        "  splat bench ch2.nii.gz --tf mri-head --size 1024x1024 --repeats 9 --json b.json");
+    cmd->callback([a, cmd] {
+        prepareCommand(*cmd, {"volume"});
+        const std::vector<int> threads = asUsage([&] {
+            if (a->repeats < 1 || a->repeats > 1000)
+                throw Error("--repeats must be between 1 and 1000");
+            return parseThreads(a->threadList);
+        });
+        if (!a->json.empty()) {
+            // Refused before the timing, not after it.
+            std::error_code ec;
+            const std::filesystem::path p(a->json), parent = p.parent_path();
+            if (std::filesystem::is_directory(p, ec))
+                throw Error(a->json + ": --json needs a file name, not a folder");
+            if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+                throw Error(a->json + ": folder '" + parent.string() + "' does not exist");
+        }
+        RenderSettings settings = settingsFromArgs(a->render, RenderUse{});
+        loadOptionsFromArgs(a->volume);
+        beginRun(*cmd);
         const Volume volume = loadVolumeFromArgs(a->volume);
         nlohmann::json out;
         out["volume"] = a->volume.spec;
@@ -65,6 +84,7 @@ void registerBench(CLI::App& app) {
         out["size"] = a->render.size;
         out["slab"] = settings.quality.slab;
         out["hardware_threads"] = std::thread::hardware_concurrency();
+        out["scene"] = sceneOf(*cmd);
         std::printf("%-8s %-7s %8s %10s %10s %12s %14s\n", "threads", "renderer", "splats",
                     "median ms", "min ms", "fp px/frame", "fp px/s");
         for (int t : threads) {
@@ -96,9 +116,8 @@ void registerBench(CLI::App& app) {
                                    {"bin_ms", stats.binMs},
                                    {"tiles_ms", stats.tilesMs}});
         }
-        if (!a->json.empty()) {
-            writeTextAtomic(a->json, out.dump(2) + "\n");
-        }
+        if (!a->json.empty()) writeTextAtomic(a->json, out.dump(2) + "\n");
+        finishRun(*cmd);
     });
 }
 

@@ -2,12 +2,16 @@
 // a polyline through the reconstructed field. The curve file:
 //   {"points": [[x, y, z], ...], "lateral": [0, 0, 1], "width": 128, "pixel-size": 1}
 // (world units; lateral, width and pixel-size optional; flags override them).
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "diagnostics.h"
+#include "render_options.h"
+#include "scene_file.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
 #include "view_options.h"
@@ -31,14 +35,32 @@ void registerCpr(CLI::App& app) {
         app.add_subcommand("cpr", "curved planar reformation along a polyline (straightened)");
     addVolumeOptions(*cmd, a->volume);
     addViewOptions(*cmd, a->view);
-    cmd->add_option("--curve", a->curve, "curve FILE.json {\"points\": [[x,y,z], ...]}")
+    addOption(*cmd, "--curve", a->curve, "curve FILE.json {\"points\": [[x,y,z], ...]}", "Curve",
+              PathKind::Input)
         ->required();
-    cmd->add_option("--lateral", a->lateral, "lateral direction X,Y,Z (default 0,0,1)");
-    cmd->add_option("--width", a->width, "image width, pixels (default 128)");
-    cmd->add_option("--pixel-size", a->pixelSize, "world units per pixel (default: spacing)");
-    cmd->add_option("-o,--output", a->output, "output image")->required();
-    cmd->callback([a] {
-        checkImagePath(a->output);
+    addOption(*cmd, "--lateral", a->lateral, "lateral direction X,Y,Z (default 0,0,1)", "Curve");
+    addOption(*cmd, "--width", a->width, "image width, pixels (0: the curve file's, or 128)",
+              "Curve");
+    addOption(*cmd, "--pixel-size", a->pixelSize,
+              "world units per pixel (0: the curve file's, or the spacing)", "Curve");
+    addOption(*cmd, "-o,--output", a->output, "output image", "Output", PathKind::Output)
+        ->required();
+    cmd->footer(
+        "Examples:\n"
+        "  splat cpr ct.nrrd --curve vessel.json -o vessel.png\n"
+        "  splat cpr ch2.nii.gz --curve spine.json --width 96 --lateral 1,0,0 -o spine.exr");
+    cmd->callback([a, cmd] {
+        prepareCommand(*cmd, {"volume"});
+        checkImageOutput(a->output);
+        checkViewArgs(a->view);
+        asUsage([&] {
+            if (!a->lateral.empty()) parseVec3(a->lateral, "--lateral");
+            if (a->width < 0 || a->width > 32768) throw Error("--width must be 0..32768");
+            if (!std::isfinite(a->pixelSize) || a->pixelSize < 0)
+                throw Error("--pixel-size must be a finite number >= 0");
+        });
+        loadOptionsFromArgs(a->volume);
+        beginRun(*cmd);
         std::ifstream in(a->curve);
         if (!in) throw Error(a->curve + ": cannot open curve file");
         nlohmann::json j;

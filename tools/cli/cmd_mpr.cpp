@@ -1,10 +1,13 @@
 // `splat mpr VOLUME --plane X,Y,Z,NX,NY,NZ [--up V] --size WxH --pixel-size S -o OUT`:
 // multiplanar reconstruction (axis-aligned or oblique) through the reconstructed field.
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
 #include "commands.h"
+#include "diagnostics.h"
 #include "render_options.h"
+#include "scene_file.h"
 #include "splat/error.h"
 #include "technique_options.h"
 #include "view_options.h"
@@ -26,17 +29,36 @@ void registerMpr(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("mpr", "a cut plane through the reconstructed field");
     addVolumeOptions(*cmd, a->volume);
     addViewOptions(*cmd, a->view);
-    cmd->add_option("--plane", a->plane, "plane POINT,NORMAL: X,Y,Z,NX,NY,NZ (world)")->required();
-    cmd->add_option("--up", a->up, "image up direction X,Y,Z (auto: +z, or +y for axial planes)")
-        ->capture_default_str();
-    cmd->add_option("--size", a->size, "image size WxH")->capture_default_str();
-    cmd->add_option("--pixel-size", a->pixelSize, "world units per pixel (0 = smallest spacing)");
-    cmd->add_option("-o,--output", a->output, "output image (.png windowed, .exr/.tif values)")
+    addOption(*cmd, "--plane", a->plane, "plane POINT,NORMAL: X,Y,Z,NX,NY,NZ (world)", "Plane")
         ->required();
-    cmd->callback([a] {
-        checkImagePath(a->output);
-        const std::vector<double> p = parseNumbers(a->plane, "--plane");
-        if (p.size() != 6) throw Error("--plane needs X,Y,Z,NX,NY,NZ");
+    addOption(*cmd, "--up", a->up, "image up direction X,Y,Z (auto: +z, or +y for axial planes)",
+              "Plane");
+    addOption(*cmd, "--size", a->size, "image size WxH", "Plane");
+    addOption(*cmd, "--pixel-size", a->pixelSize, "world units per pixel (0 = smallest spacing)",
+              "Plane");
+    addOption(*cmd, "-o,--output", a->output, "output image (.png windowed, .exr/.tif values)",
+              "Output", PathKind::Output)
+        ->required();
+    cmd->footer(
+        "Examples:\n"
+        "  splat mpr ch2.nii.gz --plane 0,0,10,0,0,1 --size 256x256 -o axial.png\n"
+        "  splat mpr ct.nrrd --plane 0,0,0,1,1,0 --window-preset ct-bone -o oblique.png");
+    cmd->callback([a, cmd] {
+        prepareCommand(*cmd, {"volume"});
+        checkImageOutput(a->output);
+        checkViewArgs(a->view);
+        const std::vector<double> p = asUsage([&] {
+            const std::vector<double> v = parseNumbers(a->plane, "--plane");
+            if (v.size() != 6 || (v[3] == 0 && v[4] == 0 && v[5] == 0))
+                throw Error("--plane needs X,Y,Z,NX,NY,NZ with a non-zero normal");
+            if (a->up != "auto") parseVec3(a->up, "--up");
+            parseSize(a->size, "--size");
+            if (!std::isfinite(a->pixelSize) || a->pixelSize < 0)
+                throw Error("--pixel-size must be a finite number >= 0");
+            return v;
+        });
+        loadOptionsFromArgs(a->volume);
+        beginRun(*cmd);
         const Volume volume = loadVolumeFromArgs(a->volume);
         PlaneView plane;
         plane.point = {p[0], p[1], p[2]};

@@ -9,8 +9,10 @@
 #include <sstream>
 
 #include "commands.h"
+#include "diagnostics.h"
 #include "progress.h"
 #include "render_options.h"
+#include "scene_file.h"
 #include "splat/error.h"
 #include "splat/popping.h"
 #include "volume_options.h"
@@ -62,39 +64,52 @@ void registerPopping(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "popping", "find and prove popping: sweep views with both splatters and the reference");
     addVolumeOptions(*cmd, a->volume);
-    addRenderOptions(*cmd, a->render);
-    cmd->add_option("--from", a->from, "first angle of the sweep, degrees")->capture_default_str();
-    cmd->add_option("--to", a->to, "last angle of the sweep (inclusive), degrees")
-        ->capture_default_str();
-    cmd->add_option("--step", a->step, "angle step, degrees")->capture_default_str();
-    cmd->add_option("--sweep", a->sweep, "the angle swept: azimuth or elevation")
-        ->capture_default_str();
-    cmd->add_option("--renderers", a->renderers, "renderers to compare (reference: ground truth)")
-        ->capture_default_str();
-    cmd->add_option("--refine", a->refine, "bisection levels around each event (0: none)")
-        ->capture_default_str();
-    cmd->add_option("--threshold-k", a->k, "event threshold: median + K * MAD of the signal")
-        ->capture_default_str();
-    cmd->add_option("--threshold-floor", a->floor, "... and at least FLOOR * median")
-        ->capture_default_str();
-    cmd->add_option("--ppd", a->ppd, "LDR-FLIP pixels per degree")->capture_default_str();
-    cmd->add_flag("--no-flip", a->noFlip, "skip the perceptual (LDR-FLIP) columns");
-    cmd->add_option("--report", a->report, "report folder (report.html, metrics.csv, summary.json)")
-        ->required();
-    cmd->add_flag("-q,--quiet", a->quiet, "no progress output");
-    cmd->callback([a] {
-        if (a->sweep != "azimuth" && a->sweep != "elevation")
-            throw Error("--sweep must be azimuth or elevation");
-        RenderSettings settings = settingsFromArgs(a->render);
+    addRenderOptions(*cmd, a->render, false);
+    const std::string sw = "Sweep", out = "Output";
+    addOption(*cmd, "--from", a->from, "first angle of the sweep, degrees", sw);
+    addOption(*cmd, "--to", a->to, "last angle of the sweep (inclusive), degrees", sw);
+    addOption(*cmd, "--step", a->step, "angle step, degrees", sw);
+    addOption(*cmd, "--sweep", a->sweep, "the angle swept: azimuth or elevation", sw);
+    addOption(*cmd, "--renderers", a->renderers, "renderers to compare (reference: ground truth)",
+              sw);
+    addOption(*cmd, "--refine", a->refine, "bisection levels around each event (0: none)", sw);
+    addOption(*cmd, "--threshold-k", a->k, "event threshold: median + K * MAD of the signal", sw);
+    addOption(*cmd, "--threshold-floor", a->floor, "... and at least FLOOR * median", sw);
+    addOption(*cmd, "--ppd", a->ppd, "LDR-FLIP pixels per degree", sw);
+    addFlag(*cmd, "--no-flip", a->noFlip, "skip the perceptual (LDR-FLIP) columns", sw);
+    addOption(*cmd, "--report", a->report, "report folder (report.html, metrics.csv, summary.json)",
+              out, PathKind::Output);
+    addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
+    cmd->footer(
+        "Examples:\n"
+        "  splat popping synthetic:phantom:64 --from 40 --to 50 --step 0.5 --report pop\n"
+        "  splat popping ch2.nii.gz --tf mri-head --renderers axis,sheet --no-flip --report pop");
+    cmd->callback([a, cmd] {
+        prepareCommand(*cmd, {"volume", "report"});
+        if (given(*cmd, "renderer") && !fromScene(*cmd, "renderer"))
+            warn("--renderer does not apply to popping (it compares --renderers); ignored");
+        RenderUse use;
+        use.oneRenderer = false;
+        RenderSettings settings = settingsFromArgs(a->render, use);
         Sweep sweep;
-        sweep.angle = a->sweep == "azimuth" ? Sweep::Angle::Azimuth : Sweep::Angle::Elevation;
-        sweep.from = a->from;
-        sweep.to = a->to;
-        sweep.step = a->step;
-        sweep.base = settings.camera;
-        (void)sweep.angles();  // refuse a bad sweep before loading anything
         PoppingOptions o;
-        o.renderers = parseRenderers(a->renderers);
+        asUsage([&] {
+            if (a->sweep != "azimuth" && a->sweep != "elevation")
+                throw Error("--sweep must be azimuth or elevation");
+            sweep.angle = a->sweep == "azimuth" ? Sweep::Angle::Azimuth : Sweep::Angle::Elevation;
+            sweep.from = a->from;
+            sweep.to = a->to;
+            sweep.step = a->step;
+            sweep.base = settings.camera;
+            (void)sweep.angles();  // refuse a bad sweep before loading anything
+            o.renderers = parseRenderers(a->renderers);
+            if (a->refine < 0 || a->refine > 60) throw Error("--refine must be between 0 and 60");
+            for (double v : {a->k, a->floor, a->ppd})
+                if (!std::isfinite(v) || v < 0)
+                    throw Error(
+                        "--threshold-k, --threshold-floor and --ppd must be finite and >= 0");
+        });
+        loadOptionsFromArgs(a->volume);
         o.refine = a->refine;
         o.madK = a->k;
         o.floorRatio = a->floor;
@@ -102,6 +117,7 @@ void registerPopping(CLI::App& app) {
         o.flip = !a->noFlip;
         // The Scene is validated against its first renderer (iso: the reference alone).
         settings.renderer = o.renderers.front();
+        beginRun(*cmd);
         auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
         const Scene scene(volume, settings);
         installInterruptHandler();
@@ -121,6 +137,7 @@ void registerPopping(CLI::App& app) {
         printSummary(result);
         std::printf("wrote %s/report.html, metrics.csv, summary.json (%.1f s)\n", a->report.c_str(),
                     result.totalMs / 1000.0);
+        finishRun(*cmd);
     });
 }
 

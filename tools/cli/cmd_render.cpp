@@ -3,7 +3,10 @@
 #include <memory>
 
 #include "commands.h"
+#include "diagnostics.h"
 #include "render_options.h"
+#include "scene_file.h"
+#include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
 #include "volume_options.h"
@@ -22,13 +25,24 @@ void registerRender(CLI::App& app) {
     auto args = std::make_shared<RenderCommand>();
     CLI::App* cmd = app.add_subcommand("render", "render one image of a volume");
     addVolumeOptions(*cmd, args->volume);
-    addRenderOptions(*cmd, args->render);
-    cmd->add_option("-o,--output", args->output,
-                    "output image: .png (8-bit display), .exr or .tif (float)")
-        ->required();
-    cmd->callback([args] {
-        checkImagePath(args->output);
-        const RenderSettings settings = settingsFromArgs(args->render);
+    addRenderOptions(*cmd, args->render, true);
+    addOption(*cmd, "-o,--output", args->output,
+              "output image: .png (8-bit display), .exr or .tif (float, values as computed)",
+              "Output", PathKind::Output);
+    cmd->footer(
+        "Examples:\n"
+        "  splat render ch2.nii.gz --tf mri-head --azimuth 30 -o head.png\n"
+        "  splat render synthetic:phantom:64 --renderer sheet --slab 0.5 --mode mip -o p.exr\n"
+        "  splat render --scene view.json --size 1024x1024 -o big.png   (flags override the "
+        "scene)");
+    cmd->callback([args, cmd] {
+        prepareCommand(*cmd, {"volume", "output"});
+        checkImageOutput(args->output);
+        RenderUse use;
+        use.imageExt = lowerExtension(args->output);
+        const RenderSettings settings = settingsFromArgs(args->render, use);
+        loadOptionsFromArgs(args->volume);  // malformed volume options: usage errors, now
+        beginRun(*cmd);
         const Volume volume = loadVolumeFromArgs(args->volume);
         const Renderer renderer(volume, settings);
         RenderStats stats;
@@ -50,6 +64,7 @@ void registerRender(CLI::App& app) {
             stats.perspective ? "perspective" : "orthographic",
             stats.exactPixels ? " (eye near the volume: exact path for every pixel)" : "",
             stats.culledSplats, stats.footprintPixels);
+        finishRun(*cmd);
     });
 }
 

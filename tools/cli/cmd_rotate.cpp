@@ -18,8 +18,10 @@
 #include <regex>
 
 #include "commands.h"
+#include "diagnostics.h"
 #include "progress.h"
 #include "render_options.h"
+#include "scene_file.h"
 #include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
@@ -90,7 +92,7 @@ nlohmann::json manifestOf(const RotateCommand& a, const RenderSettings& s) {
             {"renderer", toString(s.renderer)},
             {"mode", toString(s.mode)},
             {"classify", toString(s.classification)},
-            {"tf", a.render.tf},
+            {"tf", a.render.tfInline.is_null() ? nlohmann::json(a.render.tf) : a.render.tfInline},
             {"size", a.render.size},
             {"azimuth", s.camera.azimuthDeg},
             {"elevation", s.camera.elevationDeg},
@@ -186,75 +188,113 @@ void writeMp4(const RotateCommand& a, const std::string& ffmpeg) {
                     ")");
     out.commit();
 }
+
+/// Refuses an extra output (GIF, contact sheet, MP4) that could not be written, before any
+/// frame is rendered: its folder is created, and must be writable.
+void checkExtraOutput(const std::string& path, const char* flag) {
+    if (path.empty()) return;
+    std::error_code ec;
+    if (fs::is_directory(path, ec))
+        throw Error(path + ": " + flag + " needs a file name, not a folder");
+    fs::path parent = fs::path(path).parent_path();
+    if (parent.empty()) parent = ".";
+    fs::create_directories(parent, ec);
+    if (!fs::is_directory(parent, ec))
+        throw Error(path + ": cannot create the folder '" + parent.string() + "'");
+    if (::access(parent.c_str(), W_OK) != 0)
+        throw Error(path + ": the folder '" + parent.string() + "' is not writable");
+}
 }  // namespace
 
 void registerRotate(CLI::App& app) {
     auto a = std::make_shared<RotateCommand>();
     CLI::App* cmd = app.add_subcommand("rotate", "render a rotation sequence or a camera path");
     addVolumeOptions(*cmd, a->volume);
-    addRenderOptions(*cmd, a->render);
-    cmd->add_option("--frames", a->frames, "number of frames")->capture_default_str();
-    cmd->add_option("--from", a->from, "first angle, degrees")->capture_default_str();
-    cmd->add_option("--to", a->to,
-                    "angle one step after the last frame, degrees (frames are spaced evenly over "
-                    "[from, to): 0..360 loops without repeating a view)")
-        ->capture_default_str();
-    cmd->add_option("--sweep", a->sweep, "the angle turned: azimuth or elevation")
-        ->capture_default_str();
-    cmd->add_option("--path", a->path,
-                    "camera path JSON {\"keys\": [{\"azimuth\", \"elevation\", \"distance\", "
-                    "\"pixel_size\"}, ...]}, interpolated over --frames (instead of --sweep)");
-    cmd->add_option("-o,--output", a->outDir, "output folder for the frames (created)")->required();
-    cmd->add_option("--name", a->name, "frame file name pattern (printf %d of the frame index)")
-        ->capture_default_str();
-    cmd->add_option("--format", a->format, "frame format: png, exr or tif")->capture_default_str();
-    cmd->add_flag("--resume", a->resume, "render only the frames missing from the folder");
-    cmd->add_flag("--overwrite", a->overwrite, "replace the frames the folder holds");
-    cmd->add_option("--gif", a->gif, "also write an animated GIF");
-    cmd->add_option("--contact-sheet", a->contact,
-                    "also write a contact sheet (all frames, tiled)");
-    cmd->add_option("--mp4", a->mp4,
-                    "also write an MP4 video (needs the ffmpeg program; png frames)");
-    cmd->add_option("--fps", a->fps, "GIF and MP4 frames per second (1..100)")
-        ->capture_default_str();
-    cmd->add_option("--parallel-frames", a->parallelFrames,
-                    "frames rendered at once, one thread each (0: automatic)")
-        ->capture_default_str();
-    cmd->add_flag("-q,--quiet", a->quiet, "no progress output");
-    cmd->callback([a] {
+    addRenderOptions(*cmd, a->render, true);
+    const std::string seq = "Sequence", out = "Output";
+    addOption(*cmd, "--frames", a->frames, "number of frames", seq);
+    addOption(*cmd, "--from", a->from, "first angle, degrees", seq);
+    addOption(*cmd, "--to", a->to,
+              "end of the turn, degrees: frames are spaced evenly over [from, to), so the last "
+              "frame is one step before it and 0..360 loops without repeating a view",
+              seq);
+    addOption(*cmd, "--sweep", a->sweep, "the angle turned: azimuth or elevation", seq);
+    addOption(*cmd, "--path", a->path,
+              "camera path JSON {\"keys\": [{\"azimuth\", \"elevation\", \"distance\", "
+              "\"pixel_size\"}, ...]}, interpolated over --frames (instead of --sweep)",
+              seq, PathKind::Input);
+    addOption(*cmd, "--parallel-frames", a->parallelFrames,
+              "frames rendered at once, one thread each (0: automatic)", seq);
+    addOption(*cmd, "-o,--output", a->outDir, "output folder for the frames (created)", out,
+              PathKind::Output);
+    addOption(*cmd, "--name", a->name, "frame file name pattern (printf %d of the frame index)",
+              out);
+    addOption(*cmd, "--format", a->format, "frame format: png, exr or tif", out);
+    addFlag(*cmd, "--resume", a->resume, "render only the frames missing from the folder", out);
+    addFlag(*cmd, "--overwrite", a->overwrite, "replace the frames the folder holds", out);
+    addOption(*cmd, "--gif", a->gif, "also write an animated GIF", out, PathKind::Output);
+    addOption(*cmd, "--contact-sheet", a->contact, "also write a contact sheet (all frames, tiled)",
+              out, PathKind::Output);
+    addOption(*cmd, "--mp4", a->mp4,
+              "also write an MP4 video (needs the ffmpeg program; png frames)", out,
+              PathKind::Output);
+    addOption(*cmd, "--fps", a->fps, "GIF and MP4 frames per second (1..100)", out);
+    addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
+    cmd->footer(
+        "Examples:\n"
+        "  splat rotate ch2.nii.gz --tf mri-head --frames 36 -o turn --gif turn.gif\n"
+        "  splat rotate synthetic:phantom:64 --sweep elevation --from -30 --to 30 --frames 13 -o "
+        "tilt\n"
+        "  splat rotate ch2.nii.gz --path path.json --frames 120 -o fly --mp4 fly.mp4 --fps 30");
+    cmd->callback([a, cmd] {
         // Everything that can be refused is refused before anything is rendered or created.
-        if (a->frames < 1 || a->frames > 100000)
-            throw Error("--frames must be between 1 and 100000");
-        if (a->fps < 1 || a->fps > 100) throw Error("--fps must be between 1 and 100");
-        if (a->parallelFrames < 0 || a->parallelFrames > 1024)
-            throw Error("--parallel-frames must be between 0 and 1024");
-        if (a->format != "png" && a->format != "exr" && a->format != "tif")
-            throw Error("--format must be png, exr or tif");
-        if (a->sweep != "azimuth" && a->sweep != "elevation")
-            throw Error("--sweep must be azimuth or elevation");
-        if (a->resume && a->overwrite) throw Error("--resume and --overwrite exclude each other");
-        checkPattern(a->name);
-        for (const std::string* out : {&a->gif, &a->contact})
-            if (!out->empty()) {
-                const fs::path parent = fs::path(*out).parent_path();
-                std::error_code ec;
-                if (!parent.empty()) fs::create_directories(parent, ec);
-                checkImagePath(*out);
-            }
-        if (!a->gif.empty() && lowerExtension(a->gif) != ".gif")
-            throw Error(a->gif + ": --gif needs a .gif file name");
+        prepareCommand(*cmd, {"volume", "output"});
+        asUsage([&] {
+            if (a->frames < 1 || a->frames > 100000)
+                throw Error("--frames must be between 1 and 100000");
+            if (a->fps < 1 || a->fps > 100) throw Error("--fps must be between 1 and 100");
+            if (a->parallelFrames < 0 || a->parallelFrames > 1024)
+                throw Error("--parallel-frames must be between 0 and 1024");
+            if (!std::isfinite(a->from) || !std::isfinite(a->to) || std::abs(a->from) > 1e6 ||
+                std::abs(a->to) > 1e6)
+                throw Error("--from and --to must be finite angles (degrees)");
+            if (a->format != "png" && a->format != "exr" && a->format != "tif")
+                throw Error("--format must be png, exr or tif");
+            if (a->sweep != "azimuth" && a->sweep != "elevation")
+                throw Error("--sweep must be azimuth or elevation");
+            if (a->resume && a->overwrite)
+                throw Error("--resume and --overwrite exclude each other");
+            checkPattern(a->name);
+            if (!a->gif.empty() && lowerExtension(a->gif) != ".gif")
+                throw Error(a->gif + ": --gif needs a .gif file name");
+            if (!a->contact.empty()) checkImageExtension(a->contact);
+            if (!a->mp4.empty() && lowerExtension(a->mp4) != ".mp4")
+                throw Error(a->mp4 + ": --mp4 needs a .mp4 file name");
+            if (!a->mp4.empty() && a->format != "png")
+                throw Error("--mp4 is made from png frames (--format png)");
+        });
+        if (!a->path.empty())
+            for (const char* k : {"from", "to", "sweep"})
+                if (given(*cmd, k) && !fromScene(*cmd, k))
+                    warn(std::string("--") + k + " does not apply with --path (the path's keys " +
+                         "set the views); ignored");
+        if (a->gif.empty() && a->mp4.empty() && given(*cmd, "fps") && !fromScene(*cmd, "fps"))
+            warn("--fps applies to --gif and --mp4 only; ignored");
+        RenderUse use;
+        use.imageExt = "." + a->format;
+        const RenderSettings settings = settingsFromArgs(a->render, use);
+        loadOptionsFromArgs(a->volume);
         std::string ffmpeg;
         if (!a->mp4.empty()) {
-            if (lowerExtension(a->mp4) != ".mp4")
-                throw Error(a->mp4 + ": --mp4 needs a .mp4 file name");
-            if (a->format != "png") throw Error("--mp4 is made from png frames (--format png)");
             ffmpeg = findProgram("ffmpeg");
             if (ffmpeg.empty())
                 throw Error(
                     "--mp4 needs the ffmpeg program, which is not installed "
                     "(Debian: apt-get install ffmpeg)");
         }
-        const RenderSettings settings = settingsFromArgs(a->render);
+        checkExtraOutput(a->gif, "--gif");
+        checkExtraOutput(a->contact, "--contact-sheet");
+        checkExtraOutput(a->mp4, "--mp4");
         const bool keepImages = !a->gif.empty() || !a->contact.empty();
         if (keepImages &&
             double(a->frames) * settings.camera.width * settings.camera.height > double(1 << 28))
@@ -269,6 +309,7 @@ void registerRotate(CLI::App& app) {
                             : CameraPath::fromJson(a->path, settings.camera, a->frames);
         nlohmann::json manifest = manifestOf(*a, settings);
         const std::vector<bool> keep = prepareFolder(*a, manifest);
+        beginRun(*cmd);
         auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
         const Scene scene(volume, settings);
         std::error_code ec;
@@ -286,7 +327,7 @@ void registerRotate(CLI::App& app) {
                     w.mapping = DisplayMapping::Window;
                     w.windowLow = old["window"][0].get<float>();
                     w.windowHigh = old["window"][1].get<float>();
-                    display = w;
+                    display = withMetadata(w);
                 }
             } catch (const std::exception&) {
             }
@@ -337,7 +378,7 @@ void registerRotate(CLI::App& app) {
             if (!a->contact.empty()) {
                 std::vector<Image> small;
                 for (const Image& im : shown) small.push_back(downscale(im, 160));
-                writeImage(a->contact, contactSheet(small), asIs);
+                writeImage(a->contact, contactSheet(small), withMetadata(asIs));
             }
         }
         if (!a->mp4.empty()) writeMp4(*a, ffmpeg);
@@ -346,6 +387,7 @@ void registerRotate(CLI::App& app) {
                     a->gif.empty() ? "" : ", ", a->gif.c_str(), a->contact.empty() ? "" : ", ",
                     a->contact.c_str(), a->mp4.empty() ? "" : ", ", a->mp4.c_str(),
                     rendered ? totalMs / double(rendered) : 0.0);
+        finishRun(*cmd);
     });
 }
 

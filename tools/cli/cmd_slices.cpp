@@ -6,6 +6,8 @@
 #include <memory>
 
 #include "commands.h"
+#include "diagnostics.h"
+#include "scene_file.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
 #include "view_options.h"
@@ -27,17 +29,30 @@ void registerSlices(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("slices", "slices as images plus a mosaic");
     addVolumeOptions(*cmd, a->volume);
     addViewOptions(*cmd, a->view);
-    cmd->add_option("--axis", a->axis, "x | y | z")->capture_default_str();
-    cmd->add_option("--every", a->every, "every Nth slice")->capture_default_str();
-    cmd->add_option("--columns", a->columns, "mosaic columns (0 = square)");
-    cmd->add_option("--format", a->format, "png | exr | tif")->capture_default_str();
-    cmd->add_option("-o,--output", a->output, "output folder (created)")->required();
-    cmd->callback([a] {
+    addOption(*cmd, "--axis", a->axis, "x | y | z", "Slices");
+    addOption(*cmd, "--every", a->every, "every Nth slice", "Slices");
+    addOption(*cmd, "--columns", a->columns, "mosaic columns (0 = square)", "Output");
+    addOption(*cmd, "--format", a->format, "png | exr | tif", "Output");
+    addOption(*cmd, "-o,--output", a->output, "output folder (created)", "Output", PathKind::Output)
+        ->required();
+    cmd->footer(
+        "Examples:\n"
+        "  splat slices ch2.nii.gz --axis z --every 4 -o slices\n"
+        "  splat slices ct.nrrd --axis y --window-preset ct-bone --format exr -o cor");
+    cmd->callback([a, cmd] {
+        prepareCommand(*cmd, {"volume"});
         const int axis = a->axis == "x" ? 0 : a->axis == "y" ? 1 : a->axis == "z" ? 2 : -1;
-        if (axis < 0) throw Error("--axis must be x, y or z");
-        if (a->every < 1) throw Error("--every must be >= 1");
-        if (a->format != "png" && a->format != "exr" && a->format != "tif")
-            throw Error("--format must be png, exr or tif");
+        asUsage([&] {
+            if (axis < 0) throw Error("--axis must be x, y or z");
+            if (a->every < 1) throw Error("--every must be >= 1");
+            if (a->columns < 0 || a->columns > 100000)
+                throw Error("--columns must be between 0 and 100000");
+            if (a->format != "png" && a->format != "exr" && a->format != "tif")
+                throw Error("--format must be png, exr or tif");
+        });
+        checkViewArgs(a->view);
+        loadOptionsFromArgs(a->volume);
+        beginRun(*cmd);
         namespace fs = std::filesystem;
         std::error_code ec;
         fs::create_directories(a->output, ec);

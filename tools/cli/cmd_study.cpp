@@ -3,13 +3,16 @@
 // study of splat/study.h: every combination of the swept knobs, timed and compared with
 // the reference; Pareto-optimal settings marked; study.csv, study.json, pareto.svg and
 // pareto.png in DIR, the reference cached there.
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sstream>
 
 #include "commands.h"
+#include "diagnostics.h"
 #include "progress.h"
 #include "render_options.h"
+#include "scene_file.h"
 #include "splat/error.h"
 #include "splat/study.h"
 #include "volume_options.h"
@@ -68,39 +71,58 @@ void registerStudy(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "study", "speed vs accuracy: sweep quality knobs, time them, compare with the reference");
     addVolumeOptions(*cmd, a->volume);
-    addRenderOptions(*cmd, a->render);
-    cmd->add_option("--sweep", a->sweeps,
-                    "KNOB=V1,V2,... (repeatable): renderer, slab, early-termination, size, "
-                    "order, classify, kernel, sigma, radius, footprint-res, slab-radial-res, "
-                    "slab-depth-res, poly-tol");
-    cmd->add_option("--report", a->report,
-                    "report folder (study.csv, study.json, pareto.svg, pareto.png; references "
-                    "cached there)")
-        ->required();
-    cmd->add_option("--repeats", a->repeats, "timed frames per setting and view")
-        ->capture_default_str();
-    cmd->add_option("--warmup", a->warmup, "untimed frames before them")->capture_default_str();
-    cmd->add_option("--views", a->views, "views AZ[:EL],... (default: the camera options)");
-    cmd->add_option("--truth-step", a->truthStep, "reference ray caster step for the ground truth")
-        ->capture_default_str();
-    cmd->add_option("--truth-tolerance", a->truthTolerance, "... and its refinement tolerance")
-        ->capture_default_str();
-    cmd->add_option("--ppd", a->ppd, "LDR-FLIP pixels per degree")->capture_default_str();
-    cmd->add_flag("--convergence", a->convergence,
-                  "also fit the observed convergence orders (slab, reference step, pixel size)");
-    cmd->add_flag("-q,--quiet", a->quiet, "no progress output");
-    cmd->callback([a] {
-        const RenderSettings settings = settingsFromArgs(a->render);
+    addRenderOptions(*cmd, a->render, false);
+    const std::string st = "Study", out = "Output";
+    addOption(*cmd, "--sweep", a->sweeps,
+              "KNOB=V1,V2,... (repeatable): renderer, slab, early-termination, size, order, "
+              "classify, kernel, sigma, radius, footprint-res, slab-radial-res, slab-depth-res, "
+              "poly-tol",
+              st);
+    addOption(*cmd, "--repeats", a->repeats, "timed frames per setting and view", st);
+    addOption(*cmd, "--warmup", a->warmup, "untimed frames before them", st);
+    addOption(*cmd, "--views", a->views, "views AZ[:EL],... (default: the camera options)", st);
+    addOption(*cmd, "--truth-step", a->truthStep, "reference ray caster step for the ground truth",
+              st);
+    addOption(*cmd, "--truth-tolerance", a->truthTolerance, "... and its refinement tolerance", st);
+    addOption(*cmd, "--ppd", a->ppd, "LDR-FLIP pixels per degree", st);
+    addFlag(*cmd, "--convergence", a->convergence,
+            "also fit the observed convergence orders (slab, reference step, pixel size)", st);
+    addOption(*cmd, "--report", a->report,
+              "report folder (study.csv, study.json, pareto.svg, pareto.png; references cached "
+              "there)",
+              out, PathKind::Output);
+    addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
+    cmd->footer(
+        "Examples:\n"
+        "  splat study synthetic:phantom:48 --sweep renderer=axis,sheet --sweep slab=0.5,1,2 "
+        "--report st\n"
+        "  splat study ch2.nii.gz --tf mri-head --views 0,45:30 --convergence --report st");
+    cmd->callback([a, cmd] {
+        prepareCommand(*cmd, {"volume", "report"});
+        RenderUse use;
+        use.oneRenderer = false;
+        const RenderSettings settings = settingsFromArgs(a->render, use);
         StudyOptions o;
-        for (const auto& s : a->sweeps) o.sweeps.push_back(parseKnob(s));
-        if (!a->views.empty()) o.views = parseViews(a->views);
+        asUsage([&] {
+            for (const auto& s : a->sweeps) o.sweeps.push_back(parseKnob(s));
+            if (!a->views.empty()) o.views = parseViews(a->views);
+            if (a->repeats < 1 || a->repeats > 1000 || a->warmup < 0 || a->warmup > 1000)
+                throw Error("--repeats must be 1..1000, --warmup 0..1000");
+            if (!std::isfinite(a->truthStep) || !(a->truthStep >= 1e-3) || a->truthStep > 64 ||
+                !std::isfinite(a->truthTolerance) || !(a->truthTolerance > 0) ||
+                !std::isfinite(a->ppd) || !(a->ppd > 0))
+                throw Error(
+                    "--truth-step must be in [0.001, 64], --truth-tolerance and --ppd finite and "
+                    "> 0");
+        });
+        loadOptionsFromArgs(a->volume);
         o.repeats = a->repeats;
         o.warmup = a->warmup;
-        if (o.repeats < 1 || o.warmup < 0) throw Error("--repeats must be >= 1, --warmup >= 0");
         o.referenceStep = a->truthStep;
         o.referenceTolerance = a->truthTolerance;
         o.pixelsPerDegree = a->ppd;
         o.cacheDir = a->report + "/cache";
+        beginRun(*cmd);
         auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
         installInterruptHandler();
         ProgressReporter progress("frames", a->quiet);
@@ -124,6 +146,7 @@ void registerStudy(CLI::App& app) {
         printTable(result);
         std::printf("wrote %s/study.csv, study.json, pareto.svg, pareto.png (%.1f s)\n",
                     a->report.c_str(), result.totalMs / 1000.0);
+        finishRun(*cmd);
     });
 }
 

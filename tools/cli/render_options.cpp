@@ -1,66 +1,81 @@
-// Shared rendering options and scene files (see render_options.h).
+// Shared rendering options (see render_options.h).
 #include "render_options.h"
 
+#include <unistd.h>
+
 #include <cmath>
-#include <fstream>
-#include <nlohmann/json.hpp>
+#include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
+#include "diagnostics.h"
+#include "scene_file.h"
+#include "splat/atomic_file.h"
 #include "splat/error.h"
 
 namespace splat::cli {
 
-void addRenderOptions(CLI::App& cmd, RenderArgs& a) {
+namespace fs = std::filesystem;
+
+void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool imageOutput) {
     a.cmd = &cmd;
-    cmd.add_option("--renderer", a.renderer, "axis | sheet | reference")->capture_default_str();
-    cmd.add_option("--mode", a.mode, "dvr | mip | xray | iso")->capture_default_str();
-    cmd.add_option("--order", a.order, "ftb (front-to-back) | btf (back-to-front)")
-        ->capture_default_str();
-    cmd.add_option("--classify", a.classify,
-                   "pre | post (classification before or after reconstruction)")
-        ->capture_default_str();
-    cmd.add_option("--tf", a.tf,
-                   "transfer function preset (ct-bone, ct-soft, mri-head, gray-ramp) or FILE.json")
-        ->capture_default_str();
-    cmd.add_option("--size", a.size, "image size WxH")->capture_default_str();
-    cmd.add_option("--azimuth", a.azimuth, "camera azimuth, degrees")->capture_default_str();
-    cmd.add_option("--elevation", a.elevation, "camera elevation, degrees")->capture_default_str();
-    cmd.add_option("--projection", a.projection, "ortho | perspective")->capture_default_str();
-    cmd.add_option("--pixel-size", a.pixelSize, "world units per pixel (0 = fit the volume)")
-        ->capture_default_str();
-    cmd.add_option("--fov", a.fov, "perspective vertical field of view, degrees")
-        ->capture_default_str();
-    cmd.add_option("--slab", a.slab, "image-aligned slab thickness, voxels")->capture_default_str();
-    cmd.add_option("--kernel", a.kernel, "reconstruction kernel: gaussian | bspline")
-        ->capture_default_str();
-    cmd.add_option("--sigma", a.sigma, "Gaussian sigma in voxels (0 = default)")
-        ->capture_default_str();
-    cmd.add_option("--radius", a.radius, "kernel radius in voxels (0 = default)")
-        ->capture_default_str();
-    cmd.add_option("--early-termination", a.earlyTermination,
-                   "front-to-back: stop when opacity >= 1 - EPS (0 = off)")
-        ->capture_default_str();
-    cmd.add_option("--background", a.background, "background R,G,B[,A] in [0, 1]")
-        ->capture_default_str();
-    cmd.add_option("--iso-level", a.isoLevel, "iso mode: level of the density")
-        ->capture_default_str();
-    cmd.add_option("--window", a.window, "mip/xray PNG display window LOW,HIGH (default 0,max)");
-    cmd.add_option("--threads", a.threads, "worker threads (0 = all cores)")->capture_default_str();
-    cmd.add_option("--tile-size", a.tileSize, "screen tile edge in pixels (8..64)")
-        ->capture_default_str();
-    cmd.add_option("--ref-step", a.refStep, "reference: initial step, voxels")
-        ->capture_default_str();
-    cmd.add_option("--ref-tolerance", a.refTolerance, "reference: step refinement tolerance")
-        ->capture_default_str();
-    cmd.add_flag("--shade", a.shade,
-                 "headlight Phong shading from the density gradient (pre-classified dvr)");
-    // Issue 12 (study branch): eye distance, so that views from inside the volume are possible.
-    cmd.add_option("--distance", a.distance,
-                   "perspective: eye distance from the volume centre, world units (0 = fit)")
-        ->capture_default_str();
-    cmd.add_option("--scene", a.scene,
-                   "scene FILE.json holding any of these options (flags override it)");
-    addTechniqueOptions(cmd, a.technique);
+    const std::string cls = "Classification", cam = "Camera", ren = "Renderer", q = "Quality";
+    addOption(cmd, "--mode", a.mode, "dvr | mip | xray | iso", cls);
+    addOption(cmd, "--classify", a.classify,
+              "pre | post: classification before or after reconstruction (dvr, iso)", cls);
+    addOption(cmd, "--tf", a.tf,
+              "transfer function: preset (ct-bone, ct-soft, mri-head, gray-ramp) or FILE.json "
+              "(a scene file may hold it inline as an object)",
+              cls, PathKind::Input);
+    acceptObject(
+        cmd, "tf", [&a](const nlohmann::json& j) { a.tfInline = j; }, [&a] { return a.tfInline; });
+    addOption(cmd, "--iso-level", a.isoLevel,
+              "iso: level of the density, absolute (120) or a fraction of the volume's "
+              "[min, max] ending in n (0.4n)",
+              cls);
+    addOption(cmd, "--size", a.size, "image size WxH", cam);
+    addOption(cmd, "--azimuth", a.azimuth, "camera azimuth, degrees", cam);
+    addOption(cmd, "--elevation", a.elevation, "camera elevation, degrees", cam);
+    addOption(cmd, "--projection", a.projection, "ortho | perspective", cam);
+    addOption(cmd, "--pixel-size", a.pixelSize, "world units per pixel (0 = fit the volume)", cam);
+    addOption(cmd, "--fov", a.fov, "perspective: vertical field of view, degrees", cam);
+    addOption(cmd, "--distance", a.distance,
+              "perspective: eye distance from the volume centre, world units (0 = fit)", cam);
+    addOption(cmd, "--renderer", a.renderer,
+              "axis (axis-aligned sheets) | sheet (image-aligned slabs) | reference (ray caster)",
+              ren);
+    addOption(cmd, "--order", a.order, "dvr: ftb (front-to-back) | btf (back-to-front)", ren);
+    addOption(cmd, "--kernel", a.kernel, "reconstruction kernel: gaussian | bspline", ren);
+    addOption(cmd, "--sigma", a.sigma, "Gaussian sigma in voxels (0 = the kernel's default)", ren);
+    addOption(cmd, "--radius", a.radius, "kernel radius in voxels (0 = the kernel's default)", ren);
+    addOption(cmd, "--background", a.background, "background R,G,B[,A] in [0, 1]", ren);
+    addFlag(cmd, "--shade", a.shade, "Blinn-Phong shading from the density gradient (dvr, iso)",
+            ren);
+    addOption(cmd, "--slab", a.slab, "sheet renderer: slab thickness, voxels", q);
+    addOption(cmd, "--early-termination", a.earlyTermination,
+              "splatters, front-to-back: stop when opacity >= 1 - EPS (0 = off)", q);
+    addOption(cmd, "--ref-step", a.refStep, "reference renderer: initial step, voxels", q);
+    addOption(cmd, "--ref-tolerance", a.refTolerance,
+              "reference renderer: step refinement tolerance", q);
+    addOption(cmd, "--threads", a.threads, "worker threads (0 = all cores)", q);
+    addOption(cmd, "--tile-size", a.tileSize, "splatters: screen tile edge in pixels (8..64)", q);
+    addTechniqueOptions(cmd, a.technique, imageOutput);
+    if (imageOutput)
+        addOption(cmd, "--window", a.window,
+                  "mip/xray 8-bit output: display window LOW,HIGH (default 0,max)", "Output");
+    addSceneOptions(cmd);
+}
+
+void checkImageExtension(const std::string& path) {
+    const std::string ext = lowerExtension(path);
+    for (const char* ok : {".png", ".exr", ".tif", ".tiff", ".gif", ".jpg", ".jpeg"})
+        if (ext == ok) return;
+    throw UsageError(path + ": unsupported image type '" + ext + "' (use .png, .exr or .tif)");
+}
+
+void checkImageOutput(const std::string& path) {
+    checkImageExtension(path);
+    checkImagePath(path);
 }
 
 glm::ivec2 parseSize(const std::string& text, const std::string& what) {
@@ -74,116 +89,40 @@ glm::ivec2 parseSize(const std::string& text, const std::string& what) {
     return {w, h};
 }
 
+std::pair<double, bool> parseIsoLevel(const std::string& text) {
+    std::string t = text;
+    const bool normalized = !t.empty() && (t.back() == 'n' || t.back() == 'N');
+    if (normalized) t.pop_back();
+    char* end = nullptr;
+    const double v = t.empty() ? NAN : std::strtod(t.c_str(), &end);
+    if (t.empty() || *end != '\0' || !std::isfinite(v))
+        throw Error("--iso-level '" + text +
+                    "' must be a finite number (absolute) or a fraction of the volume's range "
+                    "ending in n (e.g. 0.4n)");
+    return {v, normalized};
+}
+
 namespace {
 
-std::vector<double> parseList(const std::string& text, const std::string& what) {
-    std::vector<double> v;
-    std::stringstream in(text);
-    std::string item;
-    while (std::getline(in, item, ',')) {
-        try {
-            std::size_t used = 0;
-            v.push_back(std::stod(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
-        } catch (const std::exception&) {
-            throw Error(what + " '" + text + "' must be comma-separated numbers");
-        }
-    }
-    return v;
+void requireIn(double v, double lo, double hi, const std::string& what) {
+    if (!std::isfinite(v) || v < lo || v > hi)
+        throw Error(what + " must be a finite number between " + CLI::detail::to_string(lo) +
+                    " and " + CLI::detail::to_string(hi) + " (got " + CLI::detail::to_string(v) +
+                    ")");
 }
 
-// Reads the scene file into `a` for every key it has; keys use the flag names without
-// dashes ("renderer", "pixel-size", ...).
-RenderArgs withScene(const RenderArgs& given) {
-    RenderArgs a = given;
-    std::ifstream in(given.scene);
-    if (!in) throw Error(given.scene + ": cannot open scene file");
-    nlohmann::json j;
-    try {
-        in >> j;
-    } catch (const std::exception& e) {
-        throw Error(given.scene + ": not valid JSON (" + std::string(e.what()) + ")");
-    }
-    if (!j.is_object()) throw Error(given.scene + ": a scene file must be a JSON object");
-    auto flagGiven = [&](const std::string& key) {
-        const CLI::Option* o = given.cmd ? given.cmd->get_option_no_throw("--" + key) : nullptr;
-        return o && o->count() > 0;
-    };
-    try {
-        for (auto& [key, value] : j.items()) {
-            if (flagGiven(key)) continue;
-            if (key == "renderer")
-                a.renderer = value.get<std::string>();
-            else if (key == "mode")
-                a.mode = value.get<std::string>();
-            else if (key == "order")
-                a.order = value.get<std::string>();
-            else if (key == "classify")
-                a.classify = value.get<std::string>();
-            else if (key == "tf")
-                a.tf = value.get<std::string>();
-            else if (key == "size")
-                a.size = value.get<std::string>();
-            else if (key == "projection")
-                a.projection = value.get<std::string>();
-            else if (key == "kernel")
-                a.kernel = value.get<std::string>();
-            else if (key == "background")
-                a.background = value.get<std::string>();
-            else if (key == "window")
-                a.window = value.get<std::string>();
-            else if (key == "azimuth")
-                a.azimuth = value.get<double>();
-            else if (key == "elevation")
-                a.elevation = value.get<double>();
-            else if (key == "pixel-size")
-                a.pixelSize = value.get<double>();
-            else if (key == "fov")
-                a.fov = value.get<double>();
-            else if (key == "slab")
-                a.slab = value.get<double>();
-            else if (key == "sigma")
-                a.sigma = value.get<double>();
-            else if (key == "radius")
-                a.radius = value.get<double>();
-            else if (key == "early-termination")
-                a.earlyTermination = value.get<double>();
-            else if (key == "iso-level")
-                a.isoLevel = value.get<double>();
-            else if (key == "ref-step")
-                a.refStep = value.get<double>();
-            else if (key == "ref-tolerance")
-                a.refTolerance = value.get<double>();
-            else if (key == "threads")
-                a.threads = value.get<int>();
-            else if (key == "tile-size")
-                a.tileSize = value.get<int>();
-            else if (key == "shade")
-                a.shade = value.get<bool>();
-            else if (key == "distance")  // issue 12
-                a.distance = value.get<double>();
-            else if (!applyTechniqueSceneKey(key, value, a.technique))
-                throw Error(given.scene + ": unknown scene key '" + key + "'");
-        }
-    } catch (const nlohmann::json::exception& e) {
-        throw Error(given.scene + ": wrong value type (" + std::string(e.what()) + ")");
-    }
-    return a;
-}
-
-}  // namespace
-
-RenderSettings settingsFromArgs(const RenderArgs& given) {
-    const RenderArgs a = given.scene.empty() ? given : withScene(given);
+// Every value that the command line reads, checked; no file is read here.
+RenderSettings parseSettings(const RenderArgs& a) {
     RenderSettings s;
     s.renderer = parseRenderer(a.renderer);
     s.mode = parseMode(a.mode);
     s.order = parseOrder(a.order);
     s.classification = parseClassification(a.classify);
-    s.transfer = TransferFunction::load(a.tf);
     const glm::ivec2 size = parseSize(a.size, "--size");
     s.camera.width = size.x;
     s.camera.height = size.y;
+    requireIn(a.azimuth, -1e6, 1e6, "--azimuth");
+    requireIn(a.elevation, -1e6, 1e6, "--elevation");
     s.camera.azimuthDeg = a.azimuth;
     s.camera.elevationDeg = a.elevation;
     if (a.projection == "ortho" || a.projection == "orthographic")
@@ -192,36 +131,110 @@ RenderSettings settingsFromArgs(const RenderArgs& given) {
         s.camera.projection = Projection::Perspective;
     else
         throw Error("unknown projection '" + a.projection + "' (ortho or perspective)");
+    requireIn(a.pixelSize, 0, 1e12, "--pixel-size");
+    requireIn(a.fov, 0.1, 170, "--fov");
+    requireIn(a.distance, 0, 1e12, "--distance");
     s.camera.pixelSize = a.pixelSize;
     s.camera.fovDeg = a.fov;
-    s.camera.distance = a.distance;  // issue 12
+    s.camera.distance = a.distance;
+    if (!std::isfinite(a.slab) || !(a.slab >= 1e-3) || a.slab > 1e4)
+        throw Error("--slab: slab thickness must be between 0.001 and 10000 voxels (got " +
+                    CLI::detail::to_string(a.slab) + ")");
     s.quality.slab = a.slab;
     s.kernel = a.kernel;
+    requireIn(a.sigma, 0, 1e3, "--sigma");
+    requireIn(a.radius, 0, 1e3, "--radius");
     s.kernelSigma = a.sigma;
     s.kernelRadius = a.radius;
+    if (!(a.earlyTermination >= 0 && a.earlyTermination < 1))
+        throw Error("--early-termination: early termination threshold must be in [0, 1)");
     s.quality.earlyTermination = a.earlyTermination;
-    const std::vector<double> bg = parseList(a.background, "--background");
+    const std::vector<double> bg = parseNumbers(a.background, "--background");
     if (bg.size() != 3 && bg.size() != 4) throw Error("--background needs R,G,B or R,G,B,A");
+    for (double c : bg) requireIn(c, 0, 1, "--background: every component");
     s.background =
         glm::vec4(float(bg[0]), float(bg[1]), float(bg[2]), bg.size() == 4 ? float(bg[3]) : 1.0f);
-    s.isoLevel = a.isoLevel;
+    const auto [iso, normalized] = parseIsoLevel(a.isoLevel);
+    s.isoLevel = iso;
+    s.isoNormalized = normalized;
+    if (a.threads < 0 || a.threads > 1024)
+        throw Error("--threads must be between 0 (all cores) and 1024");
+    if (a.tileSize < 8 || a.tileSize > 64) throw Error("--tile-size must be between 8 and 64");
     s.threads = a.threads;
     s.quality.tileSize = a.tileSize;
+    requireIn(a.refStep, 1e-3, 64, "--ref-step (voxels)");
+    if (!std::isfinite(a.refTolerance) || !(a.refTolerance > 0) || a.refTolerance > 1)
+        throw Error("--ref-tolerance must be a finite number in (0, 1]");
     s.quality.referenceStep = a.refStep;
     s.quality.referenceTolerance = a.refTolerance;
     s.shading.enabled = a.shade;
     applyTechniqueArgs(a.technique, s);
+    if (!a.window.empty()) {
+        const std::vector<double> w = parseNumbers(a.window, "--window");
+        if (w.size() != 2 || !std::isfinite(w[0]) || !std::isfinite(w[1]) || !(w[1] > w[0]))
+            throw Error("--window needs finite LOW,HIGH with HIGH > LOW");
+    }
+    return s;
+}
+
+bool isPreset(const std::string& name) {
+    for (const std::string& p : TransferFunction::presetNames())
+        if (p == name) return true;
+    return false;
+}
+
+// A transfer function given inline in a scene file is read through a private temporary
+// file, exactly as a file would be; errors name the scene key instead.
+TransferFunction inlineTransfer(const RenderArgs& a) {
+    const std::string where = sceneFileOf(*a.cmd) + ": \"tf\"";
+    std::string path = (fs::temp_directory_path() / "splat-tf-XXXXXX.json").string();
+    const int fd = ::mkstemps(path.data(), 5);
+    if (fd < 0) throw Error(where + ": cannot create a temporary file");
+    const std::string text = a.tfInline.dump();
+    const bool ok = ::write(fd, text.data(), text.size()) == ssize_t(text.size());
+    ::close(fd);
+    try {
+        if (!ok) throw Error(path + ": write failed");
+        TransferFunction tf = TransferFunction::fromJson(path);
+        std::filesystem::remove(path);
+        tf.name = "inline";
+        return tf;
+    } catch (const Error& e) {
+        std::error_code ec;
+        std::filesystem::remove(path, ec);
+        std::string m = e.what();
+        for (std::size_t at; (at = m.find(path)) != std::string::npos;)
+            m.replace(at, path.size(), where);
+        throw UsageError(m);
+    }
+}
+
+}  // namespace
+
+RenderSettings settingsFromArgs(RenderArgs& a, const RenderUse& use) {
+    RenderSettings s = asUsage([&] { return parseSettings(a); });
+    dropIgnoredOptions(a, s, use);
+    s = asUsage([&] { return parseSettings(a); });
+    if (!a.tfInline.is_null() && !(a.cmd && a.cmd->get_option("--tf")->count() > 0)) {
+        s.transfer = inlineTransfer(a);
+    } else {
+        const bool file = a.tf.size() > 5 && a.tf.substr(a.tf.size() - 5) == ".json";
+        if (!file && !isPreset(a.tf))
+            asUsage([&] { return TransferFunction::preset(a.tf); });  // names the presets
+        s.transfer = TransferFunction::load(a.tf);
+    }
+    loadTechniqueFiles(a.technique, s);
     return s;
 }
 
 WriteOptions displayOptions(const RenderArgs& a, const RenderSettings& s, const Image& image) {
     WriteOptions o;
     applyTechniqueOutput(a.technique, o);
+    o = withMetadata(o);
     if (s.mode == RenderMode::Dvr || s.mode == RenderMode::Iso) return o;
     o.mapping = DisplayMapping::Window;
     if (!a.window.empty()) {
-        const std::vector<double> w = parseList(a.window, "--window");
-        if (w.size() != 2 || !(w[1] > w[0])) throw Error("--window needs LOW,HIGH with HIGH > LOW");
+        const std::vector<double> w = parseNumbers(a.window, "--window");
         o.windowLow = float(w[0]);
         o.windowHigh = float(w[1]);
     } else {

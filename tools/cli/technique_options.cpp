@@ -1,22 +1,18 @@
 // The classic techniques' options (see technique_options.h).
 #include "technique_options.h"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
+#include "diagnostics.h"
+#include "scene_file.h"
 #include "splat/error.h"
 #include "splat/volume_io.h"
 
 namespace splat::cli {
 
 namespace {
-
-bool given(const TechniqueArgs& a, const std::string& flag) {
-    const CLI::Option* o = a.cmd ? a.cmd->get_option_no_throw(flag) : nullptr;
-    return o && o->count() > 0;
-}
-
-void warn(const std::string& line) { std::fprintf(stderr, "splat: warning: %s\n", line.c_str()); }
 
 glm::dvec3 vec3Of(const std::vector<double>& v, std::size_t at) {
     return {v[at], v[at + 1], v[at + 2]};
@@ -32,116 +28,53 @@ std::vector<double> parseNumbers(const std::string& text, const std::string& wha
         try {
             std::size_t used = 0;
             v.push_back(std::stod(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
+            if (used != item.size() || !std::isfinite(v.back())) throw std::invalid_argument(item);
         } catch (const std::exception&) {
-            throw Error(what + " '" + text + "' must be comma-separated numbers");
+            throw Error(what + " '" + text + "' must be comma-separated finite numbers");
         }
     }
     return v;
 }
 
-void addTechniqueOptions(CLI::App& cmd, TechniqueArgs& a) {
+void addTechniqueOptions(CLI::App& cmd, TechniqueArgs& a, bool imageOutput) {
     a.cmd = &cmd;
-    const std::string g = "Techniques";
-    cmd.add_option("--ambient", a.ambient, "shading: ambient coefficient")
-        ->capture_default_str()
-        ->group(g);
-    cmd.add_option("--diffuse", a.diffuse, "shading: diffuse coefficient")
-        ->capture_default_str()
-        ->group(g);
-    cmd.add_option("--specular", a.specular, "shading: specular coefficient")
-        ->capture_default_str()
-        ->group(g);
-    cmd.add_option("--shininess", a.shininess, "shading: Blinn-Phong exponent")
-        ->capture_default_str()
-        ->group(g);
-    cmd.add_option("--light", a.light,
-                   "shading light: camera (headlight) or X,Y,Z world direction towards it")
-        ->capture_default_str()
-        ->group(g);
-    cmd.add_option("--edges", a.edges,
-                   "edge enhancement GAIN[,EXPONENT]: opacity x (1 + GAIN ((|grad|/max)^EXP - 1))")
-        ->group(g);
-    cmd.add_flag("--iso-normalized", a.isoNormalized,
-                 "--iso-level is a fraction of the volume's [min, max] (like the presets)")
-        ->group(g);
-    cmd.add_option("--clip-plane", a.clipPlanes,
-                   "cut plane X,Y,Z,NX,NY,NZ (world): removes the side the normal points to; "
-                   "repeatable")
-        ->group(g);
-    cmd.add_option("--crop", a.crop, "crop box X0,Y0,Z0,X1,Y1,Z1 (world units)")->group(g);
-    cmd.add_option("--label-volume", a.labelVolume,
-                   "segmentation label volume on VOLUME's grid (VOLUME is the intensity)")
-        ->group(g);
-    cmd.add_option("--label-colors", a.labelColors,
-                   "label colours: FILE.lut (256 x RGB, mricron) or FILE.json; without "
-                   "--label-volume, VOLUME itself holds the labels")
-        ->group(g);
-    cmd.add_option("--label-names", a.labelNames, "label names: FILE.txt (index name per line)")
-        ->group(g);
-    cmd.add_option("--labels", a.labels, "show only these labels, e.g. 37,38")->group(g);
-    cmd.add_option("--label-opacity", a.labelOpacity,
-                   "opacity of the labels per unit distance (tables without their own)")
-        ->capture_default_str()
-        ->group(g);
-    cmd.add_flag("--tf-rescale", a.tfRescale,
-                 "stretch the transfer function's first..last control values over the "
-                 "volume's [min, max] (ParaView's 'rescale to data range')")
-        ->group(g);
-    cmd.add_option("--bit-depth", a.bitDepth, "PNG bits per channel: 8 or 16")
-        ->capture_default_str()
-        ->group(g);
-    cmd.add_flag("--alpha", a.alpha, "PNG with alpha (transparent background)")->group(g);
-}
-
-bool applyTechniqueSceneKey(const std::string& key, const nlohmann::json& value, TechniqueArgs& a) {
-    auto str = [&](std::string& out) {
-        if (!given(a, "--" + key)) out = value.get<std::string>();
-        return true;
-    };
-    auto num = [&](double& out) {
-        if (!given(a, "--" + key)) out = value.get<double>();
-        return true;
-    };
-    if (key == "ambient") return num(a.ambient);
-    if (key == "diffuse") return num(a.diffuse);
-    if (key == "specular") return num(a.specular);
-    if (key == "shininess") return num(a.shininess);
-    if (key == "light") return str(a.light);
-    if (key == "edges") return str(a.edges);
-    if (key == "crop") return str(a.crop);
-    if (key == "label-volume") return str(a.labelVolume);
-    if (key == "label-colors") return str(a.labelColors);
-    if (key == "label-names") return str(a.labelNames);
-    if (key == "labels") return str(a.labels);
-    if (key == "label-opacity") return num(a.labelOpacity);
-    if (key == "iso-normalized") {
-        if (!given(a, "--iso-normalized")) a.isoNormalized = value.get<bool>();
-        return true;
+    const std::string cls = "Classification", ren = "Renderer";
+    addFlag(cmd, "--iso-normalized", a.isoNormalized,
+            "--iso-level is a fraction of the volume's [min, max] (same as the n suffix)", cls);
+    addOption(cmd, "--edges", a.edges,
+              "dvr edge enhancement GAIN[,EXPONENT]: opacity x (1 + GAIN ((|grad|/max)^EXP - 1))",
+              cls);
+    addOption(cmd, "--clip-plane", a.clipPlanes,
+              "cut plane X,Y,Z,NX,NY,NZ (world): removes the side the normal points to; "
+              "repeatable",
+              cls);
+    addOption(cmd, "--crop", a.crop, "crop box X0,Y0,Z0,X1,Y1,Z1 (world units)", cls);
+    addOption(cmd, "--label-volume", a.labelVolume,
+              "segmentation label volume on VOLUME's grid (VOLUME is the intensity)", cls,
+              PathKind::Input);
+    addOption(cmd, "--label-colors", a.labelColors,
+              "label colours: FILE.lut (256 x RGB, mricron) or FILE.json; without "
+              "--label-volume, VOLUME itself holds the labels",
+              cls, PathKind::Input);
+    addOption(cmd, "--label-names", a.labelNames, "label names: FILE.txt (index name per line)",
+              cls, PathKind::Input);
+    addOption(cmd, "--labels", a.labels, "show only these labels, e.g. 37,38", cls);
+    addOption(cmd, "--label-opacity", a.labelOpacity,
+              "opacity of the labels per unit distance (tables without their own)", cls);
+    addFlag(cmd, "--tf-rescale", a.tfRescale,
+            "stretch the transfer function's first..last control values over the volume's "
+            "[min, max] (ParaView's 'rescale to data range')",
+            cls);
+    addOption(cmd, "--ambient", a.ambient, "shading: ambient coefficient", ren);
+    addOption(cmd, "--diffuse", a.diffuse, "shading: diffuse coefficient", ren);
+    addOption(cmd, "--specular", a.specular, "shading: specular coefficient", ren);
+    addOption(cmd, "--shininess", a.shininess, "shading: Blinn-Phong exponent", ren);
+    addOption(cmd, "--light", a.light,
+              "shading light: camera (headlight) or X,Y,Z world direction towards it", ren);
+    if (imageOutput) {
+        addOption(cmd, "--bit-depth", a.bitDepth, "PNG bits per channel: 8 or 16", "Output");
+        addFlag(cmd, "--alpha", a.alpha, "PNG with alpha (transparent background)", "Output");
     }
-    if (key == "tf-rescale") {
-        if (!given(a, "--tf-rescale")) a.tfRescale = value.get<bool>();
-        return true;
-    }
-    if (key == "alpha") {
-        if (!given(a, "--alpha")) a.alpha = value.get<bool>();
-        return true;
-    }
-    if (key == "bit-depth") {
-        if (!given(a, "--bit-depth")) a.bitDepth = value.get<int>();
-        return true;
-    }
-    if (key == "clip-plane" || key == "clip-planes") {
-        if (given(a, "--clip-plane")) return true;
-        a.clipPlanes.clear();
-        if (value.is_string()) {
-            a.clipPlanes.push_back(value.get<std::string>());
-        } else {
-            for (const auto& p : value) a.clipPlanes.push_back(p.get<std::string>());
-        }
-        return true;
-    }
-    return false;
 }
 
 void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
@@ -161,8 +94,9 @@ void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
     sh.diffuse = float(a.diffuse);
     sh.specular = float(a.specular);
     sh.shininess = float(a.shininess);
-    if (!(a.ambient >= 0 && a.diffuse >= 0 && a.specular >= 0 && a.shininess >= 0))
-        throw Error("--ambient, --diffuse, --specular and --shininess must be >= 0");
+    for (double c : {a.ambient, a.diffuse, a.specular, a.shininess})
+        if (!std::isfinite(c) || c < 0 || c > 1e4)
+            throw Error("--ambient, --diffuse, --specular and --shininess must be finite and >= 0");
     if (a.light == "camera" || a.light == "headlight") {
         sh.headlight = true;
     } else {
@@ -174,12 +108,13 @@ void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
     }
     if (!a.edges.empty()) {
         const std::vector<double> e = parseNumbers(a.edges, "--edges");
-        if (e.empty() || e.size() > 2 || !(e[0] >= 0) || (e.size() == 2 && !(e[1] > 0)))
+        if (e.empty() || e.size() > 2 || !(e[0] >= 0) || !std::isfinite(e[0]) ||
+            (e.size() == 2 && (!(e[1] > 0) || !std::isfinite(e[1]))))
             throw Error("--edges needs GAIN >= 0 and optionally EXPONENT > 0");
         s.edges.gain = float(e[0]);
         if (e.size() == 2) s.edges.exponent = float(e[1]);
     }
-    s.isoNormalized = a.isoNormalized;
+    if (a.isoNormalized) s.isoNormalized = true;
     for (const std::string& text : a.clipPlanes) {
         const std::vector<double> p = parseNumbers(text, "--clip-plane");
         if (p.size() != 6 || glm::length(vec3Of(p, 3)) == 0.0)
@@ -194,32 +129,27 @@ void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
         s.clipping.boxMax = glm::max(vec3Of(c, 0), vec3Of(c, 3));
     }
     if (a.bitDepth != 8 && a.bitDepth != 16) throw Error("--bit-depth must be 8 or 16");
-    if (!a.labelColors.empty()) {
-        s.labels = Labels::load(a.labelColors, a.labelNames, float(a.labelOpacity));
-        if (!a.labels.empty())
-            for (double d : parseNumbers(a.labels, "--labels"))
-                s.labels.selection.push_back(int(d));
-        if (!a.labelVolume.empty())
-            s.labels.volume = std::make_shared<const Volume>(loadVolume(a.labelVolume));
-    } else if (!a.labelVolume.empty() || !a.labels.empty() || !a.labelNames.empty()) {
+    if (a.labelColors.empty() &&
+        (!a.labelVolume.empty() || !a.labels.empty() || !a.labelNames.empty()))
         throw Error("--label-volume, --labels and --label-names need --label-colors FILE");
-    }
+    if (!std::isfinite(a.labelOpacity) || a.labelOpacity < 0)
+        throw Error("--label-opacity must be a finite number >= 0");
+    if (!a.labels.empty())
+        for (double d : parseNumbers(a.labels, "--labels"))
+            if (d != std::floor(d) || d < 0 || d > 65535)
+                throw Error("--labels needs label numbers 0..65535, e.g. 37,38");
+}
 
-    // Never silence: every option that does not apply gets a warning line.
-    for (const std::string& line : inapplicableSettings(s)) warn(line);
-    const bool shadingFlags = given(a, "--ambient") || given(a, "--diffuse") ||
-                              given(a, "--specular") || given(a, "--shininess") ||
-                              given(a, "--light");
-    if (shadingFlags && !s.shading.enabled && s.mode == RenderMode::Dvr)
-        warn("shading coefficients or --light given without --shade; ignored");
-    if (shadingFlags && (s.mode == RenderMode::Xray || s.mode == RenderMode::Mip))
-        warn(std::string("shading coefficients and --light do not apply to ") + toString(s.mode) +
-             "; ignored");
-    if (given(a, "--iso-level") && s.mode != RenderMode::Iso)
-        warn(std::string("--iso-level applies to iso mode only; ignored in ") + toString(s.mode));
-    if (a.isoNormalized && s.mode != RenderMode::Iso)
-        warn(std::string("--iso-normalized applies to iso mode only; ignored in ") +
-             toString(s.mode));
+void loadTechniqueFiles(const TechniqueArgs& a, RenderSettings& s) {
+    if (a.labelColors.empty()) return;
+    s.labels = Labels::load(a.labelColors, a.labelNames, float(a.labelOpacity));
+    if (!a.labels.empty())
+        for (double d : parseNumbers(a.labels, "--labels")) s.labels.selection.push_back(int(d));
+    if (!a.labelVolume.empty()) {
+        auto labels = std::make_shared<const Volume>(loadVolume(a.labelVolume));
+        if (!labels->note.empty()) warn(a.labelVolume + ": " + labels->note);
+        s.labels.volume = labels;
+    }
 }
 
 void applyTechniqueOutput(const TechniqueArgs& a, WriteOptions& o) {

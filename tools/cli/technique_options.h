@@ -1,11 +1,10 @@
 #pragma once
 // The classic techniques' options (issue 13), kept apart from the shared option groups:
 // shading model and light, edge enhancement, normalized iso levels, clipping, segmentation
-// labels and output bit depth / alpha. addTechniqueOptions adds the flags,
-// applyTechniqueSceneKey reads the same keys from a scene file, applyTechniqueArgs puts them
-// into RenderSettings and prints a warning for every one that does not apply.
+// labels and output bit depth / alpha. addTechniqueOptions adds the flags (scene files read
+// them like every option, scene_file.h), applyTechniqueArgs puts them into RenderSettings;
+// ignored_flags.cpp warns about every one that does not apply.
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -29,21 +28,21 @@ struct TechniqueArgs {
     CLI::App* cmd = nullptr;
 };
 
-void addTechniqueOptions(CLI::App& cmd, TechniqueArgs& args);
+/// Adds the technique options to the Classification and Renderer groups; `imageOutput`: also
+/// --bit-depth and --alpha (Output).
+void addTechniqueOptions(CLI::App& cmd, TechniqueArgs& args, bool imageOutput);
 
-/// Reads one scene-file key into `args` unless its flag was given; false if the key is not a
-/// technique key.
-bool applyTechniqueSceneKey(const std::string& key, const nlohmann::json& value,
-                            TechniqueArgs& args);
-
-/// Puts the technique options into `s` (after the shared ones) and prints one warning line
-/// per option that does not apply to the chosen mode (splat/DESIGN.md: never silence).
+/// Puts the technique options into `s` (after the shared ones); reads no file. Throws
+/// splat::Error on a malformed value.
 void applyTechniqueArgs(const TechniqueArgs& args, RenderSettings& s);
+
+/// Reads the files the options name (label tables and volumes) into `s`.
+void loadTechniqueFiles(const TechniqueArgs& args, RenderSettings& s);
 
 /// 16-bit and alpha PNG output.
 void applyTechniqueOutput(const TechniqueArgs& args, WriteOptions& o);
 
-/// "1,2,3" -> {1, 2, 3}; throws splat::Error naming `what`.
+/// "1,2,3" -> {1, 2, 3}; throws splat::Error naming `what` (also for NaN and infinities).
 std::vector<double> parseNumbers(const std::string& text, const std::string& what);
 
 }  // namespace splat::cli

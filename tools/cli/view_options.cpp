@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "diagnostics.h"
+#include "scene_file.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
 #include "technique_options.h"
@@ -11,18 +13,42 @@
 namespace splat::cli {
 
 void addViewOptions(CLI::App& cmd, ViewArgs& a) {
-    cmd.add_option("--window", a.window, "display window LO,HI (data units)");
-    cmd.add_option("--window-preset", a.windowPreset,
-                   "display window: full (min..max, default), ct-brain (L40 W80), ct-soft "
-                   "(L50 W400), ct-bone (L500 W2000), ct-lung (L-600 W1500)");
-    cmd.add_option("--scale-bar", a.scaleBar, "draw a scale bar of this many world units (mm)");
-    cmd.add_option("--kernel", a.kernel, "reconstruction kernel: gaussian | bspline")
-        ->capture_default_str();
-    cmd.add_option("--sigma", a.sigma, "Gaussian sigma in voxels (0 = default)");
-    cmd.add_option("--radius", a.radius, "kernel radius in voxels (0 = default)");
-    cmd.add_option("--threads", a.threads, "worker threads (0 = all cores)");
-    cmd.add_option("--bit-depth", a.bitDepth, "PNG bits per channel: 8 or 16")
-        ->capture_default_str();
+    const std::string ren = "Renderer", out = "Output";
+    addOption(cmd, "--kernel", a.kernel, "reconstruction kernel: gaussian | bspline", ren);
+    addOption(cmd, "--sigma", a.sigma, "Gaussian sigma in voxels (0 = default)", ren);
+    addOption(cmd, "--radius", a.radius, "kernel radius in voxels (0 = default)", ren);
+    addOption(cmd, "--threads", a.threads, "worker threads (0 = all cores)", ren);
+    addOption(cmd, "--window", a.window, "display window LO,HI (data units)", out);
+    addOption(cmd, "--window-preset", a.windowPreset,
+              "display window: full (min..max, default), ct-brain (L40 W80), ct-soft (L50 W400), "
+              "ct-bone (L500 W2000), ct-lung (L-600 W1500)",
+              out);
+    addOption(cmd, "--scale-bar", a.scaleBar, "draw a scale bar of this many world units (mm)",
+              out);
+    addOption(cmd, "--bit-depth", a.bitDepth, "PNG bits per channel: 8 or 16", out);
+}
+
+void checkViewArgs(const ViewArgs& a) {
+    asUsage([&] {
+        if (a.bitDepth != 8 && a.bitDepth != 16) throw Error("--bit-depth must be 8 or 16");
+        if (!std::isfinite(a.sigma) || a.sigma < 0 || !std::isfinite(a.radius) || a.radius < 0)
+            throw Error("--sigma and --radius must be finite and >= 0");
+        if (a.threads < 0 || a.threads > 1024)
+            throw Error("--threads must be between 0 (all cores) and 1024");
+        if (!std::isfinite(a.scaleBar) || a.scaleBar < 0)
+            throw Error("--scale-bar must be a finite length >= 0");
+        if (!a.window.empty()) {
+            const std::vector<double> w = parseNumbers(a.window, "--window");
+            if (w.size() != 2 || !(w[1] > w[0])) throw Error("--window needs LO,HI with HI > LO");
+        }
+        const std::string& p = a.windowPreset;
+        if (!p.empty() && p != "full" && p != "ct-brain" && p != "ct-soft" && p != "ct-bone" &&
+            p != "ct-lung")
+            throw Error("unknown window preset '" + p +
+                        "' (full, ct-brain, ct-soft, ct-bone, ct-lung)");
+        if (!a.window.empty() && !a.windowPreset.empty())
+            warn("--window-preset does not apply with --window; ignored");
+    });
 }
 
 glm::dvec3 parseVec3(const std::string& text, const std::string& what) {
@@ -33,7 +59,7 @@ glm::dvec3 parseVec3(const std::string& text, const std::string& what) {
 
 void writeView(const std::string& path, Image image, const ViewArgs& a, const Volume& volume,
                double pixelSize) {
-    WriteOptions o;
+    WriteOptions o = withMetadata({});
     o.mapping = DisplayMapping::Window;
     if (a.bitDepth != 8 && a.bitDepth != 16) throw Error("--bit-depth must be 8 or 16");
     o.bitDepth = a.bitDepth;

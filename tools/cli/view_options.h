@@ -21,6 +21,9 @@ struct ViewArgs {
 
 void addViewOptions(CLI::App& cmd, ViewArgs& args);
 
+/// Refuses malformed view options before any work (UsageError).
+void checkViewArgs(const ViewArgs& args);
+
 /// Writes a view: .exr/.tif hold f as computed; .png the window (default: the volume's
 /// [min, max]) with the scale bar burnt in when asked for.
 void writeView(const std::string& path, Image image, const ViewArgs& args, const Volume& volume,

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "diagnostics.h"
+#include "scene_file.h"
 #include "splat/error.h"
 
 namespace splat::cli {
@@ -47,46 +49,60 @@ glm::dvec3 parseSpacing(const std::string& s) {
 }  // namespace
 
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
-    cmd.add_option("VOLUME", args.spec,
-                   "volume file (.nii .nii.gz .nrrd .nhdr .mhd .mha .raw), folder of slices "
-                   "or DICOM files, or synthetic:NAME[:N] (phantom, blob, cube, sphere, "
-                   "marschner-lobb)")
-        ->required();
-    cmd.add_option("--dims", args.dims, "raw data: dimensions XxYxZ, e.g. 256x256x128");
-    cmd.add_option("--type", args.type,
-                   "raw data: sample type (uint8 int8 uint16 int16 uint32 int32 float32 float64)");
-    cmd.add_option("--spacing", args.spacing, "raw data: spacing X,Y,Z (default 1,1,1)");
-    cmd.add_flag("--big-endian", args.bigEndian, "raw data: samples are big-endian");
-    // NonNegativeNumber: CLI11 would otherwise read "-1" as 2^64 - 1.
-    cmd.add_option("--header-bytes", args.headerBytes, "raw data: bytes to skip at the start")
+    const std::string g = "Volume";
+    addOption(cmd, "VOLUME", args.spec,
+              "volume file (.nii .nii.gz .nrrd .nhdr .mhd .mha .raw), folder of slices or DICOM "
+              "files, or synthetic:NAME[:N] (phantom, blob, cube, sphere, marschner-lobb)",
+              g, PathKind::Input);
+    addOption(cmd, "--dims", args.dims, "raw data: dimensions XxYxZ, e.g. 256x256x128", g);
+    addOption(cmd, "--type", args.type,
+              "raw data: sample type (uint8 int8 uint16 int16 uint32 int32 float32 float64)", g);
+    addOption(cmd, "--spacing", args.spacing, "raw data: spacing X,Y,Z (default 1,1,1)", g);
+    addFlag(cmd, "--big-endian", args.bigEndian, "raw data: samples are big-endian", g);
+    addOption(cmd, "--header-bytes", args.headerBytes, "raw data: bytes to skip at the start", g)
         ->check(CLI::NonNegativeNumber);
-    cmd.add_option("--nan-policy", args.nanPolicy,
-                   "NaN/Inf samples: 'error' refuses the volume, 'zero' replaces them by 0")
-        ->default_str("error");
-    cmd.add_flag("--allow-outside-data", args.allowOutsideData,
-                 "NRRD/MetaImage: allow data files outside the header's folder (absolute "
-                 "paths, ..)");
-    cmd.add_option("--series", args.series,
-                   "DICOM: the SeriesInstanceUID to load when a folder holds several "
-                   "(`splat info FOLDER` lists them)");
+    addOption(cmd, "--nan-policy", args.nanPolicy,
+              "NaN/Inf samples: 'error' refuses the volume, 'zero' replaces them by 0", g);
+    addFlag(cmd, "--allow-outside-data", args.allowOutsideData,
+            "NRRD/MetaImage: allow data files outside the header's folder (absolute paths, ..)",
+            g);
+    addOption(cmd, "--series", args.series,
+              "DICOM: the SeriesInstanceUID to load when a folder holds several (`splat info "
+              "FOLDER` lists them)",
+              g);
+}
+
+LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
+    return asUsage([&] {
+        LoadOptions options;
+        if (!args.dims.empty()) options.raw.dims = parseDims(args.dims);
+        options.raw.type = args.type;
+        if (!args.spacing.empty()) options.raw.spacing = parseSpacing(args.spacing);
+        options.raw.bigEndian = args.bigEndian;
+        options.raw.headerBytes = args.headerBytes;
+        options.allowOutsideDataFiles = args.allowOutsideData;
+        options.dicomSeries = args.series;
+        if (args.nanPolicy == "error")
+            options.nonFinite = NonFinitePolicy::Error;
+        else if (args.nanPolicy == "zero")
+            options.nonFinite = NonFinitePolicy::Zero;
+        else
+            throw Error("--nan-policy '" + args.nanPolicy + "': expected 'error' or 'zero'");
+        return options;
+    });
 }
 
 Volume loadVolumeFromArgs(const VolumeArgs& args) {
-    LoadOptions options;
-    if (!args.dims.empty()) options.raw.dims = parseDims(args.dims);
-    options.raw.type = args.type;
-    if (!args.spacing.empty()) options.raw.spacing = parseSpacing(args.spacing);
-    options.raw.bigEndian = args.bigEndian;
-    options.raw.headerBytes = args.headerBytes;
-    options.allowOutsideDataFiles = args.allowOutsideData;
-    options.dicomSeries = args.series;
-    if (args.nanPolicy == "error")
-        options.nonFinite = NonFinitePolicy::Error;
-    else if (args.nanPolicy == "zero")
-        options.nonFinite = NonFinitePolicy::Zero;
-    else
-        throw Error("--nan-policy '" + args.nanPolicy + "': expected 'error' or 'zero'");
-    return loadVolume(args.spec, options);
+    Volume v = loadVolume(args.spec, loadOptionsFromArgs(args));
+    // Every command that loads a volume says what the loader had to assume or change.
+    std::string note = v.note;
+    for (std::size_t at; (at = note.find("; ")) != std::string::npos;) note.replace(at, 2, "\n");
+    std::string lines;
+    std::istringstream in(note);
+    for (std::string line; std::getline(in, line);)
+        if (!line.empty()) lines += args.spec + ": " + line + "\n";
+    warn(lines);
+    return v;
 }
 
 }  // namespace splat::cli

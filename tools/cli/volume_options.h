@@ -21,7 +21,11 @@ struct VolumeArgs {
 /// --allow-outside-data/--series.
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args);
 
-/// Parses the options and loads the volume; throws splat::Error on bad input.
+/// Parses the options (UsageError on malformed ones).
+LoadOptions loadOptionsFromArgs(const VolumeArgs& args);
+
+/// Parses the options and loads the volume; throws splat::Error on bad input. Prints the
+/// volume's note (what the loader assumed or changed) as warning lines.
 Volume loadVolumeFromArgs(const VolumeArgs& args);
 
 }  // namespace splat::cli

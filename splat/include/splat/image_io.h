@@ -2,6 +2,7 @@
 // Image files through OpenImageIO. Writes are atomic: a temporary file in the same folder,
 // renamed over the target only when complete.
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "splat/image.h"
@@ -23,6 +24,10 @@ struct WriteOptions {
     /// .png: an alpha channel (the image's alpha; a transparent background stays
     /// transparent). Colour is written un-premultiplied, as PNG expects.
     bool alpha = false;
+    /// Key/value text stored in the file (PNG text chunks, EXR and TIFF attributes), e.g.
+    /// {"Software", "splat 0.1.0"}, {"splat:scene", "{...}"}; read back with OpenImageIO's
+    /// ImageSpec::get_string_attribute(key).
+    std::vector<std::pair<std::string, std::string>> metadata;
 };
 
 /// Writes `.png`, `.gif`, `.jpg` (8-bit display values, RGB) or `.exr`, `.tif`/`.tiff`

@@ -48,6 +48,17 @@ std::vector<float> displayValues(const Image& image, const WriteOptions& o, int 
     return out;
 }
 
+// Metadata as attributes; TIFF keeps only its own tags, so there the entries are also
+// lines "key: value" of the ImageDescription tag.
+void addMetadata(OIIO::ImageSpec& spec, const WriteOptions& o, bool tiff) {
+    std::string description;
+    for (const auto& [key, value] : o.metadata) {
+        spec.attribute(key, value);
+        if (tiff && key != "Software" && !value.empty()) description += key + ": " + value + "\n";
+    }
+    if (!description.empty()) spec.attribute("ImageDescription", description);
+}
+
 }  // namespace
 
 void checkImagePath(const std::string& path) {
@@ -76,6 +87,7 @@ void writeImage(const std::string& path, const Image& image, const WriteOptions&
         OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
         spec.channelnames = {"R", "G", "B", "A"};
         spec.alpha_channel = 3;
+        addMetadata(spec, options, ext != ".exr");
         ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
     } else {
         const bool png = ext == ".png";
@@ -88,6 +100,7 @@ void writeImage(const std::string& path, const Image& image, const WriteOptions&
             image.width, image.height, channels,
             options.bitDepth == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
         if (channels == 4) spec.alpha_channel = 3;
+        addMetadata(spec, options, false);
         ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, v.data());
     }
     const std::string err = out->geterror();

@@ -1,0 +1,15 @@
+// Warning lines (see diagnostics.h).
+#include "diagnostics.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace splat::cli {
+
+void warn(const std::string& text) {
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);)
+        if (!line.empty()) std::fprintf(stderr, "splat: warning: %s\n", line.c_str());
+}
+
+}  // namespace splat::cli

@@ -1,0 +1,102 @@
+#pragma once
+// Options of a subcommand, remembered so that a scene file can hold every one of them
+// (README "Scene files", splat/DESIGN.md "Decisions"): a scene key is an option's long name
+// without dashes ("pixel-size", "output"; "volume" for the VOLUME argument). Reading a
+// scene feeds each key to its option through CLI11's own conversion, so a scene accepts
+// exactly what the command line accepts (typed JSON numbers, arrays and booleans, or the
+// command line's strings); a flag given on the command line overrides its key. Writing a
+// scene (--write-scene, and the metadata of every image) records every option's value as
+// the command ran, paths absolute.
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "splat/image_io.h"
+
+namespace splat::cli {
+
+/// How a scene file's value becomes the option's text.
+enum class ValueKind { Flag, Integer, Unsigned, Real, Text, TextList };
+/// Paths are resolved against the scene file's folder and written absolute.
+enum class PathKind { None, Input, Output };
+
+namespace detail {
+void recordOption(CLI::App& cmd, CLI::Option* opt, ValueKind kind, PathKind path,
+                  std::function<nlohmann::json()> get);
+template <class T>
+constexpr ValueKind valueKindOf() {
+    if constexpr (std::is_same_v<T, bool>)
+        return ValueKind::Flag;
+    else if constexpr (std::is_integral_v<T> && std::is_unsigned_v<T>)
+        return ValueKind::Unsigned;
+    else if constexpr (std::is_integral_v<T>)
+        return ValueKind::Integer;
+    else if constexpr (std::is_floating_point_v<T>)
+        return ValueKind::Real;
+    else if constexpr (std::is_same_v<T, std::vector<std::string>>)
+        return ValueKind::TextList;
+    else
+        return ValueKind::Text;
+}
+}  // namespace detail
+
+/// An option bound to `var`, shown in `group` of --help with its default, and recorded for
+/// scene files.
+template <class T>
+CLI::Option* addOption(CLI::App& cmd, const std::string& names, T& var, const std::string& help,
+                       const std::string& group, PathKind path = PathKind::None) {
+    CLI::Option* o = cmd.add_option(names, var, help)->group(group);
+    if constexpr (std::is_arithmetic_v<T>) o->capture_default_str();
+    if constexpr (std::is_same_v<T, std::string>)
+        if (!var.empty()) o->capture_default_str();
+    detail::recordOption(cmd, o, detail::valueKindOf<T>(), path,
+                         [&var] { return nlohmann::json(var); });
+    return o;
+}
+
+CLI::Option* addFlag(CLI::App& cmd, const std::string& names, bool& var, const std::string& help,
+                     const std::string& group);
+
+/// A key whose scene value may also be a JSON object (e.g. an inline transfer function):
+/// `set` takes the object, `get` returns it for written scenes (null: the option's value).
+void acceptObject(CLI::App& cmd, const std::string& key,
+                  std::function<void(const nlohmann::json&)> set,
+                  std::function<nlohmann::json()> get);
+
+/// True when the option was given on the command line or by the scene file.
+bool given(const CLI::App& cmd, const std::string& key);
+/// True when the option's value came from the scene file rather than the command line.
+bool fromScene(const CLI::App& cmd, const std::string& key);
+/// The scene file being read ("" without --scene).
+std::string sceneFileOf(const CLI::App& cmd);
+
+/// --scene FILE and --write-scene FILE (group "Scene").
+void addSceneOptions(CLI::App& cmd);
+
+/// First step of a command: reads --scene (if given) into the options, then refuses a
+/// missing required value (UsageError naming its flag and scene key).
+void prepareCommand(CLI::App& cmd, std::initializer_list<const char*> required);
+
+/// The scene of the command as it runs: {"command": NAME, "volume": {"path": ..., ...},
+/// key: value, ...} in the order of --help.
+nlohmann::ordered_json sceneOf(const CLI::App& cmd);
+
+/// Fixes the scene for this run (call once the options are final): the metadata every
+/// written image carries and what --write-scene writes.
+void beginRun(const CLI::App& cmd);
+/// The command line equivalent to the scene: every option that differs from its default,
+/// paths absolute (the same for a run from flags and one from its written scene).
+std::string canonicalCommand(const CLI::App& cmd);
+/// `o` plus this run's metadata: Software, splat:command (canonicalCommand), splat:scene.
+WriteOptions withMetadata(WriteOptions o);
+/// Writes --write-scene FILE (if given) with the scene fixed by beginRun.
+void finishRun(const CLI::App& cmd);
+
+/// Every subcommand's recorded option keys (for shell completion).
+std::vector<std::string> recordedKeys(const CLI::App& cmd);
+
+}  // namespace splat::cli
