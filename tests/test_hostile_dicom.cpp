@@ -169,6 +169,13 @@ TEST_CASE("DICOM element lengths are checked before GDCM allocates", "[volume][d
     CHECK_THAT(errorOf([&] { loadVolume((dir / "huge.dcm").string()); }),
                Catch::Contains("huge.dcm: malformed DICOM file (element (32736,16) declares "
                                "4211081216 bytes, the file holds 24)"));
+    // A file that ends right after its meta group made Debian's GDCM abort on an assert
+    // (found by fuzz_dicom); so would a sequence in the meta group.
+    const std::size_t dataSet = bytes.find(std::string("\x08\x00", 2), 132);
+    REQUIRE(dataSet != std::string::npos);
+    writeBytes(dir / "metaonly.dcm", bytes.substr(0, dataSet));
+    CHECK_THAT(errorOf([&] { loadVolume((dir / "metaonly.dcm").string()); }),
+               Catch::Contains("no data set after the file meta information"));
     // Not a Part 10 file: refused, not guessed at.
     writeBytes(dir / "nopreamble.dcm", bytes.substr(132));
     CHECK_THAT(errorOf([&] { loadVolume((dir / "nopreamble.dcm").string()); }),

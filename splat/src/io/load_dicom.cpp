@@ -195,6 +195,10 @@ void checkDicomLengths(const std::vector<unsigned char>& b, const std::string& n
                 dicts.GetDictEntry(gdcm::Tag(std::uint16_t(group), std::uint16_t(element))).GetVR();
             sequence = vr == gdcm::VR::SQ;
         }
+        // GDCM asserts (aborts the process) on a sequence or an undefined length in the meta
+        // group, and on a file that ends inside it.
+        if (inMeta && (sequence || len == 0xFFFFFFFFu))
+            fail("a sequence or undefined length in the file meta information");
         if (len == 0xFFFFFFFFu) continue;  // undefined length: walk into its items
         if (len > b.size() - pos)
             fail("element (" + std::to_string(group) + "," + std::to_string(element) +
@@ -204,6 +208,7 @@ void checkDicomLengths(const std::vector<unsigned char>& b, const std::string& n
             syntax.assign(reinterpret_cast<const char*>(&b[pos]), std::size_t(len));
         if (!sequence) pos += std::size_t(len);  // a sequence's items are checked too
     }
+    if (inMeta) fail("no data set after the file meta information");
 }
 
 SliceInfo readInfoUnguarded(const fs::path& p) {
