@@ -151,3 +151,33 @@ TEST_CASE("DICOM: shuffled InstanceNumbers, two series, Hounsfield units, uprigh
         CHECK_THAT(v.note, Catch::Contains("gantry tilt of 11.31 degrees"));
     }
 }
+
+TEST_CASE("DICOM element lengths are checked before GDCM allocates", "[volume][dicom][hostile]") {
+    auto dir = testTmpDir("dicom_lengths");
+    DicomSlice s;
+    s.stored.assign(12, 7);
+    writeDicomSlice(dir / "ok.dcm", s);
+    std::string bytes = readTextFile(dir / "ok.dcm");
+    CHECK(loadVolume((dir / "ok.dcm").string()).data[0] == 7.0f);
+    // The pixel data element (7fe0,0010) declares 4.2 GB (found by fuzz_dicom: GDCM
+    // allocated it before reading). GDCM writes implicit VR little endian: tag, 4-byte length.
+    const std::size_t at = bytes.rfind(std::string("\xe0\x7f\x10\x00", 4));
+    REQUIRE(at != std::string::npos);
+    const std::uint32_t huge = 4211081216u;
+    std::memcpy(&bytes[at + 4], &huge, 4);
+    writeBytes(dir / "huge.dcm", bytes);
+    CHECK_THAT(errorOf([&] { loadVolume((dir / "huge.dcm").string()); }),
+               Catch::Contains("huge.dcm: malformed DICOM file (element (32736,16) declares "
+                               "4211081216 bytes, the file holds 24)"));
+    // A file that ends right after its meta group made Debian's GDCM abort on an assert
+    // (found by fuzz_dicom); so would a sequence in the meta group.
+    const std::size_t dataSet = bytes.find(std::string("\x08\x00", 2), 132);
+    REQUIRE(dataSet != std::string::npos);
+    writeBytes(dir / "metaonly.dcm", bytes.substr(0, dataSet));
+    CHECK_THAT(errorOf([&] { loadVolume((dir / "metaonly.dcm").string()); }),
+               Catch::Contains("no data set after the file meta information"));
+    // Not a Part 10 file: refused, not guessed at.
+    writeBytes(dir / "nopreamble.dcm", bytes.substr(132));
+    CHECK_THAT(errorOf([&] { loadVolume((dir / "nopreamble.dcm").string()); }),
+               Catch::Contains("no DICM marker"));
+}

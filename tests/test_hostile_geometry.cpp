@@ -97,8 +97,8 @@ TEST_CASE("render refuses absurd spacings with one line and nothing written",
         INFO(r.err);
         CHECK(r.status == 1);
         REQUIRE(r.errLines().size() >= 1);
-        CHECK_THAT(r.errLines().back(), Catch::StartsWith("splat: error: ") &&
-                                            Catch::Contains("exceeds 10000:1"));
+        CHECK_THAT(r.errLines().back(),
+                   Catch::StartsWith("splat: error: ") && Catch::Contains("exceeds 10000:1"));
         CHECK_FALSE(std::filesystem::exists(out));
     }
 }

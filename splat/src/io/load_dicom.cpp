@@ -8,6 +8,8 @@
 // CT) through each file's rescale, and the LPS patient coordinates become the RAS world
 // NIfTI uses, so the same orientation code makes a head upright. A folder holding several
 // series needs LoadOptions::dicomSeries (CLI: --series UID).
+#include <gdcmDicts.h>
+#include <gdcmGlobal.h>
 #include <gdcmImageReader.h>
 #include <gdcmReader.h>
 #include <gdcmStringFilter.h>
@@ -119,9 +121,100 @@ auto guarded(const fs::path& p, F f) {
     }
 }
 
+// GDCM allocates an element's value from its length field before reading it, so a
+// 100-byte file declaring a 4 GB element would allocate 4 GB. This walk over the element
+// headers (Part 10 files: preamble, explicit-VR meta group, then the data set in its
+// transfer syntax) checks every defined length against the bytes that follow before GDCM
+// sees the file. Sequences and items of undefined length are walked into; in implicit VR
+// the public dictionary says which tags are sequences, as it does for GDCM.
+void checkDicomLengths(const std::vector<unsigned char>& b, const std::string& name) {
+    auto fail = [&](const std::string& why) {
+        throw Error(name + ": malformed DICOM file (" + why + ")");
+    };
+    if (b.size() < 132 || std::memcmp(&b[128], "DICM", 4) != 0)
+        fail("no DICM marker after the 128-byte preamble: only DICOM Part 10 files are read");
+    static const std::string longVrs = "OBODOFOLOVOWSQSVUCUNURUTUV";
+    static const std::string shortVrs = "AEASATCSDADSDTFLFDISLOLTPNSHSLSSSTTMUIULUS";
+    const gdcm::Dicts& dicts = gdcm::Global::GetInstance().GetDicts();
+    std::size_t pos = 132;
+    bool inMeta = true, explicitVr = true, bigEndian = false;
+    std::string syntax;
+    auto read16 = [&](std::size_t at, bool be) {
+        return be ? std::uint32_t(b[at] << 8 | b[at + 1]) : std::uint32_t(b[at] | b[at + 1] << 8);
+    };
+    auto read32 = [&](std::size_t at, bool be) {
+        return be ? (read16(at, true) << 16 | read16(at + 2, true))
+                  : (read16(at, false) | read16(at + 2, false) << 16);
+    };
+    auto isVr = [](const std::string& list, const char* vr) {
+        for (std::size_t i = 0; i + 1 < list.size(); i += 2)
+            if (list[i] == vr[0] && list[i + 1] == vr[1]) return true;
+        return false;
+    };
+    while (pos < b.size()) {
+        if (b.size() - pos < 8) fail("truncated element header");
+        if (inMeta && read16(pos, false) != 0x0002) {
+            inMeta = false;
+            while (!syntax.empty() && (syntax.back() == '\0' || syntax.back() == ' '))
+                syntax.pop_back();
+            if (syntax == "1.2.840.10008.1.2.1.99")
+                fail("deflated transfer syntax is not supported");
+            explicitVr = syntax != "1.2.840.10008.1.2";
+            bigEndian = syntax == "1.2.840.10008.1.2.2";
+        }
+        const bool ex = inMeta || explicitVr, be = !inMeta && bigEndian;
+        const std::uint32_t group = read16(pos, be), element = read16(pos + 2, be);
+        if (group == 0xFFFE) {  // item or delimiter: tag + 4-byte length, no VR
+            const std::uint32_t len = read32(pos + 4, be);
+            pos += 8;
+            if (element == 0xE000 && len != 0xFFFFFFFFu && len > b.size() - pos)
+                fail("an item declares " + std::to_string(len) + " bytes, the file holds " +
+                     std::to_string(b.size() - pos));
+            continue;  // walk into items; delimiters have no value
+        }
+        std::uint64_t len = 0;
+        bool sequence = false;
+        if (ex) {
+            const char vr[2] = {char(b[pos + 4]), char(b[pos + 5])};
+            if (isVr(longVrs, vr)) {
+                if (b.size() - pos < 12) fail("truncated element header");
+                len = read32(pos + 8, be);
+                pos += 12;
+            } else if (isVr(shortVrs, vr)) {
+                len = read16(pos + 6, be);
+                pos += 8;
+            } else {
+                fail("unknown value representation in element (" + std::to_string(group) + "," +
+                     std::to_string(element) + ")");
+            }
+            sequence = vr[0] == 'S' && vr[1] == 'Q';
+        } else {
+            len = read32(pos + 4, be);
+            pos += 8;
+            const gdcm::VR vr =
+                dicts.GetDictEntry(gdcm::Tag(std::uint16_t(group), std::uint16_t(element))).GetVR();
+            sequence = vr == gdcm::VR::SQ;
+        }
+        // GDCM asserts (aborts the process) on a sequence or an undefined length in the meta
+        // group, and on a file that ends inside it.
+        if (inMeta && (sequence || len == 0xFFFFFFFFu))
+            fail("a sequence or undefined length in the file meta information");
+        if (len == 0xFFFFFFFFu) continue;  // undefined length: walk into its items
+        if (len > b.size() - pos)
+            fail("element (" + std::to_string(group) + "," + std::to_string(element) +
+                 ") declares " + std::to_string(len) + " bytes, the file holds " +
+                 std::to_string(b.size() - pos));
+        if (inMeta && group == 0x0002 && element == 0x0010)
+            syntax.assign(reinterpret_cast<const char*>(&b[pos]), std::size_t(len));
+        if (!sequence) pos += std::size_t(len);  // a sequence's items are checked too
+    }
+    if (inMeta) fail("no data set after the file meta information");
+}
+
 SliceInfo readInfoUnguarded(const fs::path& p) {
     const std::string name = displayName(p);
     const std::uint64_t fileSize = regularFileSize(p);
+    checkDicomLengths(readFileBytes(p), name);
     gdcm::Reader reader;
     reader.SetFileName(p.string().c_str());
     if (!reader.ReadUpToTag(kPixelData)) throw Error(name + ": not a readable DICOM file");
