@@ -145,6 +145,9 @@ bool applyTechniqueSceneKey(const std::string& key, const nlohmann::json& value,
 }
 
 void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
+    if (a.tfRescale && s.transfer.normalized)
+        warn("--tf-rescale: transfer function '" + s.transfer.name +
+             "' is already on the volume's normalized range; ignored");
     if (a.tfRescale) s.transfer = s.transfer.rescaledToData();
     // A preset that carries its mode: it applies unless a mode was chosen explicitly (--mode,
     // or a non-default mode from a scene file); an explicit mode that disagrees wins, with a
