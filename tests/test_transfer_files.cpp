@@ -180,6 +180,10 @@ TEST_CASE("transfer function files: typos and absurd numbers are refused naming 
           std::string::npos);
     CHECK(errorOf(file("[{\"RGBPoints\": [0, 0, 0, 0, 1, 1, 0, 0], \"ColorSpace\": \"Step\"}]"))
               .find("not supported") != std::string::npos);
+    // A hostile node count is refused before anything is resampled.
+    std::string many = "[{\"RGBPoints\": [";
+    for (int q = 0; q <= 65536; ++q) many += (q ? ", " : "") + std::to_string(q) + ", 0, 0, 0";
+    CHECK(errorOf(file(many + "]}]")).find("more than 65536 nodes") != std::string::npos);
     // The extremes of the accepted range render finite pixels.
     for (double u : {kMinUnitDistance, kMaxUnitDistance}) {
         RenderSettings s;
