@@ -205,6 +205,16 @@ TEST_CASE("presets carry their mode; an explicit --mode wins with a warning", "[
     CHECK(*TransferFunction::preset("mip-gray").mode == RenderMode::Mip);
     CHECK(*TransferFunction::preset("xray").mode == RenderMode::Xray);
     CHECK_FALSE(TransferFunction::preset("ct-bone").mode);
+    // The rule (library): the function's mode unless one was chosen explicitly.
+    const TransferFunction mipTf = TransferFunction::preset("mip-gray");
+    std::string w;
+    CHECK(modeFor(mipTf, RenderMode::Dvr, false, &w) == RenderMode::Mip);
+    CHECK(w.empty());
+    CHECK(modeFor(mipTf, RenderMode::Mip, true, &w) == RenderMode::Mip);
+    CHECK(w.empty());
+    CHECK(modeFor(mipTf, RenderMode::Xray, true, &w) == RenderMode::Xray);
+    CHECK(w == "--mode xray overrides the mode mip of transfer function 'mip-gray'");
+    CHECK(modeFor(TransferFunction::preset("ct-bone"), RenderMode::Iso, false) == RenderMode::Iso);
     const fs::path dir = testTmpDir("transfer_mode");
     auto run = [&](std::vector<std::string> extra, const std::string& out) {
         std::vector<std::string> args{"render", "synthetic:blob:16", "--size", "24x24",
