@@ -23,6 +23,22 @@ inline TransferFunction surfaceTf(float level, float alpha = 1.0f,
     return tf;
 }
 
+/// An n^3 volume of ones (spacing 1): a constant cube.
+inline Volume onesVolume(int n) {
+    Volume v = makeVolume(glm::ivec3(n), glm::dvec3(1.0), "constant");
+    for (float& d : v.data) d = 1.0f;
+    return v;
+}
+
+/// Green (0.2, 0.9, 0.3), transparent at 0 and opaque from 0.5 (absolute) on.
+inline TransferFunction greenTf() {
+    TransferFunction tf;
+    tf.points = {{0.0f, glm::vec4(0.2f, 0.9f, 0.3f, 0.0f)},
+                 {0.5f, glm::vec4(0.2f, 0.9f, 0.3f, 1.0f)},
+                 {2.0f, glm::vec4(0.2f, 0.9f, 0.3f, 1.0f)}};
+    return tf;
+}
+
 inline RenderSettings techniqueSettings(RendererKind r, RenderMode m, int size) {
     RenderSettings s;
     s.renderer = r;

@@ -84,12 +84,8 @@ TEST_CASE(
     "clipping: a cut through a constant cube shows the constant's colour; a crop box "
     "around everything changes no pixel",
     "[techniques]") {
-    Volume v = makeVolume(glm::ivec3(24), glm::dvec3(1.0), "constant");
-    for (float& d : v.data) d = 1.0f;
-    TransferFunction tf;
-    tf.points = {{0.0f, glm::vec4(0.2f, 0.9f, 0.3f, 0.0f)},
-                 {0.5f, glm::vec4(0.2f, 0.9f, 0.3f, 1.0f)},
-                 {2.0f, glm::vec4(0.2f, 0.9f, 0.3f, 1.0f)}};
+    const Volume v = onesVolume(24);
+    const TransferFunction tf = greenTf();
     for (Classification c : {Classification::Pre, Classification::Post})
         for (RendererKind r : kAllRenderers) {
             INFO(toString(r) << " " << toString(c));

@@ -8,6 +8,7 @@
 #include "cli_util.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
+#include "splat/metrics.h"
 #include "splat/render.h"
 #include "splat/synthetic.h"
 
@@ -179,6 +180,10 @@ TEST_CASE("transfer function files: typos and absurd numbers are refused naming 
           std::string::npos);
     CHECK(errorOf(file("[{\"RGBPoints\": [0, 0, 0, 0, 1, 1, 0, 0], \"ColorSpace\": \"Step\"}]"))
               .find("not supported") != std::string::npos);
+    // A hostile node count is refused before anything is resampled.
+    std::string many = "[{\"RGBPoints\": [";
+    for (int q = 0; q <= 65536; ++q) many += (q ? ", " : "") + std::to_string(q) + ", 0, 0, 0";
+    CHECK(errorOf(file(many + "]}]")).find("more than 65536 nodes") != std::string::npos);
     // The extremes of the accepted range render finite pixels.
     for (double u : {kMinUnitDistance, kMaxUnitDistance}) {
         RenderSettings s;
@@ -200,6 +205,16 @@ TEST_CASE("presets carry their mode; an explicit --mode wins with a warning", "[
     CHECK(*TransferFunction::preset("mip-gray").mode == RenderMode::Mip);
     CHECK(*TransferFunction::preset("xray").mode == RenderMode::Xray);
     CHECK_FALSE(TransferFunction::preset("ct-bone").mode);
+    // The rule (library): the function's mode unless one was chosen explicitly.
+    const TransferFunction mipTf = TransferFunction::preset("mip-gray");
+    std::string w;
+    CHECK(modeFor(mipTf, RenderMode::Dvr, false, &w) == RenderMode::Mip);
+    CHECK(w.empty());
+    CHECK(modeFor(mipTf, RenderMode::Mip, true, &w) == RenderMode::Mip);
+    CHECK(w.empty());
+    CHECK(modeFor(mipTf, RenderMode::Xray, true, &w) == RenderMode::Xray);
+    CHECK(w == "--mode xray overrides the mode mip of transfer function 'mip-gray'");
+    CHECK(modeFor(TransferFunction::preset("ct-bone"), RenderMode::Iso, false) == RenderMode::Iso);
     const fs::path dir = testTmpDir("transfer_mode");
     auto run = [&](std::vector<std::string> extra, const std::string& out) {
         std::vector<std::string> args{"render", "synthetic:blob:16", "--size", "24x24",
@@ -230,6 +245,31 @@ TEST_CASE("presets carry their mode; an explicit --mode wins with a warning", "[
     REQUIRE(run({"--tf", tf}, "file.exr").status == 0);
     CHECK(readImage((dir / "file.exr").string()).pixels ==
           readImage((dir / "mip.exr").string()).pixels);
+    // --tf-rescale: ParaView's "rescale to data range": a function over 0..2 stretched over
+    // the blob's [min, max] renders like the same function written over [min, max]; ignored
+    // with a warning for the presets, which are normalized already.
+    const std::string wide = (dir / "wide.json").string();
+    std::ofstream(wide) << R"([{"Name": "w", "RGBPoints": [0, 1, 1, 1, 2, 1, 1, 1],
+                                "Points": [0, 0, 0.5, 0, 2, 0.2, 0.5, 0]}])";
+    const VolumeStats st = volumeStats(makeSynthetic("blob", 16));
+    char range[200];
+    std::snprintf(range, sizeof range,
+                  R"([{"Name": "n", "RGBPoints": [%.9g, 1, 1, 1, %.9g, 1, 1, 1],
+                      "Points": [%.9g, 0, 0.5, 0, %.9g, 0.2, 0.5, 0]}])",
+                  double(st.minValue), double(st.maxValue), double(st.minValue),
+                  double(st.maxValue));
+    const std::string narrow = (dir / "narrow.json").string();
+    std::ofstream(narrow) << range;
+    REQUIRE(run({"--tf", wide, "--tf-rescale"}, "wide.exr").status == 0);
+    REQUIRE(run({"--tf", narrow}, "narrow.exr").status == 0);
+    REQUIRE(run({"--tf", wide}, "wide0.exr").status == 0);
+    const Image rescaled = readImage((dir / "wide.exr").string());
+    CHECK(compareImages(rescaled, readImage((dir / "narrow.exr").string())).maxAbs < 1e-6);
+    CHECK(compareImages(rescaled, readImage((dir / "wide0.exr").string())).maxAbs > 0.01);
+    const RunResult normalized = run({"--tf", "ct-bone", "--tf-rescale"}, "bone.exr");
+    REQUIRE(normalized.errLines().size() == 1);
+    CHECK(normalized.err.find("already on the volume's normalized range; ignored") !=
+          std::string::npos);
     // A typo in a transfer function file is one error line naming the key.
     std::ofstream(dir / "typo.json") << R"({"unit-distance": 1, "points": [[0, 0, 0, 0, 0]]})";
     const RunResult typo = run({"--tf", (dir / "typo.json").string()}, "typo.exr");

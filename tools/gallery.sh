@@ -55,8 +55,9 @@ done
 # ch2 with the AAL atlas (116 regions, mricron's colours), and a selection of regions.
 $S render $CH2 --tf mri-head --label-volume $T/aal.nii.gz --label-colors $T/aal.nii.lut --label-names $T/aal.nii.txt --labels 37,38,41,42 --azimuth 135 --elevation 20 --size 320x320 --renderer sheet -o $G/tech_ch2_aal.png
 $S render $T/aal.nii.gz --label-colors $T/aal.nii.lut --azimuth 135 --elevation 20 --size 320x320 -o $G/tech_aal.png
-# A clipped head: the field is cut at the plane, so the cut face shows the data there.
-$S render $CH2 --tf mri-head --shade --azimuth 150 --elevation 20 --size 320x320 --clip-plane 0,0,0,1,-1,0 -o $G/tech_head_clipped.png
+# A clipped head: the field is cut at the midsagittal plane (x = 0), so the cut face, turned
+# towards the camera, shows the data there.
+$S render $CH2 --tf mri-head --shade --azimuth 120 --elevation 15 --size 320x320 --clip-plane 0,0,0,1,0,0 -o $G/tech_head_clipped.png
 # An isosurface cut by a plane facing the camera: capped at the cut.
 $S render synthetic:phantom:96 --mode iso --iso-level 0.5 --iso-normalized --renderer sheet --azimuth 30 --elevation 20 --size 256x256 --shade --clip-plane 47.5,47.5,47.5,0.47,-0.81,0.34 -o $G/tech_iso_clipped.png
 # Volume viewing through the reconstructed field: slices, an oblique MPR and a CPR.

@@ -78,17 +78,17 @@ void addTechniqueOptions(CLI::App& cmd, TechniqueArgs& a, bool imageOutput) {
 }
 
 void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
+    if (a.tfRescale && s.transfer.normalized)
+        warn("--tf-rescale: transfer function '" + s.transfer.name +
+             "' is already on the volume's normalized range; ignored");
     if (a.tfRescale) s.transfer = s.transfer.rescaledToData();
     // A preset that carries its mode: it applies unless a mode was chosen explicitly (--mode,
     // or a non-default mode from a scene file); an explicit mode that disagrees wins, with a
     // warning.
-    if (s.transfer.mode && *s.transfer.mode != s.mode) {
-        if (given(a, "--mode") || s.mode != RenderMode::Dvr)
-            warn(std::string("--mode ") + toString(s.mode) + " overrides the mode " +
-                 toString(*s.transfer.mode) + " of transfer function '" + s.transfer.name + "'");
-        else
-            s.mode = *s.transfer.mode;
-    }
+    std::string modeWarning;
+    s.mode =
+        modeFor(s.transfer, s.mode, given(a, "--mode") || s.mode != RenderMode::Dvr, &modeWarning);
+    if (!modeWarning.empty()) warn(modeWarning);
     Shading& sh = s.shading;
     sh.ambient = float(a.ambient);
     sh.diffuse = float(a.diffuse);

@@ -67,6 +67,13 @@ class TransferFunction {
     bool invisibleOver(float lo, float hi) const;
 };
 
+/// The render mode when the transfer function may carry one (presets mip-gray, xray; a JSON
+/// file's "mode"): `chosen` when the mode was chosen explicitly (then `*warning`, if given,
+/// receives a line when it differs from the function's), else the function's mode, else
+/// `chosen`.
+RenderMode modeFor(const TransferFunction& tf, RenderMode chosen, bool explicitMode,
+                   std::string* warning = nullptr);
+
 /// Accepted unit distances, world units: outside, the opacity correction overflows float
 /// (1e-300 gave NaN pixels) or no ray could ever accumulate opacity.
 inline constexpr double kMinUnitDistance = 1e-6, kMaxUnitDistance = 1e6;

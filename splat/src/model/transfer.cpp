@@ -161,6 +161,16 @@ TransferFunction TransferFunction::load(const std::string& nameOrPath) {
     return preset(nameOrPath);
 }
 
+RenderMode modeFor(const TransferFunction& tf, RenderMode chosen, bool explicitMode,
+                   std::string* warning) {
+    if (!tf.mode || *tf.mode == chosen) return chosen;
+    if (!explicitMode) return *tf.mode;
+    if (warning)
+        *warning = std::string("--mode ") + toString(chosen) + " overrides the mode " +
+                   toString(*tf.mode) + " of transfer function '" + tf.name + "'";
+    return chosen;
+}
+
 TransferFunction TransferFunction::rescaledToData() const {
     if (normalized || points.empty()) return *this;
     TransferFunction tf = *this;

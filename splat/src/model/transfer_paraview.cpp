@@ -6,7 +6,8 @@
 // (ParaView rescales a preset to the data range only when told to: --tf-rescale). Colours
 // interpolated in a space other than RGB, and opacity segments with a midpoint other than 0.5
 // or a sharpness other than 0, are resampled at kPieces pieces per interval (the curve of
-// VTK's vtkPiecewiseFunction; Moreland's diverging Msh interpolation; D65 CIELAB).
+// VTK's vtkPiecewiseFunction; Moreland's diverging Msh interpolation; D65 CIELAB; fewer
+// pieces when a function has more than 2^15 intervals).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,6 +22,9 @@ namespace splat {
 namespace {
 
 constexpr int kPieces = 32;  // resampling of non-linear intervals
+// Most nodes per function, and most resampled points in all: far beyond any colour map
+// (the renderers tabulate 4096 entries) and a bound on memory for a hostile file.
+constexpr std::size_t kMaxNodes = 65536, kMaxPoints = std::size_t(1) << 20;
 using Rgb = std::array<double, 3>;
 
 enum class Space { Rgb, Hsv, Lab, Diverging };
@@ -216,6 +220,9 @@ Nodes readNodes(const nlohmann::json& arr, int per, bool colour, const std::stri
     if (!arr.is_array() || arr.empty() || arr.size() % std::size_t(per) != 0)
         throw Error(what + ": \"" + key + "\" must hold groups of " + std::to_string(per) +
                     " numbers");
+    if (arr.size() / std::size_t(per) > kMaxNodes)
+        throw Error(what + ": \"" + key + "\" has more than " + std::to_string(kMaxNodes) +
+                    " nodes");
     Nodes n;
     n.colour = colour;
     for (std::size_t q = 0; q < arr.size(); q += std::size_t(per)) {
@@ -328,14 +335,15 @@ TransferFunction fromPreset(const nlohmann::json& o, const std::string& what) {
             return;
         tf.points.push_back({float(x), c});
     };
+    const int pieces = int(std::clamp<std::size_t>(kMaxPoints / xs.size(), 1, kPieces));
     for (std::size_t q = 0; q < xs.size(); ++q) {
         push(xs[q], rgbaAt(xs[q], true));
         push(xs[q], rgbaAt(xs[q], false));  // a step: the same x twice
         if (q + 1 == xs.size()) break;
         const double lo = xs[q], hi = xs[q + 1];
         if (colour.linearOver(lo, hi) && opacity.linearOver(lo, hi)) continue;
-        for (int k = 1; k < kPieces; ++k) {
-            const double x = lo + (hi - lo) * k / kPieces;
+        for (int k = 1; k < pieces; ++k) {
+            const double x = lo + (hi - lo) * k / pieces;
             push(x, rgbaAt(x, true));
         }
     }
