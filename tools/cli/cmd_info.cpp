@@ -14,8 +14,13 @@ void registerInfo(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "info", "print a volume's size, spacing, extent, value range and histogram");
     addVolumeOptions(*cmd, *args);
-<<<<<<< HEAD
-    cmd->callback([args] {
+    cmd->footer(
+        "Examples:\n"
+        "  splat info ch2.nii.gz\n"
+        "  splat info scan.raw --dims 256x256x128 --type uint16 --big-endian --spacing 1,1,2");
+    cmd->callback([args, cmd] {
+        prepareCommand(*cmd, {"volume"});
+        loadOptionsFromArgs(*args);
         // A folder of several DICOM series: list them (one is chosen with --series UID).
         if (args->series.empty()) {
             const auto series = listDicomSeries(args->spec);
@@ -31,15 +36,6 @@ void registerInfo(CLI::App& app) {
                 return;
             }
         }
-=======
-    cmd->footer(
-        "Examples:\n"
-        "  splat info ch2.nii.gz\n"
-        "  splat info scan.raw --dims 256x256x128 --type uint16 --big-endian --spacing 1,1,2");
-    cmd->callback([args, cmd] {
-        prepareCommand(*cmd, {"volume"});
-        loadOptionsFromArgs(*args);
->>>>>>> cli
         Volume v = loadVolumeFromArgs(*args);
         std::fputs(describeVolume(v).c_str(), stdout);
     });

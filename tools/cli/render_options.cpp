@@ -209,20 +209,30 @@ TransferFunction inlineTransfer(const RenderArgs& a) {
     }
 }
 
+TransferFunction transferFromArgs(const RenderArgs& a) {
+    if (!a.tfInline.is_null() && !(a.cmd && a.cmd->get_option("--tf")->count() > 0))
+        return inlineTransfer(a);
+    // FILE.json, or FILE.json#Name for one preset of a ParaView file holding several.
+    const std::string path = a.tf.substr(0, a.tf.find('#'));
+    const bool file = path.size() > 5 && path.substr(path.size() - 5) == ".json";
+    if (!file && !isPreset(a.tf))
+        asUsage([&] { return TransferFunction::preset(a.tf); });  // names the presets
+    return TransferFunction::load(a.tf);
+}
+
 }  // namespace
 
 RenderSettings settingsFromArgs(RenderArgs& a, const RenderUse& use) {
     RenderSettings s = asUsage([&] { return parseSettings(a); });
+    // The transfer function first: a preset may carry the mode, which decides what applies.
+    s.transfer = transferFromArgs(a);
+    applyTransferChoice(a.technique, s);
+    const TransferFunction transfer = s.transfer;
+    const RenderMode mode = s.mode;
     dropIgnoredOptions(a, s, use);
     s = asUsage([&] { return parseSettings(a); });
-    if (!a.tfInline.is_null() && !(a.cmd && a.cmd->get_option("--tf")->count() > 0)) {
-        s.transfer = inlineTransfer(a);
-    } else {
-        const bool file = a.tf.size() > 5 && a.tf.substr(a.tf.size() - 5) == ".json";
-        if (!file && !isPreset(a.tf))
-            asUsage([&] { return TransferFunction::preset(a.tf); });  // names the presets
-        s.transfer = TransferFunction::load(a.tf);
-    }
+    s.transfer = transfer;
+    s.mode = mode;
     loadTechniqueFiles(a.technique, s);
     return s;
 }

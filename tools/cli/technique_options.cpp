@@ -77,7 +77,7 @@ void addTechniqueOptions(CLI::App& cmd, TechniqueArgs& a, bool imageOutput) {
     }
 }
 
-void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
+void applyTransferChoice(const TechniqueArgs& a, RenderSettings& s) {
     if (a.tfRescale && s.transfer.normalized)
         warn("--tf-rescale: transfer function '" + s.transfer.name +
              "' is already on the volume's normalized range; ignored");
@@ -89,6 +89,9 @@ void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
     s.mode =
         modeFor(s.transfer, s.mode, given(a, "--mode") || s.mode != RenderMode::Dvr, &modeWarning);
     if (!modeWarning.empty()) warn(modeWarning);
+}
+
+void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
     Shading& sh = s.shading;
     sh.ambient = float(a.ambient);
     sh.diffuse = float(a.diffuse);

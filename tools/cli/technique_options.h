@@ -35,6 +35,9 @@ void addTechniqueOptions(CLI::App& cmd, TechniqueArgs& args, bool imageOutput);
 /// Puts the technique options into `s` (after the shared ones); reads no file. Throws
 /// splat::Error on a malformed value.
 void applyTechniqueArgs(const TechniqueArgs& args, RenderSettings& s);
+/// After s.transfer is loaded: --tf-rescale, and the mode a preset carries (an explicit
+/// --mode wins, with a warning when they disagree).
+void applyTransferChoice(const TechniqueArgs& args, RenderSettings& s);
 
 /// Reads the files the options name (label tables and volumes) into `s`.
 void loadTechniqueFiles(const TechniqueArgs& args, RenderSettings& s);
