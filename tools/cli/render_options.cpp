@@ -177,12 +177,6 @@ RenderSettings parseSettings(const RenderArgs& a) {
     return s;
 }
 
-bool isPreset(const std::string& name) {
-    for (const std::string& p : TransferFunction::presetNames())
-        if (p == name) return true;
-    return false;
-}
-
 // A transfer function given inline in a scene file is read through a private temporary
 // file, exactly as a file would be; errors name the scene key instead.
 TransferFunction inlineTransfer(const RenderArgs& a) {
@@ -219,7 +213,7 @@ RenderSettings settingsFromArgs(RenderArgs& a, const RenderUse& use) {
         s.transfer = inlineTransfer(a);
     } else {
         const bool file = a.tf.size() > 5 && a.tf.substr(a.tf.size() - 5) == ".json";
-        if (!file && !isPreset(a.tf))
+        if (!file && !isTransferPreset(a.tf))
             asUsage([&] { return TransferFunction::preset(a.tf); });  // names the presets
         s.transfer = TransferFunction::load(a.tf);
     }
