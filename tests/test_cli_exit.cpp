@@ -133,8 +133,7 @@ TEST_CASE("every numeric flag is checked before any work", "[cli][exit]") {
     CHECK(!fs::exists(frames));
 }
 
-TEST_CASE("--help is grouped with defaults and examples; --version names the build",
-          "[cli][exit]") {
+TEST_CASE("help is grouped with defaults and examples; version names the build", "[cli][exit]") {
     const RunResult h = runSplat({"render", "--help"});
     CHECK(h.status == 0);
     for (const char* g :

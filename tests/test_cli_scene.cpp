@@ -44,7 +44,7 @@ fs::path writeRamp(const fs::path& dir) {
 
 }  // namespace
 
-TEST_CASE("--write-scene writes the scene that reproduces the image byte for byte",
+TEST_CASE("write-scene: the scene written that reproduces the image byte for byte",
           "[cli][scene]") {
     const fs::path dir = testTmpDir("scene_reproduce");
     for (const char* ext : {".png", ".exr", ".tif"}) {
@@ -216,8 +216,7 @@ TEST_CASE("keys of another command are named in one warning line", "[cli][scene]
     CHECK(splat::readImage(frame.string()).pixels == before.pixels);
 }
 
-TEST_CASE("--iso-level takes absolute levels and fractions of the range ending in n",
-          "[cli][scene]") {
+TEST_CASE("iso levels: absolute levels and fractions of the range ending in n", "[cli][scene]") {
     const fs::path dir = testTmpDir("scene_iso");
     const fs::path ramp = writeRamp(dir);
     auto render = [&](const std::string& level, const std::string& name) {

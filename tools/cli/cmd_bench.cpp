@@ -64,15 +64,7 @@ void registerBench(CLI::App& app) {
                 throw Error("--repeats must be between 1 and 1000");
             return parseThreads(a->threadList);
         });
-        if (!a->json.empty()) {
-            // Refused before the timing, not after it.
-            std::error_code ec;
-            const std::filesystem::path p(a->json), parent = p.parent_path();
-            if (std::filesystem::is_directory(p, ec))
-                throw Error(a->json + ": --json needs a file name, not a folder");
-            if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
-                throw Error(a->json + ": folder '" + parent.string() + "' does not exist");
-        }
+        if (!a->json.empty()) checkOutputFile(a->json, "--json");  // before the timing
         RenderSettings settings = settingsFromArgs(a->render, RenderUse{});
         loadOptionsFromArgs(a->volume);
         beginRun(*cmd);

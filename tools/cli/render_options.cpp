@@ -177,12 +177,6 @@ RenderSettings parseSettings(const RenderArgs& a) {
     return s;
 }
 
-bool isPreset(const std::string& name) {
-    for (const std::string& p : TransferFunction::presetNames())
-        if (p == name) return true;
-    return false;
-}
-
 // A transfer function given inline in a scene file is read through a private temporary
 // file, exactly as a file would be; errors name the scene key instead.
 TransferFunction inlineTransfer(const RenderArgs& a) {
@@ -215,7 +209,7 @@ TransferFunction transferFromArgs(const RenderArgs& a) {
     // FILE.json, or FILE.json#Name for one preset of a ParaView file holding several.
     const std::string path = a.tf.substr(0, a.tf.find('#'));
     const bool file = path.size() > 5 && path.substr(path.size() - 5) == ".json";
-    if (!file && !isPreset(a.tf))
+    if (!file && !isTransferPreset(a.tf))
         asUsage([&] { return TransferFunction::preset(a.tf); });  // names the presets
     return TransferFunction::load(a.tf);
 }

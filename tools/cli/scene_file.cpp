@@ -65,16 +65,10 @@ std::string keyOf(const CLI::Option* o) {
     return k;
 }
 
-bool isPreset(const std::string& name) {
-    for (const std::string& p : TransferFunction::presetNames())
-        if (p == name) return true;
-    return false;
-}
-
 /// A path as the scene says it, relative to the scene file's folder.
 std::string resolvedPath(const Entry& e, const std::string& value, const fs::path& dir) {
     if (value.empty() || value.rfind("synthetic:", 0) == 0) return value;
-    if (e.key == "tf" && isPreset(value)) return value;
+    if (e.key == "tf" && isTransferPreset(value)) return value;
     const fs::path p(value);
     return p.is_absolute() ? value : (dir / p).lexically_normal().string();
 }
@@ -82,7 +76,7 @@ std::string resolvedPath(const Entry& e, const std::string& value, const fs::pat
 /// A path as a written scene holds it: absolute.
 std::string absolutePath(const Entry& e, const std::string& value) {
     if (value.empty() || value.rfind("synthetic:", 0) == 0) return value;
-    if (e.key == "tf" && isPreset(value)) return value;
+    if (e.key == "tf" && isTransferPreset(value)) return value;
     std::error_code ec;
     const fs::path a = fs::absolute(value, ec);
     return ec ? value : a.lexically_normal().string();
@@ -355,14 +349,22 @@ void prepareCommand(CLI::App& cmd, std::initializer_list<const char*> required) 
                              (std::string(key) == "volume" ? std::string("VOLUME") : flag) +
                              " (on the command line, or \"" + key + "\" in a --scene file)");
         }
-    if (!t.writeScene.empty()) {
-        std::error_code ec;
-        const fs::path p(t.writeScene), parent = p.parent_path();
-        if (fs::is_directory(p, ec))
-            throw Error(t.writeScene + ": --write-scene needs a file name, not a folder");
-        if (!parent.empty() && !fs::is_directory(parent, ec))
-            throw Error(t.writeScene + ": folder '" + parent.string() + "' does not exist");
-    }
+    if (!t.writeScene.empty()) checkOutputFile(t.writeScene, "--write-scene");
+}
+
+bool isTransferPreset(const std::string& name) {
+    for (const std::string& p : TransferFunction::presetNames())
+        if (p == name) return true;
+    return false;
+}
+
+void checkOutputFile(const std::string& path, const std::string& flag) {
+    std::error_code ec;
+    const fs::path p(path), parent = p.parent_path();
+    if (fs::is_directory(p, ec))
+        throw Error(path + ": " + flag + " needs a file name, not a folder");
+    if (!parent.empty() && !fs::is_directory(parent, ec))
+        throw Error(path + ": folder '" + parent.string() + "' does not exist");
 }
 
 nlohmann::ordered_json sceneOf(const CLI::App& cmd) {

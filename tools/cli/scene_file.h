@@ -96,6 +96,13 @@ WriteOptions withMetadata(WriteOptions o);
 /// Writes --write-scene FILE (if given) with the scene fixed by beginRun.
 void finishRun(const CLI::App& cmd);
 
+/// True for the names of the transfer-function presets.
+bool isTransferPreset(const std::string& name);
+
+/// Refuses, before any work, an output file name that is a folder or whose folder does not
+/// exist (splat::Error naming `flag`).
+void checkOutputFile(const std::string& path, const std::string& flag);
+
 /// Every subcommand's recorded option keys (for shell completion).
 std::vector<std::string> recordedKeys(const CLI::App& cmd);
 

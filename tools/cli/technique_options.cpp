@@ -86,8 +86,8 @@ void applyTransferChoice(const TechniqueArgs& a, RenderSettings& s) {
     // or a non-default mode from a scene file); an explicit mode that disagrees wins, with a
     // warning.
     std::string modeWarning;
-    s.mode =
-        modeFor(s.transfer, s.mode, given(a, "--mode") || s.mode != RenderMode::Dvr, &modeWarning);
+    const bool explicitMode = (a.cmd && given(*a.cmd, "mode")) || s.mode != RenderMode::Dvr;
+    s.mode = modeFor(s.transfer, s.mode, explicitMode, &modeWarning);
     if (!modeWarning.empty()) warn(modeWarning);
 }
 
