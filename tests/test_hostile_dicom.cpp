@@ -176,6 +176,14 @@ TEST_CASE("DICOM element lengths are checked before GDCM allocates", "[volume][d
     writeBytes(dir / "metaonly.dcm", bytes.substr(0, dataSet));
     CHECK_THAT(errorOf([&] { loadVolume((dir / "metaonly.dcm").string()); }),
                Catch::Contains("no data set after the file meta information"));
+    // An unknown PhotometricInterpretation made gdcm::ImageReader abort on an assert (found
+    // by fuzz_dicom); the pixels are now decoded without it, so this loads.
+    std::string odd = readTextFile(dir / "ok.dcm");
+    const std::size_t pi = odd.find("MONOCHROME2");
+    REQUIRE(pi != std::string::npos);
+    odd.replace(pi, 11, "XONOCHROMEX");
+    writeBytes(dir / "odd.dcm", odd);
+    CHECK(loadVolume((dir / "odd.dcm").string()).data[11] == 7.0f);
     // Not a Part 10 file: refused, not guessed at.
     writeBytes(dir / "nopreamble.dcm", bytes.substr(132));
     CHECK_THAT(errorOf([&] { loadVolume((dir / "nopreamble.dcm").string()); }),

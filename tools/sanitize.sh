@@ -17,8 +17,12 @@ start=$(date +%s)
 nice -n 19 cmake --build "$build" -j"${SPLAT_SAN_JOBS:-2}" --target splat_cli splat_tests
 built=$(date +%s)
 # The browser test drives Chromium, which is not instrumented; it is left to the normal build.
+status=0
 (cd "$build" && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+  LSAN_OPTIONS="suppressions=$PWD/../tools/lsan.supp" \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  nice -n 19 ctest --output-on-failure -j"${SPLAT_SAN_JOBS:-2}" --timeout 3600 -LE browser "$@")
+  nice -n 19 ctest --output-on-failure -j"${SPLAT_SAN_JOBS:-2}" --timeout 3600 -LE browser "$@") ||
+  status=$?
 done_=$(date +%s)
 echo "sanitize.sh: build $((built - start)) s, tests $((done_ - built)) s"
+exit $status

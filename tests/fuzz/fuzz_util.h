@@ -62,13 +62,14 @@ inline bool splitData(std::string_view in, std::string_view& header, std::string
 }
 
 /// Writes an input for a format with attached or detached data: with kDataMarker, the
-/// header as `detachedName` and the rest as "data.raw" beside it; otherwise all of it as
+/// header as `detachedName` and the rest as `dataName` beside it; otherwise all of it as
 /// `singleName`. Returns the file to load.
 inline std::filesystem::path writeHeaderAndData(std::string_view in, const char* singleName,
-                                                const char* detachedName) {
+                                                const char* detachedName,
+                                                const char* dataName = "data.raw") {
     std::string_view header, payload;
     if (!splitData(in, header, payload)) return writeFile(singleName, in);
-    writeFile("data.raw", payload);
+    writeFile(dataName, payload);
     return writeFile(detachedName, header);
 }
 

@@ -86,6 +86,15 @@ int main(int argc, char** argv) {
         seed("nifti_gz", "int16_4d.nii", h + ramp<std::int16_t>(48));
     }
 
+    // ANALYZE 7.5 pair: header (no NIfTI magic, vox_offset 0) + image.
+    {
+        std::string h = nii.substr(0, 348);
+        std::memset(&h[344], 0, 4);
+        const float zero = 0;
+        std::memcpy(&h[108], &zero, 4);  // vox_offset
+        seed("nifti", "analyze.hdr", h + marker + nii.substr(352));
+    }
+
     // NRRD: attached gzip, text, big-endian with space directions; detached .nhdr.
     const std::string nrrdHead = "NRRD0004\ntype: short\ndimension: 3\nsizes: 4 3 2\n";
     seed("nrrd", "gzip.nrrd",

@@ -10,7 +10,6 @@
 // series needs LoadOptions::dicomSeries (CLI: --series UID).
 #include <gdcmDicts.h>
 #include <gdcmGlobal.h>
-#include <gdcmImageReader.h>
 #include <gdcmReader.h>
 #include <gdcmStringFilter.h>
 #include <gdcmTrace.h>
@@ -46,6 +45,8 @@ const gdcm::Tag kColumns(0x0028, 0x0011);
 const gdcm::Tag kFrames(0x0028, 0x0008);
 const gdcm::Tag kSamplesPerPixel(0x0028, 0x0002);
 const gdcm::Tag kBitsAllocated(0x0028, 0x0100);
+const gdcm::Tag kBitsStored(0x0028, 0x0101);
+const gdcm::Tag kPixelRepresentation(0x0028, 0x0103);
 const gdcm::Tag kSlope(0x0028, 0x1053);
 const gdcm::Tag kIntercept(0x0028, 0x1052);
 
@@ -85,12 +86,22 @@ std::string textOf(gdcm::StringFilter& sf, const gdcm::DataSet& ds, const gdcm::
     return trim(std::string(sf.ToString(tag).c_str()));  // stops at an embedded NUL
 }
 
+/// Where a file's pixels are, from the element walk (checkDicomLengths).
+struct DicomLayout {
+    bool bigEndian = false;
+    std::string syntax;
+    bool pixelData = false, encapsulated = false;
+    std::uint64_t pixelOffset = 0, pixelLength = 0;  ///< the last (top-level) Pixel Data
+};
+
 /// What one file's header says, before any pixel is read.
 struct SliceInfo {
     fs::path path;
     std::string uid, description, modality;
     int seriesNumber = -1, instance = -1;
-    int rows = 0, columns = 0, frames = 1, samples = 1, bitsAllocated = 16;
+    int rows = 0, columns = 0, frames = 1, samples = 1, bitsAllocated = 16, bitsStored = 16;
+    bool signedPixels = false;
+    DicomLayout layout;
     std::uint64_t fileSize = 0;
     std::optional<glm::dvec3> position;
     std::optional<std::vector<double>> orientation, pixelSpacing;
@@ -127,7 +138,8 @@ auto guarded(const fs::path& p, F f) {
 // transfer syntax) checks every defined length against the bytes that follow before GDCM
 // sees the file. Sequences and items of undefined length are walked into; in implicit VR
 // the public dictionary says which tags are sequences, as it does for GDCM.
-void checkDicomLengths(const std::vector<unsigned char>& b, const std::string& name) {
+DicomLayout checkDicomLengths(const std::vector<unsigned char>& b, const std::string& name) {
+    DicomLayout layout;
     auto fail = [&](const std::string& why) {
         throw Error(name + ": malformed DICOM file (" + why + ")");
     };
@@ -199,6 +211,14 @@ void checkDicomLengths(const std::vector<unsigned char>& b, const std::string& n
         // group, and on a file that ends inside it.
         if (inMeta && (sequence || len == 0xFFFFFFFFu))
             fail("a sequence or undefined length in the file meta information");
+        // Pixel Data: a nested one (icon) comes before the top-level one, which is last.
+        const bool pixels = group == 0x7FE0 && element == 0x0010;
+        if (pixels) {
+            layout.pixelData = true;
+            layout.encapsulated = len == 0xFFFFFFFFu;
+            layout.pixelOffset = pos;
+            layout.pixelLength = len == 0xFFFFFFFFu ? 0 : len;
+        }
         if (len == 0xFFFFFFFFu) continue;  // undefined length: walk into its items
         if (len > b.size() - pos)
             fail("element (" + std::to_string(group) + "," + std::to_string(element) +
@@ -209,12 +229,15 @@ void checkDicomLengths(const std::vector<unsigned char>& b, const std::string& n
         if (!sequence) pos += std::size_t(len);  // a sequence's items are checked too
     }
     if (inMeta) fail("no data set after the file meta information");
+    layout.bigEndian = bigEndian;
+    layout.syntax = syntax;
+    return layout;
 }
 
 SliceInfo readInfoUnguarded(const fs::path& p) {
     const std::string name = displayName(p);
     const std::uint64_t fileSize = regularFileSize(p);
-    checkDicomLengths(readFileBytes(p), name);
+    const DicomLayout layout = checkDicomLengths(readFileBytes(p), name);
     gdcm::Reader reader;
     reader.SetFileName(p.string().c_str());
     if (!reader.ReadUpToTag(kPixelData)) throw Error(name + ": not a readable DICOM file");
@@ -224,6 +247,7 @@ SliceInfo readInfoUnguarded(const fs::path& p) {
     SliceInfo s;
     s.path = p;
     s.fileSize = fileSize;
+    s.layout = layout;
     s.uid = textOf(sf, ds, kSeriesUid);
     s.description = textOf(sf, ds, kSeriesDescription);
     s.modality = textOf(sf, ds, kModality);
@@ -238,6 +262,10 @@ SliceInfo readInfoUnguarded(const fs::path& p) {
                       "SamplesPerPixel");
     s.bitsAllocated =
         intOf(numbersOf(sf, ds, kBitsAllocated, name, "BitsAllocated"), 16, name, "BitsAllocated");
+    s.bitsStored = intOf(numbersOf(sf, ds, kBitsStored, name, "BitsStored"), s.bitsAllocated, name,
+                         "BitsStored");
+    s.signedPixels = intOf(numbersOf(sf, ds, kPixelRepresentation, name, "PixelRepresentation"), 0,
+                           name, "PixelRepresentation") == 1;
     if (auto v = numbersOf(sf, ds, kPosition, name, "ImagePositionPatient")) {
         if (v->size() != 3) throw Error(name + ": DICOM ImagePositionPatient needs 3 numbers");
         s.position = glm::dvec3((*v)[0], (*v)[1], (*v)[2]);
@@ -262,29 +290,6 @@ SliceInfo readInfo(const fs::path& p) {
     return guarded(p, [&] { return readInfoUnguarded(p); });
 }
 
-std::optional<SampleType> gdcmSampleType(const gdcm::PixelFormat& pf) {
-    switch (pf.GetScalarType()) {
-        case gdcm::PixelFormat::UINT8:
-            return SampleType::U8;
-        case gdcm::PixelFormat::INT8:
-            return SampleType::I8;
-        case gdcm::PixelFormat::UINT16:
-            return SampleType::U16;
-        case gdcm::PixelFormat::INT16:
-            return SampleType::I16;
-        case gdcm::PixelFormat::UINT32:
-            return SampleType::U32;
-        case gdcm::PixelFormat::INT32:
-            return SampleType::I32;
-        case gdcm::PixelFormat::FLOAT32:
-            return SampleType::F32;
-        case gdcm::PixelFormat::FLOAT64:
-            return SampleType::F64;
-        default:
-            return std::nullopt;
-    }
-}
-
 /// Reads the pixels of one single-frame slice into `out` (columns x rows floats, rescaled).
 void readPixelsUnguarded(const SliceInfo& s, float* out);
 void readPixels(const SliceInfo& s, float* out) {
@@ -295,31 +300,48 @@ void readPixels(const SliceInfo& s, float* out) {
 }
 
 void readPixelsUnguarded(const SliceInfo& s, float* out) {
+    // The pixels are decoded here from the native (uncompressed) Pixel Data the element
+    // walk located, not through gdcm::ImageReader: Debian's GDCM keeps its asserts, and its
+    // image reader aborts the process on many malformed headers (found by fuzz_dicom).
     const std::string name = displayName(s.path);
-    gdcm::ImageReader reader;
-    reader.SetFileName(s.path.string().c_str());
-    if (!reader.Read()) throw Error(name + ": cannot read the DICOM pixel data");
-    const gdcm::Image& image = reader.GetImage();
-    const gdcm::PixelFormat& pf = image.GetPixelFormat();
-    auto type = gdcmSampleType(pf);
-    if (!type || pf.GetSamplesPerPixel() != 1)
-        throw Error(name + ": DICOM pixel format " + pf.GetScalarTypeAsString() + " with " +
-                    std::to_string(pf.GetSamplesPerPixel()) +
-                    " samples per pixel is not supported (need one scalar sample)");
+    const DicomLayout& l = s.layout;
+    static const char* native[] = {"1.2.840.10008.1.2", "1.2.840.10008.1.2.1",
+                                   "1.2.840.10008.1.2.2"};
+    if (std::none_of(std::begin(native), std::end(native),
+                     [&](const char* t) { return l.syntax == t; }) ||
+        l.encapsulated)
+        throw Error(name + ": compressed DICOM (transfer syntax " + l.syntax +
+                    ") is not supported; decompress it first (e.g. gdcmconv --raw)");
+    if (!l.pixelData) throw Error(name + ": DICOM file has no Pixel Data");
+    if (s.bitsAllocated != 8 && s.bitsAllocated != 16 && s.bitsAllocated != 32)
+        throw Error(name + ": DICOM BitsAllocated " + std::to_string(s.bitsAllocated) +
+                    " is not supported (8, 16 or 32)");
+    if (s.bitsStored < 1 || s.bitsStored > s.bitsAllocated)
+        throw Error(name + ": DICOM BitsStored " + std::to_string(s.bitsStored) +
+                    " does not fit BitsAllocated " + std::to_string(s.bitsAllocated));
     const std::uint64_t count = std::uint64_t(s.columns) * std::uint64_t(s.rows);
-    if (image.GetNumberOfDimensions() < 2 || image.GetDimension(0) != unsigned(s.columns) ||
-        image.GetDimension(1) != unsigned(s.rows))
-        throw Error(name + ": DICOM image size disagrees with Rows/Columns");
-    const std::uint64_t bytes = checkedMul(count, sampleSize(*type), name);
-    if (image.GetBufferLength() != bytes)
-        throw Error(name + ": DICOM pixel data holds " + std::to_string(image.GetBufferLength()) +
+    const std::uint64_t size = std::uint64_t(s.bitsAllocated / 8);
+    const std::uint64_t bytes = checkedMul(count, size, name);
+    if (l.pixelLength < bytes)
+        throw Error(name + ": DICOM Pixel Data holds " + std::to_string(l.pixelLength) +
                     " bytes, Rows x Columns needs " + std::to_string(bytes));
-    std::vector<unsigned char> buffer(bytes);
-    if (!image.GetBuffer(reinterpret_cast<char*>(buffer.data())))
-        throw Error(name + ": cannot decode the DICOM pixel data");
-    decodeSamples(buffer.data(), std::size_t(count), *type, false, out);  // GDCM: host order
-    if (s.slope != 1.0 || s.intercept != 0.0)
-        for (std::size_t i = 0; i < count; ++i) out[i] = float(s.slope * out[i] + s.intercept);
+    const std::vector<unsigned char> raw = readFileRange(s.path, l.pixelOffset, bytes);
+    // Stored values: the low BitsStored bits, two's complement when PixelRepresentation 1.
+    const std::uint64_t mask =
+        s.bitsStored >= 32 ? 0xFFFFFFFFull : (std::uint64_t(1) << s.bitsStored) - 1;
+    const std::uint64_t signBit = std::uint64_t(1) << (s.bitsStored - 1);
+    for (std::size_t i = 0; i < count; ++i) {
+        std::uint64_t v = 0;
+        for (std::size_t k = 0; k < size; ++k) {
+            const std::size_t at = i * size + (l.bigEndian ? size - 1 - k : k);
+            v |= std::uint64_t(raw[at]) << (8 * k);
+        }
+        v &= mask;
+        const double value = s.signedPixels && (v & signBit)
+                                 ? double(std::int64_t(v) - std::int64_t(mask) - 1)
+                                 : double(v);
+        out[i] = float(s.slope * value + s.intercept);
+    }
 }
 
 std::string fmt(double v) {
