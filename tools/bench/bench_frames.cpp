@@ -15,6 +15,8 @@
 //       RMSE and max abs difference of the RGB of two W x H images over black, each a .f32
 //       (float RGBA premultiplied, top row first) or .rgb8 (8-bit RGB, bottom row first, as
 //       OpenGL reads a frame buffer): prints {"rmse": .., "max": ..}.
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -34,6 +36,14 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// CPU time of the whole process (all threads), ms: the work a frame did, which a loaded
+/// machine stretches far less than its wall time.
+double cpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
 
 double msSince(Clock::time_point t) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
@@ -125,16 +135,18 @@ int renderRotation(const std::string& spec, const std::string& tfPath, const Opt
         const splat::RenderSettings frame = cameraOf(f);
         splat::RenderStats st;
         const auto t = Clock::now();
+        const double c = cpuMs();
         const splat::Image image = scene.render(frame, &st);
-        const double ms = msSince(t);
+        const double ms = msSince(t), cpu = cpuMs() - c;
         if (std::find(save.begin(), save.end(), f) != save.end())
             writeFloats(out + "/frame_" + std::to_string(f) + ".f32", image);
         const splat::Camera cam(frame.camera, *volume);
         json << (first ? "" : ", ") << "\n  {\"frame\": " << f
              << ", \"azimuth\": " << frame.camera.azimuthDeg << ", \"elevation\": " << elevation
-             << ", \"ms\": " << ms << ", \"project_ms\": " << st.projectMs
-             << ", \"order_ms\": " << st.orderMs << ", \"bin_ms\": " << st.binMs
-             << ", \"tiles_ms\": " << st.tilesMs << ", \"footprint_pixels\": " << st.footprintPixels
+             << ", \"ms\": " << ms << ", \"cpu_ms\": " << cpu
+             << ", \"project_ms\": " << st.projectMs << ", \"order_ms\": " << st.orderMs
+             << ", \"bin_ms\": " << st.binMs << ", \"tiles_ms\": " << st.tilesMs
+             << ", \"footprint_pixels\": " << st.footprintPixels
              << ", \"culled_splats\": " << st.culledSplats << ", \"sheets\": " << st.sheets
              << ", \"target\": " << vec(cam.target) << ", \"right\": " << vec(cam.right)
              << ", \"up\": " << vec(cam.up) << ", \"view\": " << vec(cam.view)

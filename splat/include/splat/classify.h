@@ -15,11 +15,13 @@
 namespace splat {
 
 struct SplatList {
-    std::vector<float> x, y, z;          ///< world position of the voxel
     std::vector<std::uint16_t> i, j, k;  ///< index position
-    std::vector<float> density;          ///< d_i
-    std::vector<float> extinction;       ///< rho_i = f_rho(d_i), per world unit (pre)
-    std::vector<float> r, g, b;          ///< premultiplied emission e_i = colour * rho_i (pre)
+    /// The volume's grid: a splat's world position is origin + spacing (i, j, k), computed
+    /// when needed (world()) rather than stored beside the index position.
+    glm::dvec3 origin{0.0}, spacing{1.0};
+    std::vector<float> density;     ///< d_i
+    std::vector<float> extinction;  ///< rho_i = f_rho(d_i), per world unit (pre)
+    std::vector<float> r, g, b;     ///< premultiplied emission e_i = colour * rho_i (pre)
     /// Unit normals -grad d / |grad d| (central differences in world units), only when
     /// classify() was asked for them (shading); empty otherwise.
     std::vector<float> nx, ny, nz;
@@ -33,7 +35,12 @@ struct SplatList {
     /// shown), only when the scene has labels.
     std::vector<float> label;
     std::size_t voxels = 0;  ///< voxels considered
-    std::size_t size() const { return x.size(); }
+    std::size_t size() const { return i.size(); }
+    /// World position of splat n.
+    glm::dvec3 world(std::size_t n) const {
+        return origin + spacing * glm::dvec3(double(i[n]), double(j[n]), double(k[n]));
+    }
+    /// Bytes held per splat by the arrays in use, times the splat count.
     std::size_t bytes() const;
 };
 

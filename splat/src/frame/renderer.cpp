@@ -124,9 +124,9 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
         s.renderer == RendererKind::Axis ? axisAlignedSplatter() : imageAlignedSplatter();
     const WorkspaceLease work(scene);
     const Emission e = shade(scene, camera, *work, stats);
-    project(scene, camera, *work, stats);
+    if (!splatter.streams()) project(scene, camera, *work, stats);
     const SheetPlan plan = order(splatter, scene, camera, s, *work, stats);
-    bin(camera, s, *work, stats);
+    if (!splatter.streams()) bin(camera, s, *work, stats);
     const PolicyContext ctx = policyContext(scene, camera, s);
     Image positions;
     if (depth) positions = Image(camera.width(), camera.height());
@@ -183,7 +183,7 @@ bool needsExactPath(const Scene::Impl& scene, const Camera& camera) {
         tbb::blocked_range<std::size_t>(0, s.size(), 8192), false,
         [&](const tbb::blocked_range<std::size_t>& r, bool found) {
             for (std::size_t n = r.begin(); n != r.end() && !found; ++n) {
-                const glm::dvec3 w(s.x[n], s.y[n], s.z[n]);
+                const glm::dvec3 w = s.world(n);
                 const double depth = glm::dot(w - eye, view);
                 // Kernels entirely behind the eye contribute nothing to any ray.
                 if (depth > -bound && depth < nearest) found = true;

@@ -150,7 +150,11 @@ float maxGradientMagnitude(const Volume& v) {
 }
 
 std::size_t SplatList::bytes() const {
-    return size() * (3 * sizeof(float) + 3 * sizeof(std::uint16_t) + 5 * sizeof(float));
+    std::size_t total = 0;
+    for (const auto* a : {&i, &j, &k}) total += a->size() * sizeof(std::uint16_t);
+    for (const auto* a : {&density, &extinction, &r, &g, &b, &nx, &ny, &nz, &gx, &gy, &gz, &label})
+        total += a->size() * sizeof(float);
+    return total;
 }
 
 SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
@@ -221,7 +225,9 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
     s.gradientScale = maxGradient;
     const std::size_t n = count.back();
     s.voxels = volume.voxelCount();
-    for (auto* a : {&s.x, &s.y, &s.z, &s.density, &s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
+    s.origin = volume.origin;
+    s.spacing = volume.spacing;
+    for (auto* a : {&s.density, &s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
     for (auto* a : {&s.i, &s.j, &s.k}) a->resize(n);
     if (normals)
         for (auto* a : {&s.nx, &s.ny, &s.nz}) a->resize(n);
@@ -234,10 +240,6 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
             for (int i = 0; i < d.x; ++i) {
                 const float value = volume.at(i, j, k);
                 if (!keep(i, j, k, value)) continue;
-                const glm::dvec3 w = volume.world(glm::dvec3(i, j, k));
-                s.x[o] = float(w.x);
-                s.y[o] = float(w.y);
-                s.z[o] = float(w.z);
                 s.i[o] = std::uint16_t(i);
                 s.j[o] = std::uint16_t(j);
                 s.k[o] = std::uint16_t(k);
