@@ -28,7 +28,8 @@ double msSince(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-/// Emission to splat: the list's own, or (shaded scenes) this view's shaded emission.
+/// Emission to splat: null (the list's own, SplatList::emission) or (shaded scenes) this
+/// view's shaded emission.
 struct Emission {
     const float *r, *g, *b;
 };
@@ -38,7 +39,7 @@ struct Emission {
 Emission shade(const Scene::Impl& scene, const Camera& camera, FrameWorkspace& work,
                RenderStats& stats) {
     const SplatList& s = scene.splats;
-    if (!scene.shaded()) return {s.r.data(), s.g.data(), s.b.data()};
+    if (!scene.shaded()) return {nullptr, nullptr, nullptr};  // the list's own (emission())
     const auto start = Clock::now();
     shadeEmission(s, scene.settings.shading, camera.view, work.r, work.g, work.b);
     stats.shadeMs = msSince(start);
@@ -162,6 +163,7 @@ Image referenceFrame(const Scene::Impl& scene, const Camera& camera, const Rende
                                scene.splats.gradientScale, labelLookup(scene));
     // Shaded emission depends on the view: the field is made for this frame.
     SplatList lit = scene.splats;
+    lit.expandEmission();
     shadeEmission(scene.splats, scene.settings.shading, camera.view, lit.r, lit.g, lit.b);
     const ReferenceField field(*scene.volume, lit, scene.kernel, FieldLayout::Emission);
     return renderReference(*scene.volume, field, camera, s, &stats, depth,

@@ -58,7 +58,7 @@ struct TileInputs {
     const ProjectedSplats& proj;
     const TileBins& bins;
     const SheetPlan& plan;
-    const float *er, *eg, *eb;      ///< emission to splat: the list's own or this view's shaded
+    const float *er, *eg, *eb;      ///< this view's shaded emission; null: the list's own
     const PolicyContext& policy;    ///< the frame's compositing policy and its parameters
     Image* isoPositions = nullptr;  ///< iso: per pixel, the hit's fractional sheet position
 };
@@ -92,16 +92,15 @@ std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& 
 template <class Policy>
 inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Policy::kChannels]) {
     const SplatList& s = in.scene.splats;
-    if constexpr (Policy::kSource == SheetSource::Emission) {
-        v[0] = s.extinction[id];
-        v[1] = in.er[id];
-        v[2] = in.eg[id];
-        v[3] = in.eb[id];
-    } else if constexpr (Policy::kSource == SheetSource::Labels) {
-        v[0] = s.extinction[id];
-        v[1] = in.er[id];
-        v[2] = in.eg[id];
-        v[3] = in.eb[id];
+    if constexpr (Policy::kSource == SheetSource::Emission ||
+                  Policy::kSource == SheetSource::Labels) {
+        const glm::vec4 e = s.emission(id);
+        v[0] = e.x;
+        v[1] = in.er ? in.er[id] : e.y;
+        v[2] = in.er ? in.eg[id] : e.z;
+        v[3] = in.er ? in.eb[id] : e.w;
+    }
+    if constexpr (Policy::kSource == SheetSource::Labels) {
         v[4] = 1.0f;  // every splat competes for the pixel's label, the background too
         v[5] = s.label[id];
     } else if constexpr (Policy::kSource == SheetSource::DensityGradient) {
@@ -109,7 +108,7 @@ inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Polic
         v[1] = s.gx[id];
         v[2] = s.gy[id];
         v[3] = s.gz[id];
-    } else {
+    } else if constexpr (Policy::kSource == SheetSource::Density) {
         v[0] = s.density[id];
     }
 }

@@ -93,6 +93,7 @@ Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
     options.gradients = needsGradients();
     if (s.mode == RenderMode::Dvr) options.edges = s.edges;
     options.clipping = s.clipping;
+    options.compactEmission = true;
     if (s.labels.enabled) {
         if (s.mode != RenderMode::Dvr || s.classification != Classification::Pre)
             throw Error(
@@ -172,8 +173,15 @@ const ReferenceField& Scene::Impl::referenceField() const {
     std::lock_guard<std::mutex> lock(lazyMutex_);
     if (!field_) {
         validateReferenceKernel(kernel);
-        field_ = std::make_shared<ReferenceField>(*volume, splats, kernel,
-                                                  fieldLayout(settings, splats));
+        if (splats.paletted()) {  // the field reads the emission arrays: a full copy
+            SplatList full = splats;
+            full.expandEmission();
+            field_ = std::make_shared<ReferenceField>(*volume, full, kernel,
+                                                      fieldLayout(settings, full));
+        } else {
+            field_ = std::make_shared<ReferenceField>(*volume, splats, kernel,
+                                                      fieldLayout(settings, splats));
+        }
     }
     return *field_;
 }
