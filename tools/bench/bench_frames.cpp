@@ -117,9 +117,10 @@ int renderRotation(const std::string& spec, const std::string& tfPath, const Opt
     auto wanted = [&](int f) {
         return !onlySaved || std::find(save.begin(), save.end(), f) != save.end();
     };
-    // Warm-up: the first frame along each sheet axis builds lazy orders and workspaces.
+    // Warm-up: the first frames build the scene's lazy orders and the frame workspaces (a
+    // quarter turn apart, so both horizontal sheet axes are seen).
     if (warmup && !onlySaved)
-        for (int f = 0; f < frames; ++f) scene.render(cameraOf(f));
+        for (int f : {0, frames / 4}) scene.render(cameraOf(f));
 
     std::ostringstream json;
     json.precision(10);
