@@ -324,11 +324,13 @@ TEST_CASE("splatters against the reference ray caster", "[splatter][accuracy]") 
         int n;
         const char* tf;
         double axisBound, sheetBound;
-        bool converges;  // a binary ball has one colour: every sheet order is exact already
+        bool converges;  // the error falls as the slab thins
     };
     // Bounds: RMSE over the image, dvr colour in [0, 1]; measured values are ~2-3x lower.
     const Case cases[] = {{"blob", 32, "gray-ramp", 0.01, 0.01, true},
-                          {"sphere", 32, "gray-ramp", 1e-5, 1e-5, false},
+                          // The antialiased ball (issue 13; the binary one had one colour,
+                          // so every sheet order was exact to 1e-5).
+                          {"sphere", 32, "gray-ramp", 5e-4, 3e-4, true},
                           {"phantom", 64, "ct-soft", 0.02, 0.02, true}};
     for (const Case& c : cases) {
         const Volume v = makeSynthetic(c.volume, c.n);

@@ -61,13 +61,17 @@ TEST_CASE("phantom: brain ~1.0 at the centre, skull 2.0, head upright", "[volume
     CHECK(s.maxValue == Approx(2.0));
 }
 
-TEST_CASE("sphere voxel count is close to 4/3 pi r^3", "[volume]") {
+TEST_CASE("sphere voxel sum is the smooth ball's volume 4/3 pi (r^3 + 3 r w^2 / 7)", "[volume]") {
+    // The antialiased ball (issue 13): the edge profile's second moment is w^2 / 7.
     for (int n : {32, 64}) {
         Volume v = makeSynthetic("sphere", n);
         double count = 0;
         for (float d : v.data) count += d;
-        double r = syntheticSphereRadius(n);
-        CHECK(count == Approx(4.0 / 3.0 * M_PI * r * r * r).epsilon(0.02));
+        const double r = syntheticSphereRadius(n), w = syntheticSphereEdge();
+        CHECK(count ==
+              Approx(4.0 / 3.0 * M_PI * (r * r * r + 3.0 * r * w * w / 7.0)).epsilon(1e-3));
+        CHECK(v.at(0, 0, 0) == 0.0f);
+        CHECK(v.at(n / 2, n / 2, n / 2) == 1.0f);
     }
     Volume cube = makeSynthetic("cube", 32);
     double c = 0;

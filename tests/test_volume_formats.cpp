@@ -9,6 +9,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "deflate_util.h"
 #include "splat/volume_io.h"
 #include "test_volume_util.h"
 
@@ -17,21 +18,6 @@ using namespace splat::test;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string deflateBytes(const std::string& in, bool gzip) {
-    z_stream zs{};
-    deflateInit2(&zs, Z_DEFAULT_COMPRESSION, Z_DEFLATED, gzip ? 15 + 16 : 15, 8,
-                 Z_DEFAULT_STRATEGY);
-    std::string out(deflateBound(&zs, uLong(in.size())) + 32, '\0');
-    zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data()));
-    zs.avail_in = uInt(in.size());
-    zs.next_out = reinterpret_cast<Bytef*>(out.data());
-    zs.avail_out = uInt(out.size());
-    deflate(&zs, Z_FINISH);
-    out.resize(zs.total_out);
-    deflateEnd(&zs);
-    return out;
-}
 
 // A NIfTI-1 single-file image with int16 samples, scaling and the given sform rows.
 std::string niftiFile(glm::ivec3 dims, const std::vector<double>& values, float slope, float inter,

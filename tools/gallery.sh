@@ -44,7 +44,9 @@ T=/usr/share/mricron/templates
 # Post-classified ch2, unshaded and shaded (Blinn-Phong, light from the upper left).
 $S render $CH2 --tf mri-head --classify post --renderer sheet --azimuth 180 --elevation 10 --size 320x320 -o $G/tech_head_post.png
 $S render $CH2 --tf mri-head --classify post --renderer sheet --azimuth 180 --elevation 10 --size 320x320 --shade --light -1,-1,1 -o $G/tech_head_post_shaded.png
-# Edge enhancement (opacity x |grad d| / max): boundaries stand out in the low-contrast MRI.
+# Edge enhancement (opacity x |grad d| / max): boundaries stand out in the low-contrast MRI;
+# the same view without it beside.
+$S render $CH2 --tf mri-head --azimuth 90 --size 320x320 -o $G/tech_head_noedges.png
 $S render $CH2 --tf mri-head --azimuth 90 --size 320x320 --edges 1 -o $G/tech_head_edges.png
 # An isosurface of the phantom from each renderer.
 for r in axis sheet reference; do
@@ -53,8 +55,10 @@ done
 # ch2 with the AAL atlas (116 regions, mricron's colours), and a selection of regions.
 $S render $CH2 --tf mri-head --label-volume $T/aal.nii.gz --label-colors $T/aal.nii.lut --label-names $T/aal.nii.txt --labels 37,38,41,42 --azimuth 135 --elevation 20 --size 320x320 --renderer sheet -o $G/tech_ch2_aal.png
 $S render $T/aal.nii.gz --label-colors $T/aal.nii.lut --azimuth 135 --elevation 20 --size 320x320 -o $G/tech_aal.png
-# A clipped head: the cut face shows the data.
+# A clipped head: the field is cut at the plane, so the cut face shows the data there.
 $S render $CH2 --tf mri-head --shade --azimuth 150 --elevation 20 --size 320x320 --clip-plane 0,0,0,1,-1,0 -o $G/tech_head_clipped.png
+# An isosurface cut by a plane facing the camera: capped at the cut.
+$S render synthetic:phantom:96 --mode iso --iso-level 0.5 --iso-normalized --renderer sheet --azimuth 30 --elevation 20 --size 256x256 --shade --clip-plane 47.5,47.5,47.5,0.47,-0.81,0.34 -o $G/tech_iso_clipped.png
 # Volume viewing through the reconstructed field: slices, an oblique MPR and a CPR.
 $S slices $CH2 --axis z --every 12 --scale-bar 50 -o $tmp/slices && cp $tmp/slices/mosaic.png $G/tech_slices_mosaic.png
 $S mpr $CH2 --plane 0,0,10,0.3,0.2,1 --size 256x256 --pixel-size 0.8 --scale-bar 50 -o $G/tech_mpr_oblique.png

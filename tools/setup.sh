@@ -3,8 +3,9 @@
 # are already installed are skipped, and apt is not touched at all when none is missing).
 set -euo pipefail
 packages=(build-essential cmake pkg-config libglm-dev libopenimageio-dev openimageio-tools
-          libtbb-dev catch2 libcli11-dev nlohmann-json3-dev libnifti2-dev zlib1g-dev
-          mricron-data chromium)
+          libtbb-dev catch2 libcli11-dev nlohmann-json3-dev libnifti2-dev zlib1g-dev libgdcm-dev
+          clang-14 libclang-rt-14-dev mricron-data chromium
+          xvfb xauth)  # xvfb, xauth: tools/bench/vs_vtk.py runs VTK without a display
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -8,15 +8,26 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 S=build/bin/splat
+# On a shared machine other processes distort wall times (and make the 1 -> 2 thread
+# speed-up meaningless); as root, run each timing at real-time priority (SCHED_FIFO; the
+# kernel still leaves 5% of every second to the rest), so the figures are this program's.
+RT=()
+if [ "$(id -u)" -eq 0 ] && command -v chrt > /dev/null && chrt -f 50 true 2> /dev/null; then
+    RT=(chrt -f 50)
+    echo "(timings at real-time priority: ${RT[*]})"
+fi
 MAXN=${1:-512}
 MAXSIZE=${2:-2048}
 ALL=$(nproc)
+CH2=/usr/share/mricron/templates/ch2.nii.gz
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # bench VOLUME SIZE RENDERER THREADS -> "splats median_ms peak_MiB"
 bench() {
-    /usr/bin/time -f "%M" -o "$tmp/mem" $S bench "$1" --tf ct-soft --size "$2" --renderer "$3" \
-        --azimuth 30 --elevation 15 --repeats 3 --thread-list "$4" --json "$tmp/b.json" > /dev/null
+    local tf=ct-soft
+    [[ "$1" == *.nii* ]] && tf=mri-head
+    "${RT[@]}" /usr/bin/time -f "%M" -o "$tmp/mem" $S bench "$1" --tf "$tf" --size "$2" --renderer "$3" \
+        --azimuth 30 --elevation 15 --repeats 5 --thread-list "$4" --json "$tmp/b.json" > /dev/null
     python3 - "$tmp/b.json" "$tmp/mem" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))["runs"][0]
@@ -58,8 +69,11 @@ for R in axis sheet; do
     done
     echo "time exponent against pixels: $(fit "$tmp/s_$R")"
     echo
-    read -r _ ms1 _ < <(bench synthetic:phantom:128 512x512 $R 1)
-    read -r _ msall _ < <(bench synthetic:phantom:128 512x512 $R "$ALL")
-    python3 -c "print(f'$R speed-up 1 -> $ALL threads (phantom:128, 512x512): {$ms1 / $msall:.2f}x ($ms1 ms -> $msall ms)')"
+    for V in synthetic:phantom:128 synthetic:phantom:256 "$CH2"; do
+        [ "$V" != "$CH2" ] || [ -f "$CH2" ] || continue
+        read -r _ ms1 _ < <(bench "$V" 512x512 $R 1)
+        read -r _ msall _ < <(bench "$V" 512x512 $R "$ALL")
+        python3 -c "print(f'- $R speed-up 1 -> $ALL threads ($(basename "$V"), 512x512): {$ms1 / $msall:.2f}x ($ms1 ms -> $msall ms)')"
+    done
     echo
 done

@@ -13,6 +13,21 @@ void registerInfo(CLI::App& app) {
         "info", "print a volume's size, spacing, extent, value range and histogram");
     addVolumeOptions(*cmd, *args);
     cmd->callback([args] {
+        // A folder of several DICOM series: list them (one is chosen with --series UID).
+        if (args->series.empty()) {
+            const auto series = listDicomSeries(args->spec);
+            if (series.size() > 1) {
+                std::printf("%s: %zu DICOM series (load one with --series UID)\n",
+                            args->spec.c_str(), series.size());
+                for (const auto& s : series)
+                    std::printf("  %s  #%d %s %s, %zu files of %d x %d\n", s.uid.c_str(),
+                                s.seriesNumber, s.modality.c_str(),
+                                s.description.empty() ? "(no description)"
+                                                      : ("'" + s.description + "'").c_str(),
+                                s.files, s.columns, s.rows);
+                return;
+            }
+        }
         Volume v = loadVolumeFromArgs(*args);
         std::fputs(describeVolume(v).c_str(), stdout);
     });

@@ -84,6 +84,10 @@ void addTechniqueOptions(CLI::App& cmd, TechniqueArgs& a) {
                    "opacity of the labels per unit distance (tables without their own)")
         ->capture_default_str()
         ->group(g);
+    cmd.add_flag("--tf-rescale", a.tfRescale,
+                 "stretch the transfer function's first..last control values over the "
+                 "volume's [min, max] (ParaView's 'rescale to data range')")
+        ->group(g);
     cmd.add_option("--bit-depth", a.bitDepth, "PNG bits per channel: 8 or 16")
         ->capture_default_str()
         ->group(g);
@@ -115,6 +119,10 @@ bool applyTechniqueSceneKey(const std::string& key, const nlohmann::json& value,
         if (!given(a, "--iso-normalized")) a.isoNormalized = value.get<bool>();
         return true;
     }
+    if (key == "tf-rescale") {
+        if (!given(a, "--tf-rescale")) a.tfRescale = value.get<bool>();
+        return true;
+    }
     if (key == "alpha") {
         if (!given(a, "--alpha")) a.alpha = value.get<bool>();
         return true;
@@ -137,6 +145,17 @@ bool applyTechniqueSceneKey(const std::string& key, const nlohmann::json& value,
 }
 
 void applyTechniqueArgs(const TechniqueArgs& a, RenderSettings& s) {
+    if (a.tfRescale) s.transfer = s.transfer.rescaledToData();
+    // A preset that carries its mode: it applies unless a mode was chosen explicitly (--mode,
+    // or a non-default mode from a scene file); an explicit mode that disagrees wins, with a
+    // warning.
+    if (s.transfer.mode && *s.transfer.mode != s.mode) {
+        if (given(a, "--mode") || s.mode != RenderMode::Dvr)
+            warn(std::string("--mode ") + toString(s.mode) + " overrides the mode " +
+                 toString(*s.transfer.mode) + " of transfer function '" + s.transfer.name + "'");
+        else
+            s.mode = *s.transfer.mode;
+    }
     Shading& sh = s.shading;
     sh.ambient = float(a.ambient);
     sh.diffuse = float(a.diffuse);

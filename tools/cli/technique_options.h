@@ -25,6 +25,7 @@ struct TechniqueArgs {
     double labelOpacity = 1.0;
     int bitDepth = 8;
     bool alpha = false;
+    bool tfRescale = false;  ///< --tf-rescale: the function's range onto the volume's [min, max]
     CLI::App* cmd = nullptr;
 };
 

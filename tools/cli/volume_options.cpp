@@ -57,10 +57,18 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
                    "raw data: sample type (uint8 int8 uint16 int16 uint32 int32 float32 float64)");
     cmd.add_option("--spacing", args.spacing, "raw data: spacing X,Y,Z (default 1,1,1)");
     cmd.add_flag("--big-endian", args.bigEndian, "raw data: samples are big-endian");
-    cmd.add_option("--header-bytes", args.headerBytes, "raw data: bytes to skip at the start");
+    // NonNegativeNumber: CLI11 would otherwise read "-1" as 2^64 - 1.
+    cmd.add_option("--header-bytes", args.headerBytes, "raw data: bytes to skip at the start")
+        ->check(CLI::NonNegativeNumber);
     cmd.add_option("--nan-policy", args.nanPolicy,
                    "NaN/Inf samples: 'error' refuses the volume, 'zero' replaces them by 0")
         ->default_str("error");
+    cmd.add_flag("--allow-outside-data", args.allowOutsideData,
+                 "NRRD/MetaImage: allow data files outside the header's folder (absolute "
+                 "paths, ..)");
+    cmd.add_option("--series", args.series,
+                   "DICOM: the SeriesInstanceUID to load when a folder holds several "
+                   "(`splat info FOLDER` lists them)");
 }
 
 Volume loadVolumeFromArgs(const VolumeArgs& args) {
@@ -70,6 +78,8 @@ Volume loadVolumeFromArgs(const VolumeArgs& args) {
     if (!args.spacing.empty()) options.raw.spacing = parseSpacing(args.spacing);
     options.raw.bigEndian = args.bigEndian;
     options.raw.headerBytes = args.headerBytes;
+    options.allowOutsideDataFiles = args.allowOutsideData;
+    options.dicomSeries = args.series;
     if (args.nanPolicy == "error")
         options.nonFinite = NonFinitePolicy::Error;
     else if (args.nanPolicy == "zero")

@@ -13,9 +13,12 @@ struct VolumeArgs {
     bool bigEndian = false;
     std::size_t headerBytes = 0;
     std::string nanPolicy = "error";  // error | zero
+    bool allowOutsideData = false;    // NRRD/MetaImage data files outside the header's folder
+    std::string series;               // DICOM SeriesInstanceUID
 };
 
-/// Adds VOLUME and --dims/--type/--spacing/--big-endian/--header-bytes/--nan-policy.
+/// Adds VOLUME and --dims/--type/--spacing/--big-endian/--header-bytes/--nan-policy/
+/// --allow-outside-data/--series.
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args);
 
 /// Parses the options and loads the volume; throws splat::Error on bad input.

@@ -41,8 +41,10 @@ struct EdgeEnhancement {
     bool enabled() const { return gain != 0.0f; }
 };
 
-/// Clipping in world units, applied to the voxels (a voxel outside is not a splat, in every
-/// renderer: the cut face shows the data up to the cut, blurred by the kernel).
+/// Clipping in world units of the reconstructed field, in every renderer (issue 13): the
+/// reference clips each ray to the kept region, the splatters cut each sheet pixel's path at
+/// it (frame/clip_cut.h), and the voxels whose kernels reach the region are kept, so the cut
+/// face shows the reconstruction of all the data exactly where the plane is.
 struct ClipPlane {
     glm::dvec3 point{0.0}, normal{0.0, 0.0, 1.0};  ///< keeps (x - point) . normal <= 0
 };

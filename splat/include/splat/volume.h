@@ -19,7 +19,11 @@ struct Volume {
     glm::dvec3 origin{0.0};   ///< world position of sample (0, 0, 0)
     std::vector<float> data;  ///< dims.x * dims.y * dims.z samples, x fastest
     std::string source;       ///< how it was obtained, e.g. "NIfTI-1 int16 (ch2.nii.gz)"
-    std::string note;         ///< anything a user should know (oblique rotation dropped, ...)
+    /// Warnings about the input, "; " separated: anything accepted with an assumption or
+    /// an ignored field (oblique rotation dropped, 4D file's first volume, DICOM gantry
+    /// tilt, NaNs replaced, ...). Every command prints it (README "Input files and bad
+    /// input" lists the cases).
+    std::string note;
 
     std::size_t voxelCount() const {
         return std::size_t(dims.x) * std::size_t(dims.y) * std::size_t(dims.z);
@@ -39,6 +43,10 @@ struct Volume {
     /// Memory held by the samples, in bytes.
     std::size_t bytes() const { return data.size() * sizeof(float); }
 };
+
+/// The voxel count of `dims` after checking every dimension >= 1 and the count within
+/// kMaxVoxels (64-bit, no wrap); throws splat::Error naming `what` otherwise.
+std::uint64_t checkedVoxelCount(const glm::ivec3& dims, const std::string& what);
 
 /// Allocates a zero-filled volume after validating its size: every dimension >= 1, the
 /// voxel count within kMaxVoxels without overflow, spacings finite and > 0.

@@ -3,6 +3,7 @@
 // content. See splat/DESIGN.md ("Command line") for the VOLUME syntax.
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "splat/volume.h"
 
@@ -21,18 +22,41 @@ struct RawOptions {
     std::string type;  ///< uint8, int8, uint16, int16, uint32, int32, float32, float64
     std::optional<glm::dvec3> spacing;
     bool bigEndian = false;
-    std::size_t headerBytes = 0;  ///< bytes to skip at the start of the file
+    std::size_t headerBytes = 0;  ///< bytes to skip at the start of the file (or of the
+                                  ///< decompressed stream of a .raw.gz)
 };
 
 struct LoadOptions {
     RawOptions raw;
     NonFinitePolicy nonFinite = NonFinitePolicy::Error;
+    /// NRRD "data file" and MetaImage ElementDataFile may name files outside the header's
+    /// folder (absolute paths, `..`). Off by default: a downloaded header could otherwise
+    /// read any file on the machine into the image (CLI: --allow-outside-data).
+    bool allowOutsideDataFiles = false;
+    /// DICOM: the SeriesInstanceUID to load when a folder holds several series (CLI:
+    /// --series UID). Empty: the folder must hold exactly one series.
+    std::string dicomSeries;
 };
 
-/// Loads `spec`: a file (.nii, .nii.gz, .nrrd, .nhdr, .mhd, .mha, .raw), a folder of 2D
-/// slices (PNG/TIFF, natural sort order) or of DICOM files, or `synthetic:NAME[:N]`.
-/// Throws splat::Error with one line naming the file and the problem.
+/// Loads `spec`: a file (.nii, .nii.gz, .hdr/.img ANALYZE 7.5 or NIfTI pair, NIfTI-2,
+/// .nrrd, .nhdr, .mhd, .mha, .raw, .raw.gz, .dcm), a folder of 2D slices (PNG/TIFF,
+/// natural sort order) or of DICOM files, or `synthetic:NAME[:N]`.
+/// Throws splat::Error with one line naming the file and the problem. Anything accepted
+/// but worth a word (an assumption, an ignored field) is in Volume::note.
 Volume loadVolume(const std::string& spec, const LoadOptions& options = {});
+
+/// One DICOM series of a folder (SeriesInstanceUID, with what identifies it to a user).
+struct DicomSeriesInfo {
+    std::string uid;
+    std::string description;  ///< SeriesDescription (may be empty)
+    std::string modality;
+    int seriesNumber = -1;  ///< -1 when absent
+    std::size_t files = 0;
+    int rows = 0, columns = 0;
+};
+/// The DICOM series in `folder` (empty when it holds no DICOM files), sorted by series
+/// number then UID. Throws splat::Error when the folder cannot be listed.
+std::vector<DicomSeriesInfo> listDicomSeries(const std::string& folder);
 
 /// Writers (float32 samples, spacing and origin kept), atomic: temporary file then rename.
 void saveNifti(const std::string& path, const Volume& v);      ///< .nii or .nii.gz

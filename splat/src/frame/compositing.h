@@ -5,8 +5,10 @@
 // TileAccumulator, so no pixel is ever shared between threads.
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
+#include "frame/clip_cut.h"
 #include "frame/transfer_table.h"
 #include "model/shading_model.h"
 #include "splat/image.h"
@@ -37,6 +39,17 @@ class TileAccumulator {
     int width() const { return w_; }
     int height() const { return h_; }
     int size() const { return w_ * h_; }
+
+    /// Where the tile lies in an image `imageWidth` pixels wide (per-pixel frame data: the
+    /// clip cut); imageIndex maps a tile pixel to its image pixel.
+    void setOrigin(int ox, int oy, int imageWidth) {
+        ox_ = ox;
+        oy_ = oy;
+        imageWidth_ = imageWidth;
+    }
+    std::size_t imageIndex(int p) const {
+        return std::size_t(oy_ + p / w_) * std::size_t(imageWidth_) + std::size_t(ox_ + p % w_);
+    }
 
     void composite(int p, const Sample& s) {
         if (order_ == CompositeOrder::FrontToBack) {
@@ -71,6 +84,8 @@ class TileAccumulator {
         a_[p] = 1.0f;
         pos_[p] = position;
     }
+    float hitPosition(int p) const { return pos_[p]; }
+    void setHitPosition(int p, float position) { pos_[p] = position; }
     /// Iso: writes the hit positions (r; alpha 1 where hit, 0 where not) at (ox, oy).
     void resolvePositions(Image& image, int ox, int oy) const;
 
@@ -89,6 +104,7 @@ class TileAccumulator {
 
   private:
     int w_, h_;
+    int ox_ = 0, oy_ = 0, imageWidth_ = 0;
     CompositeOrder order_;
     bool terminates_;
     float threshold_;
@@ -137,6 +153,8 @@ struct PolicyContext {
     glm::vec3 isoColour{1.0f};
     /// Labels: colour and extinction (in a) per shown label; null without labels.
     const std::vector<glm::vec4>* labelTable = nullptr;
+    /// Clipping: the per-pixel cut of the sheets; null when nothing is clipped.
+    const ClipCut* cut = nullptr;
 };
 
 /// Pre-classified dvr: optical depth and emission, alpha = 1 - exp(-tau), C = E a / tau.
@@ -264,21 +282,69 @@ struct XrayPolicy {
     }
 };
 
-/// Calls f(policy) with the compositing policy of the frame's mode and classification.
+/// Clipping (frame/clip_cut.h): the part of a sheet pixel's path outside the kept region is
+/// cut off. The sheet's additive channels (integrals along the path) and its path length are
+/// scaled by the kept fraction, so means (density, gradient) are unchanged and optical depth,
+/// emission and line integrals shrink with the path; a sheet wholly outside is skipped (mip
+/// never sees it, iso keeps the previous sheet's value), one wholly inside is untouched.
+template <class Inner>
+struct ClippedPolicy {
+    static constexpr int kChannels = Inner::kChannels;
+    static constexpr bool kTerminates = Inner::kTerminates;
+    static constexpr SheetSource kSource = Inner::kSource;
+    Inner inner;
+    const ClipCut* cut;
+    void operator()(TileAccumulator& acc, int p, const float* v, std::size_t plane,
+                    float len) const {
+        const std::size_t q = acc.imageIndex(p);
+        const float f = cut->fraction(q, acc.sheet());
+        if (!(f > 0.0f)) return;
+        constexpr bool surface = std::is_same_v<Inner, IsoPolicy>;
+        const bool before = surface && acc.hit(p);
+        if (f >= 1.0f) {
+            inner(acc, p, v, plane, len);
+        } else {
+            // Labels: the (weight, label) select channels are not integrals.
+            constexpr int kAdditive = kSource == SheetSource::Labels ? 4 : kChannels;
+            float c[kChannels];
+            for (int i = 0; i < kChannels; ++i)
+                c[i] = v[std::size_t(i) * plane] * (i < kAdditive ? f : 1.0f);
+            inner(acc, p, c, 1, len * f);
+        }
+        // Iso (front to back): nothing lies in front of the kept region, so a surface found
+        // in the sheet holding its entry is no nearer than the entry (the cap of the cut).
+        if (surface && !before && acc.hit(p))
+            acc.setHitPosition(p, std::max(acc.hitPosition(p), cut->entry(q)));
+    }
+};
+
+/// Iso compositing (the accumulator keeps hit positions), also when cut by clipping.
+template <class P>
+inline constexpr bool kSurfacePolicy = std::is_same_v<P, IsoPolicy>;
+template <class P>
+inline constexpr bool kSurfacePolicy<ClippedPolicy<P>> = kSurfacePolicy<P>;
+
+/// Calls f(policy) with the compositing policy of the frame's mode and classification (cut
+/// by the clipping when the frame clips).
 template <class F>
 decltype(auto) withPolicy(const PolicyContext& ctx, F&& f) {
+    auto run = [&](auto policy) {
+        using P = decltype(policy);
+        if (ctx.cut) return f(ClippedPolicy<P>{policy, ctx.cut});
+        return f(policy);
+    };
     switch (ctx.mode) {
         case RenderMode::Mip:
-            return f(MipPolicy{});
+            return run(MipPolicy{});
         case RenderMode::Xray:
-            return f(XrayPolicy{});
+            return run(XrayPolicy{});
         case RenderMode::Iso:
-            return f(IsoPolicy{&ctx});
+            return run(IsoPolicy{&ctx});
         default:
-            if (ctx.labelTable) return f(LabelPolicy{&ctx});
-            if (ctx.classification == Classification::Pre) return f(DvrPrePolicy{});
-            if (ctx.gradients) return f(DvrPostGradientPolicy{&ctx});
-            return f(DvrPostPolicy{ctx.transfer});
+            if (ctx.labelTable) return run(LabelPolicy{&ctx});
+            if (ctx.classification == Classification::Pre) return run(DvrPrePolicy{});
+            if (ctx.gradients) return run(DvrPostGradientPolicy{&ctx});
+            return run(DvrPostPolicy{ctx.transfer});
     }
 }
 

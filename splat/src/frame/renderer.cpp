@@ -128,7 +128,11 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
     if (!splatter.streams()) project(scene, camera, *work, stats);
     const SheetPlan plan = order(splatter, scene, camera, s, *work, stats);
     if (!splatter.streams()) bin(camera, s, *work, stats);
-    const PolicyContext ctx = policyContext(scene, camera, s);
+    PolicyContext ctx = policyContext(scene, camera, s);
+    // Issue 13: clipping cuts the sheets at the planes and box per pixel (frame/clip_cut.h).
+    const ClipCut cut(s.clipping, camera, plan, *scene.volume, scene.kernel.radius(),
+                      s.order == CompositeOrder::FrontToBack);
+    if (!cut.empty()) ctx.cut = &cut;
     Image positions;
     if (depth) positions = Image(camera.width(), camera.height());
     const TileInputs in{scene,

@@ -216,8 +216,10 @@ inline TileAccumulator makeTileAccumulator(const TileInputs& in, const TileGrid&
                                            bool terminates, bool surface) {
     const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
     const int w = std::min(g.tileSize, g.width - ox), h = std::min(g.tileSize, g.height - oy);
-    return TileAccumulator(w, h, in.settings.order,
-                           terminates ? in.settings.quality.earlyTermination : 0.0, surface);
+    TileAccumulator acc(w, h, in.settings.order,
+                        terminates ? in.settings.quality.earlyTermination : 0.0, surface);
+    acc.setOrigin(ox, oy, g.width);  // issue 13: per-pixel clip cut
+    return acc;
 }
 
 inline void addCounters(RenderStats* stats, const std::vector<TileCounters>& counters) {
@@ -242,7 +244,7 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
     tbb::parallel_for(0, g.count(), 1, [&](int t) {
         const DenormalsAreZero ftz;  // footprint tails must not hit slow denormal paths
         const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
-        constexpr bool surface = std::is_same_v<Policy, IsoPolicy>;
+        constexpr bool surface = kSurfacePolicy<Policy>;  // issue 13: also when clipped
         TileAccumulator acc = makeTileAccumulator(in, g, t, Policy::kTerminates, surface);
         if (in.bins.begin[t] != in.bins.begin[t + 1]) {
             const std::uint32_t ring = in.plan.ring;
@@ -308,7 +310,7 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
     const SplatProjector projector(in.scene.splats, in.camera, in.scene.volume->spacing,
                                    in.scene.kernel.radius());
     const std::vector<float> pathScale = perspectivePathScale(in.camera, in.plan.normal);
-    constexpr bool surface = std::is_same_v<Policy, IsoPolicy>;
+    constexpr bool surface = kSurfacePolicy<Policy>;
     const bool cull = Policy::kTerminates && in.settings.order == CompositeOrder::FrontToBack &&
                       in.settings.quality.earlyTermination > 0;
     std::vector<TileAccumulator> tiles;

@@ -40,6 +40,20 @@ std::vector<double> numbers(const std::string& s, const std::string& what, const
     return out;
 }
 
+// ITK's orientation code of a direction matrix: per index axis the letter of the side it
+// comes FROM in LPS space (+x runs from R, +y from A, +z from I), so the identity is "RAI".
+std::string impliedOrientation(const glm::dmat3& dirs, int ndims) {
+    static const char from[3][2] = {{'R', 'L'}, {'A', 'P'}, {'I', 'S'}};
+    std::string code;
+    for (int a = 0; a < ndims; ++a) {
+        int best = 0;
+        for (int r = 1; r < 3; ++r)
+            if (std::abs(dirs[a][r]) > std::abs(dirs[a][best])) best = r;
+        code += from[best][dirs[a][best] < 0 ? 1 : 0];
+    }
+    return code;
+}
+
 bool isTrue(const std::string& s) {
     std::string l = toLower(s);
     return l == "true" || l == "1" || l == "yes";
@@ -47,7 +61,7 @@ bool isTrue(const std::string& s) {
 
 }  // namespace
 
-Volume loadMetaImage(const fs::path& p) {
+Volume loadMetaImage(const fs::path& p, const LoadOptions& options) {
     const std::string name = displayName(p);
     std::vector<unsigned char> file = readFileBytes(p);
 
@@ -91,12 +105,11 @@ Volume loadMetaImage(const fs::path& p) {
         throw Error(name + ": DimSize has " + std::to_string(size.size()) + " entries, NDims is " +
                     std::to_string(ndims));
     glm::ivec3 dims(1);
-    for (int a = 0; a < ndims; ++a) {
-        if (size[a] < 1 || size[a] > 2147483647.0 || size[a] != std::floor(size[a]))
-            throw Error(name + ": invalid MetaImage DimSize '" + get("dimsize") + "'");
-        dims[a] = int(size[a]);
-    }
-    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
+    for (int a = 0; a < ndims; ++a)
+        dims[a] = dimensionFrom(size[a], name, "MetaImage DimSize", get("dimsize"));
+    // Every size check before anything is allocated (64-bit, no wrap).
+    const std::size_t expected = volumeBytes(dims, *type, name);
+    std::vector<std::string> notes;
 
     // Geometry.
     glm::dvec3 spacing(1.0), origin(0.0);
@@ -104,21 +117,34 @@ Volume loadMetaImage(const fs::path& p) {
     if (sp.empty()) sp = get("elementsize");
     if (!sp.empty()) {
         auto s = numbers(sp, name, "ElementSpacing");
-        for (int a = 0; a < ndims && a < int(s.size()); ++a) spacing[a] = s[a];
+        if (int(s.size()) != ndims)
+            throw Error(name + ": ElementSpacing has " + std::to_string(s.size()) +
+                        " entries, NDims is " + std::to_string(ndims));
+        for (int a = 0; a < ndims; ++a) spacing[a] = s[std::size_t(a)];
     }
     for (const char* k : {"offset", "origin", "position"})
         if (!get(k).empty()) {
             auto o = numbers(get(k), name, k);
-            for (int a = 0; a < ndims && a < int(o.size()); ++a) origin[a] = o[a];
+            if (int(o.size()) != ndims)
+                throw Error(name + ": MetaImage " + k + " has " + std::to_string(o.size()) +
+                            " entries, NDims is " + std::to_string(ndims));
+            for (int a = 0; a < ndims; ++a) origin[a] = o[std::size_t(a)];
             break;
         }
+    for (int a = 0; a < 3; ++a)
+        if (!std::isfinite(origin[a])) throw Error(name + ": MetaImage Offset is not finite");
     glm::dmat3 dirs(1.0);
+    bool haveMatrix = false;
     for (const char* k : {"transformmatrix", "rotation", "orientation"})
         if (!get(k).empty()) {
             auto m = numbers(get(k), name, k);
-            if (int(m.size()) == ndims * ndims)
-                for (int a = 0; a < ndims; ++a)
-                    for (int r = 0; r < ndims; ++r) dirs[a][r] = m[std::size_t(a * ndims + r)];
+            if (int(m.size()) != ndims * ndims)
+                throw Error(name + ": MetaImage TransformMatrix has " + std::to_string(m.size()) +
+                            " entries, NDims " + std::to_string(ndims) + " needs " +
+                            std::to_string(ndims * ndims));
+            for (int a = 0; a < ndims; ++a)
+                for (int r = 0; r < ndims; ++r) dirs[a][r] = m[std::size_t(a * ndims + r)];
+            haveMatrix = true;
             break;
         }
     for (int a = 0; a < 3; ++a)
@@ -126,6 +152,23 @@ Volume loadMetaImage(const fs::path& p) {
             throw Error(name + ": invalid MetaImage ElementSpacing '" + sp + "'");
     glm::dmat3 M;
     for (int a = 0; a < 3; ++a) M[a] = dirs[a] * spacing[a];
+    // AnatomicalOrientation repeats what the matrix says (ITK's "from" letters, identity =
+    // RAI); the matrix decides. A disagreement is worth a warning, an invalid code an error.
+    const std::string anat = toLower(get("anatomicalorientation"));
+    if (!anat.empty() && anat != "?" && anat != "???") {
+        const std::string implied = impliedOrientation(dirs, ndims);
+        std::string code = anat;
+        for (char& c : code) c = char(std::toupper(static_cast<unsigned char>(c)));
+        if (code.size() == 3 && ndims == 2) code.pop_back();  // some writers add a 3rd letter
+        if (code.size() != std::size_t(ndims) ||
+            code.find_first_not_of("RLAPSI") != std::string::npos)
+            throw Error(name + ": invalid MetaImage AnatomicalOrientation '" +
+                        get("anatomicalorientation") + "'");
+        if (code != implied)
+            notes.push_back("MetaImage AnatomicalOrientation " + code + " disagrees with " +
+                            (haveMatrix ? "the TransformMatrix" : "the identity orientation") +
+                            " (" + implied + "); the matrix was used");
+    }
 
     // Data.
     std::string byteOrder = get("binarydatabyteordermsb");
@@ -143,46 +186,51 @@ Volume loadMetaImage(const fs::path& p) {
     } else {
         if (toLower(dataFile).rfind("list", 0) == 0 || dataFile.find('%') != std::string::npos)
             throw Error(name + ": multi-file MetaImage data ('" + dataFile + "') is not supported");
-        fs::path dp =
-            fs::path(dataFile).is_absolute() ? fs::path(dataFile) : p.parent_path() / dataFile;
+        fs::path dp = resolveDataFile(p, dataFile, options.allowOutsideDataFiles);
         dataName = displayName(dp);
-        std::error_code ec;
-        if (!fs::exists(dp, ec)) throw Error(name + ": data file " + dataName + " does not exist");
         separate = readFileBytes(dp);
         data = separate.data();
         dataSize = separate.size();
-        long long headerSize =
-            get("headersize").empty() ? 0 : std::atoll(get("headersize").c_str());
+        long long headerSize = 0;
+        if (!get("headersize").empty()) {
+            auto h = numbers(get("headersize"), name, "HeaderSize");
+            if (h.size() != 1 || !(h[0] >= -1 && h[0] <= 9.0e15) || h[0] != std::floor(h[0]))
+                throw Error(name + ": bad MetaImage HeaderSize '" + get("headersize") + "'");
+            headerSize = (long long)h[0];
+        }
         if (headerSize > 0 && !compressed) {
             checkDataLength(std::size_t(headerSize), dataSize, dataName, false);
             data += headerSize;
             dataSize -= std::size_t(headerSize);
         } else if (headerSize == -1 && !compressed) {
-            std::size_t need = v.voxelCount() * sampleSize(*type);
-            checkDataLength(need, dataSize, dataName, false);
-            data += dataSize - need;
-            dataSize = need;
+            checkDataLength(expected, dataSize, dataName, false);
+            data += dataSize - expected;
+            dataSize = expected;
         }
     }
-    const std::size_t expected = v.voxelCount() * sampleSize(*type);
     std::vector<unsigned char> inflated;
     if (compressed) {
         std::string csize = get("compresseddatasize");
         if (!csize.empty()) {
-            std::size_t n = std::size_t(std::atoll(csize.c_str()));
+            auto c = numbers(csize, name, "CompressedDataSize");
+            if (c.size() != 1 || !(c[0] >= 0 && c[0] <= 9.0e15) || c[0] != std::floor(c[0]))
+                throw Error(name + ": bad MetaImage CompressedDataSize '" + csize + "'");
+            std::size_t n = std::size_t(c[0]);
             checkDataLength(n, dataSize, dataName, false);
             dataSize = n;
         }
-        inflated = inflateAll(data, dataSize, dataName);
+        inflated = inflateAll(data, dataSize, dataName, expected);
         data = inflated.data();
         dataSize = inflated.size();
     }
     checkDataLength(expected, dataSize, dataName, true);
+    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
     decodeSamples(data, v.voxelCount(), *type, bigEndian, v.data.data());
 
     v.source = std::string("MetaImage ") + sampleTypeName(*type) +
                (compressed ? " compressed" : "") + " (" + p.filename().string() + ")";
     applyOrientation(v, M, origin, "TransformMatrix");
+    for (const std::string& n : notes) addNote(v, n);
     return v;
 }
 

@@ -1,17 +1,21 @@
-// NIfTI-1 (.nii, .nii.gz) through niftilib's nifti1_io.
+// NIfTI-1, NIfTI-2 and ANALYZE 7.5 (.nii, .nii.gz, .hdr/.img pairs) through nifti2_io.
 //
 // A NIfTI-1 file is a 348-byte header (dims, datatype, pixdim, scl_slope/scl_inter and
 // two index-to-world transforms: the qform quaternion and the sform affine, both in
-// RAS+ millimetres) followed by the samples, x fastest. niftilib parses the header,
-// swaps bytes to the host order and handles gzip; we convert to float, apply the
-// intensity scaling and the orientation (sform preferred, then qform, else pixdim).
-#include <nifti1_io.h>
+// RAS+ millimetres) followed by the samples, x fastest; NIfTI-2 is the same with a
+// 540-byte header of 64-bit fields; ANALYZE 7.5 is the 348-byte ancestor without
+// orientation. niftilib's header structures, byte swapping and quaternion maths are used;
+// the header values are checked here, in 64-bit arithmetic, before anything is
+// allocated, and only the first volume's bytes are read (a 4D series is not loaded to
+// keep one volume). Values go through the intensity scaling and the orientation (sform
+// preferred, then qform, else pixdim). README "Input files and bad input" lists what is
+// refused and what is only warned about.
+#include <nifti2_io.h>
 #include <zlib.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <memory>
 
 #include "splat/error.h"
 #include "volume_detail.h"
@@ -20,11 +24,6 @@ namespace fs = std::filesystem;
 
 namespace splat::detail {
 namespace {
-
-struct NimDeleter {
-    void operator()(nifti_image* nim) const { nifti_image_free(nim); }
-};
-using NimPtr = std::unique_ptr<nifti_image, NimDeleter>;
 
 std::optional<SampleType> niftiType(int datatype) {
     switch (datatype) {
@@ -49,117 +48,320 @@ std::optional<SampleType> niftiType(int datatype) {
     }
 }
 
-// Total (decompressed) length of a .nii or .nii.gz file.
-std::size_t contentLength(const fs::path& p, bool gz) {
-    std::error_code ec;
-    if (!gz) return std::size_t(fs::file_size(p, ec));
-    gzFile f = gzopen(p.string().c_str(), "rb");
-    if (!f) return 0;
-    std::size_t total = 0;
-    std::vector<char> buf(1 << 18);
-    int n;
-    while ((n = gzread(f, buf.data(), unsigned(buf.size()))) > 0) total += std::size_t(n);
-    gzclose(f);
-    return total;
-}
+/// The fields we use, from any of the three header layouts, in host byte order.
+struct Header {
+    int version = 1;         ///< 0 = ANALYZE 7.5, 1 = NIfTI-1, 2 = NIfTI-2
+    bool singleFile = true;  ///< n+1 / n+2: data in the same file after the header
+    bool swapped = false;    ///< file byte order differs from the host's
+    std::int64_t dim[8] = {};
+    int datatype = 0, bitpix = 0;
+    double pixdim[8] = {};
+    double voxOffset = 0;
+    double sclSlope = 0, sclInter = 0;
+    int qformCode = 0, sformCode = 0;
+    double quatern[3] = {}, qoffset[3] = {};
+    double srow[3][4] = {};
+    std::size_t headerSize() const { return version == 2 ? 540 : 348; }
+};
 
-// Checks the 348-byte header ourselves before handing the file to niftilib, which
-// prints its own complaints to stderr: size field, magic, dims, data length.
-void validateHeader(const fs::path& p, const std::string& name) {
-    const bool gz = lowerExtension(p) == ".nii.gz";
-    nifti_1_header h;
+bool isGz(const fs::path& p) { return toLower(p.extension().string()) == ".gz"; }
+
+// Up to `n` bytes from the start of a plain or gzip file (gzread reads both).
+std::string readStart(const fs::path& p, std::size_t n, const std::string& name) {
     gzFile f = gzopen(p.string().c_str(), "rb");
     if (!f) throw Error(name + ": cannot open for reading");
-    int got = gzread(f, &h, sizeof h);
+    std::string buf(n, '\0');
+    int got = gzread(f, buf.data(), unsigned(n));
     int gzErr = 0;
     gzerror(f, &gzErr);
     gzclose(f);
-    if (gzErr != Z_OK && gzErr != Z_STREAM_END) throw Error(name + ": corrupt gzip data");
-    if (got != int(sizeof h))
-        throw Error(name + ": not a NIfTI-1 file (shorter than its 348-byte header)");
-    bool swapped = h.sizeof_hdr != 348;
-    if (swapped) {
-        swap_nifti_header(&h, 1);
-        if (h.sizeof_hdr != 348)
-            throw Error(name + ": not a readable NIfTI-1 file (bad header size)");
-    }
-    if (std::memcmp(h.magic, "n+1", 4) != 0)
-        throw Error(name + ": not a readable NIfTI-1 single file (magic is not n+1)");
-    if (h.dim[0] < 1 || h.dim[0] > 7)
-        throw Error(
-            name + ": not a readable NIfTI-1 file (bad dim[0] = " + std::to_string(h.dim[0]) + ")");
-    std::uint64_t count = 1;
-    for (int d = 1; d <= h.dim[0]; ++d) {
-        if (h.dim[d] < 1)
-            throw Error(name + ": invalid dimension " + std::to_string(h.dim[d]) + " along axis " +
-                        std::to_string(d));
-        count *= std::uint64_t(h.dim[d]);  // at most 7 factors below 2^15: no overflow
-    }
-    if (!niftiType(h.datatype))
-        throw Error(name + ": unsupported NIfTI data type " + nifti_datatype_string(h.datatype) +
-                    " (supported: uint8, int8, int16, uint16, int32, uint32, float32, float64)");
-    std::size_t offset = std::size_t(std::max(0.0f, h.vox_offset));
-    std::size_t expected = std::size_t(count) * std::size_t(h.bitpix / 8);
-    std::size_t total = contentLength(p, gz);
-    checkDataLength(expected, total > offset ? total - offset : 0, name, false);
+    if (got < 0 || (gzErr != Z_OK && gzErr != Z_STREAM_END))
+        throw Error(name + ": corrupt gzip data");
+    buf.resize(std::size_t(got));
+    return buf;
 }
 
-glm::dmat3 linearPart(const mat44& m, glm::dvec3& t) {
-    glm::dmat3 M;
-    for (int a = 0; a < 3; ++a)
-        for (int r = 0; r < 3; ++r) M[a][r] = m.m[r][a];
-    t = glm::dvec3(m.m[0][3], m.m[1][3], m.m[2][3]);
-    return M;
+// The fields NIfTI-1, NIfTI-2 and ANALYZE 7.5 share (types differ: short/float vs
+// int64/double).
+template <typename H>
+void copyDims(const H& n, Header& h) {
+    for (int d = 0; d < 8; ++d) {
+        h.dim[d] = n.dim[d];
+        h.pixdim[d] = n.pixdim[d];
+    }
+    h.datatype = n.datatype;
+    h.bitpix = n.bitpix;
+    h.voxOffset = double(n.vox_offset);
+}
+
+// Scaling and both transforms (NIfTI-1 and NIfTI-2 only).
+template <typename H>
+void copyTransforms(const H& n, Header& h) {
+    h.sclSlope = n.scl_slope;
+    h.sclInter = n.scl_inter;
+    h.qformCode = n.qform_code;
+    h.sformCode = n.sform_code;
+    const double q[6] = {n.quatern_b, n.quatern_c, n.quatern_d,
+                         n.qoffset_x, n.qoffset_y, n.qoffset_z};
+    for (int i = 0; i < 3; ++i) {
+        h.quatern[i] = q[i];
+        h.qoffset[i] = q[i + 3];
+    }
+    for (int i = 0; i < 4; ++i) {
+        h.srow[0][i] = n.srow_x[i];
+        h.srow[1][i] = n.srow_y[i];
+        h.srow[2][i] = n.srow_z[i];
+    }
+}
+
+Header parseHeader(const std::string& bytes, const std::string& name) {
+    Header h;
+    if (bytes.size() < 4) throw Error(name + ": not a NIfTI/ANALYZE file (too short)");
+    std::int32_t size;
+    std::memcpy(&size, bytes.data(), 4);
+    const std::int32_t swappedSize = std::int32_t(__builtin_bswap32(std::uint32_t(size)));
+    if (size == 540 || swappedSize == 540) {
+        if (bytes.size() < sizeof(nifti_2_header))
+            throw Error(name + ": not a NIfTI-2 file (shorter than its 540-byte header)");
+        nifti_2_header n2;
+        std::memcpy(&n2, bytes.data(), sizeof n2);
+        h.swapped = size != 540;
+        if (h.swapped) swap_nifti_header(&n2, 2);
+        h.version = 2;
+        if (std::memcmp(n2.magic, "n+2", 4) == 0)
+            h.singleFile = true;
+        else if (std::memcmp(n2.magic, "ni2", 4) == 0)
+            h.singleFile = false;
+        else
+            throw Error(name + ": not a readable NIfTI-2 file (magic is not n+2 or ni2)");
+        copyDims(n2, h);
+        copyTransforms(n2, h);
+        return h;
+    }
+    if (size != 348 && swappedSize != 348)
+        throw Error(name + ": not a readable NIfTI-1 file (header size field is " +
+                    std::to_string(size) + ", expected 348; 540 for NIfTI-2)");
+    if (bytes.size() < sizeof(nifti_1_header))
+        throw Error(name + ": not a NIfTI-1 file (shorter than its 348-byte header)");
+    nifti_1_header n1;
+    std::memcpy(&n1, bytes.data(), sizeof n1);
+    h.swapped = size != 348;
+    // ANALYZE 7.5 shares every field used here (dims, datatype, bitpix, pixdim, vox_offset)
+    // at the same offsets, so the NIfTI-1 swap is right for both.
+    if (h.swapped) swap_nifti_header(&n1, 1);
+    if (std::memcmp(n1.magic, "n+1", 4) == 0) {
+        h.version = 1;
+        h.singleFile = true;
+    } else if (std::memcmp(n1.magic, "ni1", 4) == 0) {
+        h.version = 1;
+        h.singleFile = false;
+    } else {
+        h.version = 0;
+        h.singleFile = false;
+    }
+    copyDims(n1, h);
+    if (h.version == 1) copyTransforms(n1, h);  // ANALYZE has other fields there
+    return h;
+}
+
+// The other file of a .hdr/.img pair (also .img.gz / .hdr.gz).
+fs::path pairedFile(const fs::path& p, bool wantImage, const std::string& name) {
+    std::string file = p.filename().string();
+    std::string lower = toLower(file);
+    bool gz = lower.size() > 3 && lower.compare(lower.size() - 3, 3, ".gz") == 0;
+    std::string stem = file.substr(0, file.size() - (gz ? 7 : 4));
+    const char* exts[] = {".img", ".img.gz", ".IMG", ".IMG.gz"};
+    const char* hexts[] = {".hdr", ".hdr.gz", ".HDR", ".HDR.gz"};
+    for (const char* e : wantImage ? exts : hexts) {
+        fs::path c = p.parent_path() / (stem + e);
+        std::error_code ec;
+        if (fs::exists(c, ec)) return c;
+    }
+    throw Error(name + ": the " + (wantImage ? "image (.img)" : "header (.hdr)") +
+                " file of this ANALYZE/NIfTI pair does not exist");
+}
+
+// `count` bytes at `offset` of a plain or gzip file, never more than the file holds.
+std::vector<unsigned char> readData(const fs::path& p, std::uint64_t offset, std::uint64_t count) {
+    if (!isGz(p)) return readFileRange(p, offset, count);
+    const std::string name = displayName(p);
+    regularFileSize(p);
+    gzFile f = gzopen(p.string().c_str(), "rb");
+    if (!f) throw Error(name + ": cannot open for reading");
+    std::vector<unsigned char> out;
+    std::vector<unsigned char> skip(1 << 16);
+    std::uint64_t skipped = 0;
+    int n = 1;
+    while (skipped < offset && n > 0) {
+        n = gzread(f, skip.data(),
+                   unsigned(std::min<std::uint64_t>(skip.size(), offset - skipped)));
+        if (n > 0) skipped += std::uint64_t(n);
+    }
+    // Grow with the data that really arrives, so a lying header cannot make us allocate.
+    while (out.size() < count && n > 0) {
+        std::size_t old = out.size();
+        std::size_t chunk = std::size_t(std::min<std::uint64_t>(count - old, 1u << 24));
+        out.resize(old + chunk);
+        n = gzread(f, out.data() + old, unsigned(chunk));
+        out.resize(old + std::size_t(std::max(n, 0)));
+    }
+    int gzErr = 0;
+    const char* msg = gzerror(f, &gzErr);
+    std::string reason = msg ? msg : "";
+    gzclose(f);
+    if (n < 0 || (gzErr != Z_OK && gzErr != Z_STREAM_END))
+        throw Error(name + ": corrupt gzip data (" + reason + ")");
+    if (skipped < offset || out.size() < count)
+        throw Error(name + ": truncated data: expected " + std::to_string(count) +
+                    " bytes, found " + std::to_string(skipped < offset ? 0 : out.size()) +
+                    " (after byte " + std::to_string(offset) + ")");
+    return out;
+}
+
+bool allFinite(const double* v, int n) {
+    for (int i = 0; i < n; ++i)
+        if (!std::isfinite(v[i])) return false;
+    return true;
 }
 
 }  // namespace
 
-Volume loadNifti(const fs::path& p) {
+Volume loadNifti(const fs::path& given) {
+    std::string ext = toLower(given.extension().string());
+    if (ext == ".gz") ext = toLower(given.stem().extension().string());
+    // An .img names the pair's header; the header is where everything starts.
+    const fs::path p = ext == ".img" ? pairedFile(given, false, displayName(given)) : given;
     const std::string name = displayName(p);
-    std::error_code ec;
-    if (!fs::exists(p, ec)) throw Error(name + ": no such file");
-    validateHeader(p, name);
-    nifti_set_debug_level(0);  // niftilib prints to stderr otherwise; we report ourselves
-    NimPtr nim(nifti_image_read(p.string().c_str(), 0));
-    if (!nim) throw Error(name + ": not a readable NIfTI-1 file (bad header or corrupt gzip data)");
-    auto type = niftiType(nim->datatype);
-    if (!type) throw Error(name + ": unsupported NIfTI data type");
-    glm::ivec3 dims(std::max(nim->nx, 1), std::max(nim->ny, 1), std::max(nim->nz, 1));
-    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
-    std::size_t extraVolumes = dims.x > 0 ? nim->nvox / v.voxelCount() : 1;
+    regularFileSize(p);
+    const Header h = parseHeader(readStart(p, 540, name), name);
+    const char* format = h.version == 2 ? "NIfTI-2" : h.version == 1 ? "NIfTI-1" : "ANALYZE 7.5";
+    std::vector<std::string> notes;
+    if ((ext == ".nii") && !h.singleFile)
+        throw Error(name + ": not a readable single-file NIfTI (magic is not n+1 or n+2)");
 
-    if (nifti_image_load(nim.get()) < 0 || !nim->data)
-        throw Error(name + ": cannot read the sample data (corrupt gzip data?)");
-    decodeSamples(static_cast<const unsigned char*>(nim->data), v.voxelCount(), *type, false,
-                  v.data.data());
+    // Dimensions: dim[0] axes, each >= 1; the product in checked 64-bit arithmetic.
+    if (h.dim[0] < 1 || h.dim[0] > 7)
+        throw Error(name + ": not a readable " + format +
+                    " file (bad dim[0] = " + std::to_string(h.dim[0]) + ")");
+    std::uint64_t volumes = 1;
+    glm::ivec3 dims(1);
+    for (int d = 1; d <= h.dim[0]; ++d) {
+        if (h.dim[d] < 1 || h.dim[d] > 2147483647)
+            throw Error(name + ": invalid dimension " + std::to_string(h.dim[d]) + " along axis " +
+                        std::to_string(d));
+        if (d <= 3)
+            dims[d - 1] = int(h.dim[d]);
+        else
+            volumes = checkedMul(volumes, std::uint64_t(h.dim[d]), name);
+    }
+    auto type = niftiType(h.datatype);
+    if (!type)
+        throw Error(name + ": unsupported " + (h.version ? "NIfTI" : "ANALYZE") + " data type " +
+                    nifti_datatype_string(h.datatype) +
+                    " (supported: uint8, int8, int16, uint16, int32, uint32, float32, float64)");
+    if (std::size_t(h.bitpix) != 8 * sampleSize(*type))
+        throw Error(name + ": bitpix " + std::to_string(h.bitpix) + " does not match datatype " +
+                    sampleTypeName(*type) + " (" + std::to_string(8 * sampleSize(*type)) +
+                    " bits)");
+    const std::size_t bytes = volumeBytes(dims, *type, name);
+    checkedMul(bytes, volumes, name);  // the whole series must be addressable too
+
+    // Where the samples start.
+    if (!std::isfinite(h.voxOffset) || h.voxOffset < 0 || h.voxOffset > 9.0e15 ||
+        h.voxOffset != std::floor(h.voxOffset))
+        throw Error(name + ": invalid vox_offset " + std::to_string(h.voxOffset));
+    std::uint64_t offset = std::uint64_t(h.voxOffset);
+    fs::path dataPath = p;
+    if (h.singleFile) {
+        const std::uint64_t minimum = h.headerSize() + 4;
+        if (offset < minimum)
+            throw Error(name + ": vox_offset " + std::to_string(offset) +
+                        " lies inside the header (a single-file " + format +
+                        " needs vox_offset >= " + std::to_string(minimum) + ")");
+    } else {
+        dataPath = pairedFile(p, true, name);
+    }
+    if (dataPath != p) regularFileSize(dataPath, "image file ");
 
     // Intensity scaling: value = scl_slope * stored + scl_inter; slope 0 means none.
-    double slope = nim->scl_slope, inter = nim->scl_inter;
-    if (std::isfinite(slope) && slope != 0.0 && std::isfinite(inter) &&
-        (slope != 1.0 || inter != 0.0))
-        for (float& d : v.data) d = float(slope * d + inter);
+    double slope = h.sclSlope, inter = h.sclInter;
+    if (std::isinf(slope) || (slope != 0 && std::isfinite(slope) && !std::isfinite(inter)))
+        throw Error(name + ": scl_slope " + std::to_string(slope) + " / scl_inter " +
+                    std::to_string(inter) + " is not a usable intensity scaling");
+    if (std::isnan(slope)) {
+        notes.push_back("scl_slope is NaN: no intensity scaling applied");
+        slope = 0;
+    }
 
-    v.source = std::string("NIfTI-1 ") + sampleTypeName(*type) + " (" + p.filename().string() + ")";
-    if (extraVolumes > 1)
-        v.note =
-            "4D file: only the first of " + std::to_string(extraVolumes) + " volumes was loaded";
-
+    // Geometry: sform, then qform, else pixdim ("method 1").
+    for (int a = 1; a <= 3; ++a)
+        if (!std::isfinite(h.pixdim[a]))
+            throw Error(name + ": pixdim[" + std::to_string(a) + "] is " +
+                        std::to_string(h.pixdim[a]) + " (must be finite)");
     glm::dvec3 t(0.0);
     glm::dmat3 M(1.0);
     std::string what;
-    if (nim->sform_code > 0) {
-        M = linearPart(nim->sto_xyz, t);
-        what = "sform";
-    } else if (nim->qform_code > 0) {
-        M = linearPart(nim->qto_xyz, t);
-        what = "qform";
-    } else {
-        // "Method 1" (ANALYZE-style): spacing from pixdim only, no orientation.
+    if (h.sformCode > 0) {
+        for (int r = 0; r < 3; ++r)
+            if (!allFinite(h.srow[r], 4))
+                throw Error(name + ": the sform (srow_x/y/z) holds NaN or Inf");
         for (int a = 0; a < 3; ++a)
-            M[a][a] = std::abs(nim->pixdim[a + 1]) > 0 ? std::abs(nim->pixdim[a + 1]) : 1.0;
-        what = "pixdim";
+            for (int r = 0; r < 3; ++r) M[a][r] = h.srow[r][a];
+        t = glm::dvec3(h.srow[0][3], h.srow[1][3], h.srow[2][3]);
+        what = "sform";
+    } else {
+        double d[3];
+        for (int a = 0; a < 3; ++a) {
+            d[a] = h.pixdim[a + 1];
+            const std::string axis = "pixdim[" + std::to_string(a + 1) + "]";
+            if (d[a] == 0) {
+                notes.push_back(axis + " is 0: spacing 1 assumed");
+                d[a] = 1;
+            } else if (d[a] < 0 && h.qformCode > 0) {
+                notes.push_back(axis +
+                                " is negative: its magnitude is used (the qform's qfac "
+                                "gives the handedness)");
+                d[a] = -d[a];
+            } else if (d[a] < 0) {
+                notes.push_back(axis + " is negative: applied as a flip of that axis");
+            }
+        }
+        if (h.qformCode > 0) {
+            if (!allFinite(h.quatern, 3) || !allFinite(h.qoffset, 3))
+                throw Error(name + ": the qform (quatern_b/c/d, qoffset) holds NaN or Inf");
+            const double qfac = h.pixdim[0] < 0 ? -1.0 : 1.0;
+            nifti_dmat44 q =
+                nifti_quatern_to_dmat44(h.quatern[0], h.quatern[1], h.quatern[2], h.qoffset[0],
+                                        h.qoffset[1], h.qoffset[2], d[0], d[1], d[2], qfac);
+            for (int a = 0; a < 3; ++a)
+                for (int r = 0; r < 3; ++r) M[a][r] = q.m[r][a];
+            t = glm::dvec3(q.m[0][3], q.m[1][3], q.m[2][3]);
+            what = "qform";
+        } else {
+            for (int a = 0; a < 3; ++a) M[a][a] = d[a];
+            what = "pixdim";
+            if (h.version == 0)
+                notes.push_back(
+                    "ANALYZE 7.5 has no orientation: the index axes are taken as "
+                    "x, y, z");
+        }
     }
+
+    std::vector<unsigned char> data = readData(dataPath, offset, bytes);
+    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
+    // Host byte order is little-endian (volume_decode.cpp): a swapped header means the
+    // samples are big-endian.
+    decodeSamples(data.data(), v.voxelCount(), *type, h.swapped, v.data.data());
+    if (std::isfinite(slope) && slope != 0.0 && (slope != 1.0 || inter != 0.0))
+        for (float& s : v.data) s = float(slope * s + inter);
+
+    v.source =
+        std::string(format) + " " + sampleTypeName(*type) + " (" + p.filename().string() + ")";
+    if (volumes > 1)
+        notes.insert(notes.begin(), "4D file: only the first of " + std::to_string(volumes) +
+                                        " volumes was loaded");
     applyOrientation(v, M, t, what);
+    for (const std::string& n : notes) addNote(v, n);
     return v;
 }
 

@@ -69,7 +69,7 @@ std::vector<double> parseNumbers(const std::string& s, const std::string& what,
 
 }  // namespace
 
-Volume loadNrrd(const fs::path& p) {
+Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
     const std::string name = displayName(p);
     std::vector<unsigned char> file = readFileBytes(p);
     const std::string magic(file.begin(), file.begin() + std::min<std::size_t>(file.size(), 7));
@@ -121,17 +121,20 @@ Volume loadNrrd(const fs::path& p) {
         throw Error(name + ": 'sizes' has " + std::to_string(sizes.size()) + " entries, " +
                     "dimension is " + std::to_string(dimension));
     glm::ivec3 dims(1);
-    for (int a = 0; a < dimension; ++a) {
-        if (sizes[a] < 1 || sizes[a] > 2147483647.0 || sizes[a] != std::floor(sizes[a]))
-            throw Error(name + ": invalid NRRD sizes '" + field("sizes") + "'");
-        dims[a] = int(sizes[a]);
-    }
-    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
+    for (int a = 0; a < dimension; ++a)
+        dims[a] = dimensionFrom(sizes[a], name, "NRRD sizes", field("sizes"));
+    // Every size check before anything is allocated (64-bit, no wrap).
+    const std::size_t expected = volumeBytes(dims, *type, name);
+    std::vector<std::string> notes;
 
     // Geometry: space directions (with optional space origin) or per-axis spacings.
     glm::dmat3 M(1.0);
     glm::dvec3 t(0.0);
     bool oriented = false;
+    if (!field("space directions").empty() && !field("spacings").empty())
+        throw Error(name +
+                    ": NRRD header has both 'spacings' and 'space directions' (the format "
+                    "forbids it: the two could disagree); keep one");
     if (!field("space directions").empty()) {
         auto dirs = parseVectors(field("space directions"), name);
         if (int(dirs.size()) != dimension)
@@ -140,17 +143,69 @@ Volume loadNrrd(const fs::path& p) {
         for (int a = 0; a < dimension; ++a) {
             if (!dirs[a]) throw Error(name + ": 'space directions' is 'none' for a spatial axis");
             M[a] = *dirs[a];
+            if (!std::isfinite(M[a].x) || !std::isfinite(M[a].y) || !std::isfinite(M[a].z) ||
+                glm::length(M[a]) <= 0)
+                throw Error(name + ": 'space directions' has a zero, NaN or Inf vector for axis " +
+                            std::to_string(a));
         }
         if (dimension == 2) M[2] = glm::normalize(glm::cross(M[0], M[1])) * glm::length(M[0]);
         oriented = true;
     } else if (!field("spacings").empty()) {
         auto sp = parseNumbers(field("spacings"), name, "spacings");
-        for (int a = 0; a < dimension && a < int(sp.size()); ++a)
-            if (std::isfinite(sp[a])) M[a][a] = std::abs(sp[a]);
+        if (int(sp.size()) != dimension)
+            throw Error(name + ": 'spacings' has " + std::to_string(sp.size()) +
+                        " entries, dimension is " + std::to_string(dimension));
+        for (int a = 0; a < dimension; ++a) {
+            if (std::isnan(sp[a])) {
+                // NRRD's own way to say "unknown spacing".
+                notes.push_back("NRRD spacing of axis " + std::to_string(a) +
+                                " is NaN (unknown): 1 assumed");
+                continue;
+            }
+            if (!std::isfinite(sp[a]) || sp[a] == 0)
+                throw Error(name + ": invalid NRRD spacings '" + field("spacings") +
+                            "' (each must be finite and non-zero, or NaN for unknown)");
+            M[a][a] = sp[a];  // a negative spacing is a flip, applied by applyOrientation
+        }
     }
     if (!field("space origin").empty()) {
         auto o = parseVectors(field("space origin"), name);
-        if (o.size() == 1 && o[0]) t = *o[0];
+        if (o.size() != 1 || !o[0])
+            throw Error(name + ": bad NRRD space origin '" + field("space origin") + "'");
+        t = *o[0];
+        if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z))
+            throw Error(name + ": NRRD space origin '" + field("space origin") + "' is not finite");
+    }
+
+    std::string encoding = toLower(field("encoding"));
+    if (encoding.empty()) encoding = "raw";
+    const bool gzip = encoding == "gzip" || encoding == "gz";
+    const bool text = encoding == "text" || encoding == "txt" || encoding == "ascii";
+    if (!gzip && !text && encoding != "raw")
+        throw Error(name + ": unsupported NRRD encoding '" + encoding +
+                    "' (supported: raw, gzip, text)");
+    std::string endian = toLower(field("endian"));
+    if (!endian.empty() && endian != "big" && endian != "little")
+        throw Error(name + ": bad NRRD endian '" + endian + "'");
+    if (endian.empty() && !text && sampleSize(*type) > 1)
+        notes.push_back("NRRD header has no 'endian' field: little-endian assumed for its " +
+                        std::to_string(sampleSize(*type)) + "-byte samples");
+    const bool bigEndian = endian == "big";
+    long long byteSkip = 0;
+    if (!field("byte skip").empty()) {
+        std::vector<double> b = parseNumbers(field("byte skip"), name, "byte skip");
+        if (b.size() != 1 || !(b[0] >= -1 && b[0] <= 9.0e15) || b[0] != std::floor(b[0]))
+            throw Error(name + ": bad NRRD byte skip '" + field("byte skip") + "'");
+        byteSkip = (long long)b[0];
+        if (byteSkip == -1 && !(encoding == "raw"))
+            throw Error(name + ": NRRD byte skip -1 is only allowed with raw encoding");
+    }
+    long long lineSkip = 0;
+    if (!field("line skip").empty()) {
+        std::vector<double> l = parseNumbers(field("line skip"), name, "line skip");
+        if (l.size() != 1 || !(l[0] >= 0 && l[0] <= 9.0e15) || l[0] != std::floor(l[0]))
+            throw Error(name + ": bad NRRD line skip '" + field("line skip") + "'");
+        lineSkip = (long long)l[0];
     }
 
     // Where the data is.
@@ -164,73 +219,65 @@ Volume loadNrrd(const fs::path& p) {
         if (dataFile.rfind("LIST", 0) == 0 || dataFile.find('%') != std::string::npos)
             throw Error(name + ": multi-file NRRD data ('data file: " + dataFile +
                         "') is not supported");
-        fs::path dp =
-            fs::path(dataFile).is_absolute() ? fs::path(dataFile) : p.parent_path() / dataFile;
+        fs::path dp = resolveDataFile(p, dataFile, options.allowOutsideDataFiles);
         dataName = displayName(dp);
-        std::error_code ec;
-        if (!fs::exists(dp, ec)) throw Error(name + ": data file " + dataName + " does not exist");
         detached = readFileBytes(dp);
         data = detached.data();
         dataSize = detached.size();
-        // line skip: lines of text to skip in the data file before byte skip.
-        int lineSkip = std::atoi(field("line skip").c_str());
-        std::size_t skipPos = 0;
-        for (int l = 0; l < lineSkip && skipPos < dataSize; ++l) {
-            while (skipPos < dataSize && data[skipPos] != '\n') ++skipPos;
-            if (skipPos < dataSize) ++skipPos;
-        }
-        data += skipPos;
-        dataSize -= skipPos;
     } else {
         if (!blankSeen)
             throw Error(name + ": NRRD header has no data (no blank line, no 'data file')");
         data = file.data() + pos;
         dataSize = file.size() - pos;
     }
-
-    std::string encoding = toLower(field("encoding"));
-    if (encoding.empty()) encoding = "raw";
-    std::string endian = toLower(field("endian"));
-    bool bigEndian = endian == "big";
-    if (!endian.empty() && endian != "big" && endian != "little")
-        throw Error(name + ": bad NRRD endian '" + endian + "'");
-    const std::size_t expected = v.voxelCount() * sampleSize(*type);
-    long long byteSkip = field("byte skip").empty() ? 0 : std::atoll(field("byte skip").c_str());
+    // line skip: lines of text to skip before byte skip.
+    std::size_t skipPos = 0;
+    for (long long l = 0; l < lineSkip && skipPos < dataSize; ++l) {
+        while (skipPos < dataSize && data[skipPos] != '\n') ++skipPos;
+        if (skipPos < dataSize) ++skipPos;
+    }
+    data += skipPos;
+    dataSize -= skipPos;
 
     std::vector<unsigned char> inflated;
-    if (encoding == "gzip" || encoding == "gz") {
-        if (byteSkip > 0) {
-            if (std::size_t(byteSkip) > dataSize)
-                checkDataLength(std::size_t(byteSkip), dataSize, dataName, false);
-            data += byteSkip;
-            dataSize -= std::size_t(byteSkip);
-        }
-        inflated = inflateAll(data, dataSize, dataName);
-        checkDataLength(expected, inflated.size(), dataName, true);
-        decodeSamples(inflated.data(), v.voxelCount(), *type, bigEndian, v.data.data());
+    if (byteSkip > 0) {
+        checkDataLength(std::size_t(byteSkip), dataSize, dataName, false);
+        data += byteSkip;
+        dataSize -= std::size_t(byteSkip);
+    }
+    if (gzip) {
+        inflated = inflateAll(data, dataSize, dataName, expected);
+        data = inflated.data();
+        dataSize = inflated.size();
+        checkDataLength(expected, dataSize, dataName, true);
     } else if (encoding == "raw") {
         if (byteSkip == -1) {
             // "-1": the data is the last `expected` bytes of the file.
             checkDataLength(expected, dataSize, dataName, false);
             data += dataSize - expected;
             dataSize = expected;
-        } else if (byteSkip > 0) {
-            checkDataLength(std::size_t(byteSkip) + expected, dataSize, dataName, false);
-            data += byteSkip;
-            dataSize -= std::size_t(byteSkip);
         }
         checkDataLength(expected, dataSize, dataName, true);
-        decodeSamples(data, v.voxelCount(), *type, bigEndian, v.data.data());
-    } else if (encoding == "text" || encoding == "txt" || encoding == "ascii") {
-        decodeText(std::string(data, data + dataSize), v.voxelCount(), v.data.data(), dataName);
     } else {
-        throw Error(name + ": unsupported NRRD encoding '" + encoding +
-                    "' (supported: raw, gzip, text)");
+        // Text: n numbers take at least 2n - 1 characters (digits and separators).
+        const std::size_t count = expected / sampleSize(*type);
+        if (dataSize < 2 * count - 1)
+            throw Error(dataName + ": truncated data: " + std::to_string(count) +
+                        " numbers need at least " + std::to_string(2 * count - 1) +
+                        " characters of text, found " + std::to_string(dataSize));
+    }
+    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
+    if (text) {
+        decodeText(std::string(data, data + dataSize), v.voxelCount(), *type, v.data.data(),
+                   dataName);
+    } else {
+        decodeSamples(data, v.voxelCount(), *type, bigEndian, v.data.data());
     }
 
     v.source = std::string("NRRD ") + sampleTypeName(*type) + " " + encoding + " (" +
                p.filename().string() + ")";
     applyOrientation(v, M, t, oriented ? "space directions" : "spacings");
+    for (const std::string& n : notes) addNote(v, n);
     return v;
 }
 

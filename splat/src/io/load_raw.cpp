@@ -1,5 +1,7 @@
-// Headerless .raw files: the caller says dims/type/spacing/byte order (RawOptions), or
-// the name does, as in skull_256x256x256_uint8.raw ("NAME_XxYxZ_TYPE.raw").
+// Headerless .raw (and gzip-compressed .raw.gz) files: the caller says dims/type/spacing/
+// byte order (RawOptions), or the name does, as in skull_256x256x256_uint8.raw
+// ("NAME_XxYxZ_TYPE.raw"). Sizes are checked in 64-bit arithmetic against the file before
+// anything is allocated; a .raw.gz is inflated no further than the size it must hold.
 #include <regex>
 
 #include "splat/error.h"
@@ -11,13 +13,13 @@ namespace splat::detail {
 
 Volume loadRaw(const fs::path& p, const RawOptions& options) {
     const std::string name = displayName(p);
-    std::error_code ec;
-    if (!fs::exists(p, ec)) throw Error(name + ": no such file");
+    const std::uint64_t fileSize = regularFileSize(p);
+    const bool gz = lowerExtension(p) == ".raw.gz";
 
     std::optional<glm::ivec3> dims = options.dims;
     std::string typeName = options.type;
     // Name convention: ..._<X>x<Y>x<Z>_<type>.raw (type may be omitted if given).
-    static const std::regex pattern(R"(.*?(\d+)x(\d+)x(\d+)(?:_([A-Za-z0-9]+))?\.raw$)",
+    static const std::regex pattern(R"(.*?(\d+)x(\d+)x(\d+)(?:_([A-Za-z0-9]+))?\.raw(\.gz)?$)",
                                     std::regex::icase);
     std::smatch m;
     const std::string file = p.filename().string();
@@ -42,17 +44,24 @@ Volume loadRaw(const fs::path& p, const RawOptions& options) {
     if (!type)
         throw Error(name + ": unsupported sample type '" + typeName +
                     "' (uint8, int8, uint16, int16, uint32, int32, float32, float64)");
+    const std::size_t dataBytes = volumeBytes(*dims, *type, name);
+    const std::uint64_t expected = checkedAdd(options.headerBytes, dataBytes, name);
+    std::vector<unsigned char> bytes;
+    if (gz) {
+        std::vector<unsigned char> packed = readFileBytes(p);
+        bytes = inflateAll(packed.data(), packed.size(), name, std::size_t(expected));
+        checkDataLength(std::size_t(expected), bytes.size(), name, true);
+    } else {
+        checkDataLength(std::size_t(expected), std::size_t(fileSize), name, true);
+        bytes = readFileRange(p, options.headerBytes, dataBytes);
+    }
+    const unsigned char* data = bytes.data() + (gz ? options.headerBytes : 0);
     Volume v = makeVolume(*dims, options.spacing.value_or(glm::dvec3(1.0)), name);
-
-    std::vector<unsigned char> bytes = readFileBytes(p);
-    const std::size_t expected = options.headerBytes + v.voxelCount() * sampleSize(*type);
-    checkDataLength(expected, bytes.size(), name, true);
-    decodeSamples(bytes.data() + options.headerBytes, v.voxelCount(), *type, options.bigEndian,
-                  v.data.data());
+    decodeSamples(data, v.voxelCount(), *type, options.bigEndian, v.data.data());
     v.source =
         std::string("raw ") + sampleTypeName(*type) +
         (sampleSize(*type) > 1 ? (options.bigEndian ? " big-endian" : " little-endian") : "") +
-        " (" + file + ")";
+        (gz ? " gzip" : "") + " (" + file + ")";
     return v;
 }
 

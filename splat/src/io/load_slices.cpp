@@ -1,5 +1,6 @@
-// Folders of 2D slices: PNG/TIFF stacks (one image per z, natural sort order so that
-// slice2 comes before slice10) and DICOM series, both read through OpenImageIO.
+// Folders of 2D slices: PNG/TIFF stacks read through OpenImageIO (one image per z,
+// natural sort order so that slice2 comes before slice10); folders of DICOM files go to
+// the GDCM reader (load_dicom.cpp).
 //
 // Slice pixel (column c, row r) of the n-th slice becomes voxel (c, r, n); values keep
 // their native range (0..255 for 8-bit, 0..65535 for 16-bit images); colour images
@@ -21,32 +22,6 @@ namespace {
 bool isSliceImage(const fs::path& p) {
     std::string e = toLower(p.extension().string());
     return e == ".png" || e == ".tif" || e == ".tiff";
-}
-
-// DICOM files: ".dcm"/".dicom" or the "DICM" magic after the 128-byte preamble.
-bool isDicom(const fs::path& p) {
-    std::string e = toLower(p.extension().string());
-    if (e == ".dcm" || e == ".dicom") return true;
-    std::FILE* f = std::fopen(p.string().c_str(), "rb");
-    if (!f) return false;
-    char magic[4] = {};
-    bool ok = std::fseek(f, 128, SEEK_SET) == 0 && std::fread(magic, 1, 4, f) == 4 &&
-              std::memcmp(magic, "DICM", 4) == 0;
-    std::fclose(f);
-    return ok;
-}
-
-bool oiioHasFormat(const char* format) {
-    std::string list = OIIO::get_string_attribute("format_list");
-    std::string needle = format;
-    std::size_t pos = 0;
-    while ((pos = list.find(needle, pos)) != std::string::npos) {
-        bool startOk = pos == 0 || list[pos - 1] == ',';
-        bool endOk = pos + needle.size() == list.size() || list[pos + needle.size()] == ',';
-        if (startOk && endOk) return true;
-        ++pos;
-    }
-    return false;
 }
 
 std::optional<SampleType> oiioSampleType(TypeDesc t) {
@@ -102,7 +77,20 @@ glm::ivec2 readImageSlice(const fs::path& p, std::vector<float>& out, std::strin
     return {spec.width, spec.height};
 }
 
-Volume loadSliceFolder(const fs::path& dir) {
+// DICOM files: ".dcm"/".dicom" or the "DICM" magic after the 128-byte preamble.
+bool isDicomFile(const fs::path& p) {
+    std::string e = toLower(p.extension().string());
+    if (e == ".dcm" || e == ".dicom") return true;
+    std::FILE* f = std::fopen(p.string().c_str(), "rb");
+    if (!f) return false;
+    char magic[4] = {};
+    bool ok = std::fseek(f, 128, SEEK_SET) == 0 && std::fread(magic, 1, 4, f) == 4 &&
+              std::memcmp(magic, "DICM", 4) == 0;
+    std::fclose(f);
+    return ok;
+}
+
+Volume loadSliceFolder(const fs::path& dir, const LoadOptions& options) {
     const std::string name = displayName(dir);
     std::vector<fs::path> images, dicoms;
     std::error_code ec;
@@ -112,7 +100,7 @@ Volume loadSliceFolder(const fs::path& dir) {
         if (p.filename().string().starts_with(".")) continue;
         if (isSliceImage(p))
             images.push_back(p);
-        else if (isDicom(p))
+        else if (isDicomFile(p))
             dicoms.push_back(p);
     }
     if (ec) throw Error(name + ": cannot list folder (" + ec.message() + ")");
@@ -121,7 +109,7 @@ Volume loadSliceFolder(const fs::path& dir) {
     };
     if (images.empty() && !dicoms.empty()) {
         std::sort(dicoms.begin(), dicoms.end(), byName);
-        return loadDicomFolder(dir, dicoms);
+        return loadDicomFiles(name, dicoms, options);
     }
     if (images.empty()) throw Error(name + ": folder holds no PNG/TIFF slices or DICOM files");
     std::sort(images.begin(), images.end(), byName);
@@ -138,51 +126,6 @@ Volume loadSliceFolder(const fs::path& dir) {
     v.source = "slice folder, " + std::to_string(images.size()) + " images (" +
                images.front().filename().string() + " .. " + images.back().filename().string() +
                ")";
-    return v;
-}
-
-Volume loadDicomFolder(const fs::path& dir, const std::vector<fs::path>& files) {
-    const std::string name = displayName(dir);
-    if (!oiioHasFormat("dicom"))
-        throw Error(name + ": DICOM not supported by this OpenImageIO build");
-
-    // Order by InstanceNumber when every file has one (OpenImageIO exposes it as
-    // "dicom:InstanceNumber"; it does not expose ImagePositionPatient or PixelSpacing,
-    // so spacing is 1 with the in-plane aspect ratio from PixelAspectRatio).
-    struct Slice {
-        fs::path path;
-        int instance;
-    };
-    std::vector<Slice> slices;
-    bool allNumbered = true;
-    float aspect = 1.0f;
-    for (const fs::path& p : files) {
-        auto in = ImageInput::open(p.string());
-        if (!in)
-            throw Error(displayName(p) + ": cannot read DICOM file (" + OIIO::geterror() + ")");
-        const ImageSpec& spec = in->spec();
-        int instance = spec.get_int_attribute("dicom:InstanceNumber", -1);
-        if (instance < 0) allNumbered = false;
-        if (slices.empty()) aspect = spec.get_float_attribute("PixelAspectRatio", 1.0f);
-        slices.push_back({p, instance});
-    }
-    if (allNumbered)
-        std::stable_sort(slices.begin(), slices.end(),
-                         [](const Slice& a, const Slice& b) { return a.instance < b.instance; });
-
-    std::vector<float> slice;
-    glm::ivec2 size = readImageSlice(slices[0].path, slice);
-    glm::dvec3 spacing(1.0, aspect > 0 && std::isfinite(aspect) ? double(aspect) : 1.0, 1.0);
-    Volume v = makeVolume({size.x, size.y, int(slices.size())}, spacing, name);
-    placeSlice(v, 0, slice, size, slices[0].path);
-    for (std::size_t k = 1; k < slices.size(); ++k) {
-        size = readImageSlice(slices[k].path, slice);
-        placeSlice(v, int(k), slice, size, slices[k].path);
-    }
-    v.source = "DICOM series, " + std::to_string(slices.size()) + " files (" + name + ")";
-    v.note = std::string("DICOM slices ordered by ") +
-             (allNumbered ? "InstanceNumber" : "file name") +
-             "; spacing is not available through OpenImageIO, 1 is assumed";
     return v;
 }
 

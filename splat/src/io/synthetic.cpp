@@ -1,6 +1,7 @@
 // Deterministic synthetic volumes (`synthetic:NAME[:N]`), see synthetic.h.
 #include "splat/synthetic.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "splat/error.h"
@@ -100,10 +101,11 @@ Volume makeSynthetic(const std::string& name, int n) {
             return std::abs(i - c) < h && std::abs(j - c) < h && std::abs(k - c) < h ? 1.0 : 0.0;
         });
     } else if (name == "sphere") {
-        const double r = syntheticSphereRadius(n);
+        const double r = syntheticSphereRadius(n), w = syntheticSphereEdge();
         fill(v, [&](int i, int j, int k) {
-            double r2 = (i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c);
-            return r2 < r * r ? 1.0 : 0.0;
+            const double d = std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c));
+            const double t = std::clamp((r + w - d) / (2.0 * w), 0.0, 1.0);
+            return t * t * t * (10.0 + t * (6.0 * t - 15.0));  // smootherstep
         });
     } else {  // marschner-lobb over [-1, 1]^3, sample 0 at -1 and sample N-1 at +1
         const double s = n > 1 ? 2.0 / (n - 1) : 0.0;

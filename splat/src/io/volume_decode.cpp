@@ -1,7 +1,11 @@
 // Typed sample decoding shared by every loader: the element types volume files use,
 // their many spellings, and conversion of either byte order to float.
+#include <cmath>
 #include <cstring>
+#include <limits>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "splat/error.h"
 #include "volume_detail.h"
@@ -161,7 +165,31 @@ void decodeSamples(const unsigned char* bytes, std::size_t count, SampleType t, 
     }
 }
 
-void decodeText(const std::string& text, std::size_t count, float* out, const std::string& what) {
+namespace {
+// The value range of an integer sample type; nullopt for floating-point types.
+std::optional<std::pair<double, double>> integerRange(SampleType t) {
+    switch (t) {
+        case SampleType::U8:
+            return std::pair(0.0, 255.0);
+        case SampleType::I8:
+            return std::pair(-128.0, 127.0);
+        case SampleType::U16:
+            return std::pair(0.0, 65535.0);
+        case SampleType::I16:
+            return std::pair(-32768.0, 32767.0);
+        case SampleType::U32:
+            return std::pair(0.0, 4294967295.0);
+        case SampleType::I32:
+            return std::pair(-2147483648.0, 2147483647.0);
+        default:
+            return std::nullopt;
+    }
+}
+}  // namespace
+
+void decodeText(const std::string& text, std::size_t count, SampleType t, float* out,
+                const std::string& what) {
+    const auto range = integerRange(t);
     const char* p = text.c_str();
     for (std::size_t i = 0; i < count; ++i) {
         while (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r' || *p == ',') ++p;
@@ -173,6 +201,15 @@ void decodeText(const std::string& text, std::size_t count, float* out, const st
         if (end == p)
             throw Error(what + ": text data: cannot parse sample " + std::to_string(i) + " ('" +
                         std::string(p, std::min<std::size_t>(16, std::strlen(p))) + "')");
+        if (range &&
+            !(value >= range->first && value <= range->second && value == std::floor(value)))
+            throw Error(what + ": text sample " + std::to_string(i) + " ('" +
+                        std::string(p, std::size_t(end - p)) + "') is not a " + sampleTypeName(t) +
+                        " value");
+        if (!range && t == SampleType::F32 && std::isfinite(value) &&
+            std::abs(value) > double(std::numeric_limits<float>::max()))
+            throw Error(what + ": text sample " + std::to_string(i) + " ('" +
+                        std::string(p, std::size_t(end - p)) + "') is out of the float32 range");
         out[i] = static_cast<float>(value);
         p = end;
     }

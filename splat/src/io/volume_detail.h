@@ -38,18 +38,53 @@ void decodeSamples(const unsigned char* bytes, std::size_t count, SampleType t, 
                    float* out);
 
 /// Parses ASCII numbers (whitespace separated) into `out[0..count)`; throws naming
-/// `what` if fewer numbers are present or one does not parse.
-void decodeText(const std::string& text, std::size_t count, float* out, const std::string& what);
+/// `what` if fewer numbers are present, one does not parse, or (integer types) one is
+/// not an integer in the range of `t` (1.7, -5 or 300 in a uint8 file).
+void decodeText(const std::string& text, std::size_t count, SampleType t, float* out,
+                const std::string& what);
+
+// ---- checked sizes ---------------------------------------------------------------
+
+/// a * b in 64 bits; throws "WHAT: sizes overflow 64-bit arithmetic" when it wraps.
+std::uint64_t checkedMul(std::uint64_t a, std::uint64_t b, const std::string& what);
+/// a + b in 64 bits; throws like checkedMul.
+std::uint64_t checkedAdd(std::uint64_t a, std::uint64_t b, const std::string& what);
+/// Bytes the samples of a dims.x * dims.y * dims.z volume of type t take in a file, after
+/// checking every dimension >= 1 and the voxel count <= kMaxVoxels (64-bit, no wrap).
+/// Call it before allocating anything a header asks for.
+std::size_t volumeBytes(const glm::ivec3& dims, SampleType t, const std::string& what);
+/// A header number (parsed as double) as an int dimension: integral, 1 .. 2^31-1; throws
+/// "WHAT: invalid FIELD 'TEXT'" otherwise.
+int dimensionFrom(double value, const std::string& what, const std::string& field,
+                  const std::string& text);
 
 // ---- files -----------------------------------------------------------------------
 
 /// Name used in error messages: the path as given by the user.
 std::string displayName(const std::filesystem::path& p);
-/// Whole file into memory; throws "FILE: no such file" / "FILE: cannot read".
+/// Size of a regular file, checked without opening it (a FIFO or device would block or
+/// never end): throws "FILE: no such file" / "FILE: is a folder" / "FILE: not a regular
+/// file (FIFO, device or socket)". `role` prefixes the name, e.g. "data file ".
+std::uint64_t regularFileSize(const std::filesystem::path& p, const std::string& role = "");
+/// Whole (regular) file into memory; throws "FILE: no such file" / "FILE: cannot read".
 std::vector<unsigned char> readFileBytes(const std::filesystem::path& p);
-/// Inflates gzip or zlib data (auto-detected); throws "WHAT: corrupt gzip data ..."
+/// Exactly `count` bytes at `offset` of a regular file, checked against its size before
+/// allocating: "FILE: truncated data: expected N bytes, found M".
+std::vector<unsigned char> readFileRange(const std::filesystem::path& p, std::uint64_t offset,
+                                         std::uint64_t count);
+/// Inflates gzip or zlib data (auto-detected) into at most `limit` bytes: a stream that
+/// holds more throws "WHAT: compressed data holds more data than the header declares (N
+/// bytes)" as soon as it passes the limit; corrupt data throws "WHAT: corrupt gzip data".
 std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t size,
-                                      const std::string& what);
+                                      const std::string& what, std::size_t limit);
+/// The detached data file a header names (NRRD "data file", MetaImage ElementDataFile),
+/// resolved against the header's folder. Unless `allowOutside`, an absolute path or one
+/// whose `..` leaves that folder is refused: "HEADER: data file 'X' is outside the
+/// header's folder (use --allow-outside-data to allow it)". The file must be regular.
+std::filesystem::path resolveDataFile(const std::filesystem::path& header, const std::string& field,
+                                      bool allowOutside);
+/// Appends one warning to v.note ("; " separated). Every command prints the note.
+void addNote(Volume& v, const std::string& text);
 std::string toLower(std::string s);
 std::string trim(const std::string& s);
 
@@ -67,12 +102,15 @@ void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t, const
 // ---- the loaders (one per file) --------------------------------------------------
 
 Volume loadNifti(const std::filesystem::path& p);
-Volume loadNrrd(const std::filesystem::path& p);
-Volume loadMetaImage(const std::filesystem::path& p);
+Volume loadNrrd(const std::filesystem::path& p, const LoadOptions& options);
+Volume loadMetaImage(const std::filesystem::path& p, const LoadOptions& options);
 Volume loadRaw(const std::filesystem::path& p, const RawOptions& options);
-Volume loadSliceFolder(const std::filesystem::path& dir);
-Volume loadDicomFolder(const std::filesystem::path& dir,
-                       const std::vector<std::filesystem::path>& files);
+Volume loadSliceFolder(const std::filesystem::path& dir, const LoadOptions& options);
+/// DICOM files through GDCM (load_dicom.cpp): one series, sorted along the slice normal.
+Volume loadDicomFiles(const std::string& name, const std::vector<std::filesystem::path>& files,
+                      const LoadOptions& options);
+/// DICOM files: ".dcm"/".dicom" or the "DICM" magic after the 128-byte preamble.
+bool isDicomFile(const std::filesystem::path& p);
 
 /// Reads one 2D image file through OpenImageIO into `out` (width*height floats, the
 /// first channel or the luminance of RGB, native value range: 0..255 for 8-bit).

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -31,31 +33,82 @@ std::string trim(const std::string& s) {
     return s.substr(b, e - b);
 }
 
-std::vector<unsigned char> readFileBytes(const fs::path& p) {
+std::uint64_t checkedMul(std::uint64_t a, std::uint64_t b, const std::string& what) {
+    std::uint64_t r = 0;
+    if (__builtin_mul_overflow(a, b, &r))
+        throw Error(what + ": sizes overflow 64-bit arithmetic (" + std::to_string(a) + " x " +
+                    std::to_string(b) + ")");
+    return r;
+}
+
+std::uint64_t checkedAdd(std::uint64_t a, std::uint64_t b, const std::string& what) {
+    std::uint64_t r = 0;
+    if (__builtin_add_overflow(a, b, &r))
+        throw Error(what + ": sizes overflow 64-bit arithmetic (" + std::to_string(a) + " + " +
+                    std::to_string(b) + ")");
+    return r;
+}
+
+std::size_t volumeBytes(const glm::ivec3& dims, SampleType t, const std::string& what) {
+    return std::size_t(checkedMul(checkedVoxelCount(dims, what), sampleSize(t), what));
+}
+
+int dimensionFrom(double value, const std::string& what, const std::string& field,
+                  const std::string& text) {
+    if (!(value >= 1 && value <= 2147483647.0) || value != std::floor(value))
+        throw Error(what + ": invalid " + field + " '" + text + "'");
+    return int(value);
+}
+
+std::uint64_t regularFileSize(const fs::path& p, const std::string& role) {
+    const std::string name = role + displayName(p);
     std::error_code ec;
-    if (!fs::exists(p, ec)) throw Error(displayName(p) + ": no such file");
-    if (fs::is_directory(p, ec)) throw Error(displayName(p) + ": is a folder, expected a file");
+    // status() is stat(2): it never opens the file, so a FIFO cannot block us here.
+    const fs::file_status st = fs::status(p, ec);
+    if (!fs::exists(st)) throw Error(name + ": no such file");
+    if (fs::is_directory(st)) throw Error(name + ": is a folder, expected a file");
+    if (!fs::is_regular_file(st))
+        throw Error(name + ": not a regular file (FIFO, device or socket); refusing to read it");
+    const std::uintmax_t size = fs::file_size(p, ec);
+    if (ec) throw Error(name + ": cannot read (" + ec.message() + ")");
+    return std::uint64_t(size);
+}
+
+std::vector<unsigned char> readFileRange(const fs::path& p, std::uint64_t offset,
+                                         std::uint64_t count) {
+    const std::string name = displayName(p);
+    const std::uint64_t size = regularFileSize(p);
+    const std::uint64_t available = size > offset ? size - offset : 0;
+    if (available < count)
+        throw Error(name + ": truncated data: expected " + std::to_string(count) +
+                    " bytes, found " + std::to_string(available) + " (after byte " +
+                    std::to_string(offset) + ")");
     std::ifstream in(p, std::ios::binary);
-    if (!in) throw Error(displayName(p) + ": cannot open for reading");
-    in.seekg(0, std::ios::end);
-    std::streamoff size = in.tellg();
-    if (size < 0) throw Error(displayName(p) + ": cannot read");
-    in.seekg(0);
-    std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
-    if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size))
-        throw Error(displayName(p) + ": cannot read");
+    if (!in) throw Error(name + ": cannot open for reading");
+    in.seekg(std::streamoff(offset));
+    std::vector<unsigned char> bytes(static_cast<std::size_t>(count));
+    if (count > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(count)))
+        throw Error(name + ": cannot read (the file shrank while reading?)");
     return bytes;
 }
 
+std::vector<unsigned char> readFileBytes(const fs::path& p) {
+    return readFileRange(p, 0, regularFileSize(p));
+}
+
 std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t size,
-                                      const std::string& what) {
+                                      const std::string& what, std::size_t limit) {
     z_stream zs{};
     // 15 + 32: accept both gzip and zlib headers.
     if (inflateInit2(&zs, 15 + 32) != Z_OK) throw Error(what + ": cannot initialise zlib");
+    // The output grows with what the stream really holds (never beyond limit + 1 bytes, so
+    // one byte past the declared size is enough to know the stream holds too much).
     std::vector<unsigned char> out;
-    out.resize(std::max<std::size_t>(size * 4, 1 << 16));
+    const std::size_t cap = limit == SIZE_MAX ? limit : limit + 1;
+    out.resize(std::min<std::size_t>(cap, std::max<std::size_t>(size * 4, 1 << 16)));
     std::size_t inPos = 0;
     int ret = Z_OK;
+    bool tooMuch = false;
     while (true) {
         if (zs.avail_in == 0 && inPos < size) {
             std::size_t chunk = std::min<std::size_t>(size - inPos, 1u << 30);
@@ -63,7 +116,13 @@ std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t siz
             zs.avail_in = static_cast<uInt>(chunk);
             inPos += chunk;
         }
-        if (zs.total_out == out.size()) out.resize(out.size() * 2);
+        if (zs.total_out == out.size()) {
+            if (out.size() >= cap) {
+                tooMuch = true;
+                break;
+            }
+            out.resize(std::min(cap, out.size() * 2));
+        }
         std::size_t room = std::min<std::size_t>(out.size() - zs.total_out, 1u << 30);
         zs.next_out = out.data() + zs.total_out;
         zs.avail_out = static_cast<uInt>(room);
@@ -83,9 +142,42 @@ std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t siz
     const char* msg = zs.msg;
     std::string reason = msg ? msg : (ret == Z_BUF_ERROR ? "unexpected end of stream" : "error");
     inflateEnd(&zs);
+    if (tooMuch)
+        throw Error(what + ": compressed data holds more data than the header declares (" +
+                    std::to_string(limit) + " bytes)");
     if (ret != Z_STREAM_END) throw Error(what + ": corrupt gzip data (" + reason + ")");
     out.resize(produced);
     return out;
+}
+
+fs::path resolveDataFile(const fs::path& header, const std::string& field, bool allowOutside) {
+    const std::string name = displayName(header);
+    const fs::path given(field);
+    fs::path dp;
+    if (given.is_absolute()) {
+        dp = given;
+    } else {
+        dp = header.parent_path() / given;
+    }
+    if (!allowOutside) {
+        const fs::path rel = given.lexically_normal();
+        const bool escapes = given.is_absolute() || given.has_root_name() || rel.empty() ||
+                             (rel.begin() != rel.end() && *rel.begin() == "..");
+        if (escapes)
+            throw Error(name + ": data file '" + field +
+                        "' is outside the header's folder (use --allow-outside-data, or "
+                        "LoadOptions::allowOutsideDataFiles, to allow it)");
+    }
+    std::error_code ec;
+    if (!fs::exists(dp, ec))
+        throw Error(name + ": data file " + displayName(dp) + " does not exist");
+    regularFileSize(dp, "data file ");
+    return dp;
+}
+
+void addNote(Volume& v, const std::string& text) {
+    if (!v.note.empty()) v.note += "; ";
+    v.note += text;
 }
 
 bool naturalLess(const std::string& a, const std::string& b) {

@@ -43,6 +43,8 @@ std::string sniff(const fs::path& p) {
     std::size_t got = std::size_t(in.gcount());
     if (got >= 4 && std::string(head, 4) == "NRRD") return ".nrrd";
     if (got >= 348 && (std::string(head + 344, 4) == std::string("n+1\0", 4))) return ".nii";
+    if (got >= 12 && std::string(head + 4, 4) == std::string("n+2\0", 4)) return ".nii";
+    if (got >= 132 && std::string(head + 128, 4) == "DICM") return ".dcm";
     std::string text(head, got);
     if (text.find("ObjectType") != std::string::npos || text.rfind("NDims", 0) == 0) return ".mha";
     return "";
@@ -68,11 +70,13 @@ void applyNonFinitePolicy(Volume& v, NonFinitePolicy policy, const std::string& 
 }
 
 Volume loadByType(const fs::path& p, const std::string& ext, const LoadOptions& options) {
-    if (ext == ".nii" || ext == ".nii.gz") return detail::loadNifti(p);
-    if (ext == ".nrrd" || ext == ".nhdr") return detail::loadNrrd(p);
-    if (ext == ".mhd" || ext == ".mha") return detail::loadMetaImage(p);
-    if (ext == ".raw") return detail::loadRaw(p, options.raw);
-    if (ext == ".dcm" || ext == ".dicom") return detail::loadDicomFolder(p.parent_path(), {p});
+    if (ext == ".nii" || ext == ".nii.gz" || ext == ".hdr" || ext == ".img")
+        return detail::loadNifti(p);
+    if (ext == ".nrrd" || ext == ".nhdr") return detail::loadNrrd(p, options);
+    if (ext == ".mhd" || ext == ".mha") return detail::loadMetaImage(p, options);
+    if (ext == ".raw" || ext == ".raw.gz") return detail::loadRaw(p, options.raw);
+    if (ext == ".dcm" || ext == ".dicom")
+        return detail::loadDicomFiles(detail::displayName(p), {p}, options);
     if (ext == ".png" || ext == ".tif" || ext == ".tiff")
         throw Error(detail::displayName(p) +
                     ": a single 2D image; give the folder of slices instead");
@@ -92,16 +96,20 @@ Volume loadVolume(const std::string& spec, const LoadOptions& options) {
         fs::file_status st = fs::status(p, ec);
         if (!fs::exists(st)) throw Error(spec + ": no such file or folder");
         if (fs::is_directory(st)) {
-            v = detail::loadSliceFolder(p);
+            v = detail::loadSliceFolder(p, options);
         } else {
+            detail::regularFileSize(p);  // FIFOs and devices are refused before any open
             std::string ext = lowerExtension(p);
+            // .hdr.gz / .img.gz pairs: the extension before .gz decides.
+            if (ext == ".gz") ext = lowerExtension(p.stem());
             v = loadByType(p, ext, options);
             if (v.data.empty()) {
                 std::string guess = sniff(p);
                 if (guess.empty() || guess == ext)
                     throw Error(spec + ": unknown file type '" + p.extension().string() +
-                                "' (expected .nii, .nii.gz, .nrrd, .nhdr, .mhd, .mha, .raw, a "
-                                "folder of slices or synthetic:NAME)");
+                                "' (expected .nii, .nii.gz, .hdr/.img, .nrrd, .nhdr, .mhd, .mha, "
+                                ".raw, .raw.gz, .dcm, a folder of slices or DICOM files, or "
+                                "synthetic:NAME)");
                 v = loadByType(p, guess, options);
             }
         }

@@ -1,7 +1,7 @@
 // Writers: NIfTI-1 (through niftilib), NRRD and MetaImage, float32 samples with spacing
 // and origin. Each writes a temporary file in the destination folder and renames it,
 // so a failed or interrupted write never leaves a half-written volume behind.
-#include <nifti1_io.h>
+#include <nifti2_io.h>
 
 #include <cstdio>
 #include <cstring>
@@ -47,7 +47,7 @@ void saveNifti(const std::string& path, const Volume& v) {
     // niftilib picks compression from the name, so the temporary keeps the extension.
     AtomicFile out(target);
     const fs::path& tmp = out.temporary();
-    int dims[8] = {3, v.dims.x, v.dims.y, v.dims.z, 1, 1, 1, 1};
+    const std::int64_t dims[8] = {3, v.dims.x, v.dims.y, v.dims.z, 1, 1, 1, 1};
     nifti_set_debug_level(0);
     nifti_image* nim = nifti_make_new_nim(dims, DT_FLOAT32, 1);
     if (!nim) throw Error(path + ": cannot create NIfTI image");

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <string>
 
+#include "model/clip_region.h"
 #include "model/shading_model.h"
 #include "splat/error.h"
 
@@ -207,6 +208,7 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                           float(glm::length(gradientAt(volume, i, j, k))) * invMaxGradient);
     };
     const bool clips = options.clipping.enabled();
+    const glm::dvec3 clipMargin = radius * volume.spacing;
     const bool labelled = options.labels && options.labels->enabled;
     const bool intensity = !labelled || options.labels->volume != nullptr;
     std::vector<std::uint16_t> shown;
@@ -216,7 +218,10 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
         near = nearLabels(volume, shown, int(std::ceil(radius)));
     }
     auto keep = [&](int i, int j, int k, float value) {
-        if (clips && !options.clipping.keeps(volume.world(glm::dvec3(i, j, k)))) return false;
+        // Clipping keeps every voxel whose kernel reaches the kept region: the renderers cut
+        // the reconstructed field at the planes and box (model/clip_region.h).
+        if (clips && !keepsNear(options.clipping, volume.world(glm::dvec3(i, j, k)), clipMargin))
+            return false;
         if (labelled) {
             if (near[volume.index(i, j, k)]) return true;
             if (!intensity) return false;

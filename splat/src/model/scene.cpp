@@ -2,6 +2,10 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <cmath>
+#include <string>
+
 #include "frame/frame.h"
 #include "model/scene_impl.h"
 #include "reference/field.h"
@@ -29,9 +33,38 @@ footprint::FootprintTable makeTable(const footprint::Kernel& kernel, const Quali
     }
 }
 
+/// Largest ratio between a volume's largest and smallest spacing a renderer accepts: beyond
+/// it, slab counts and float depths lose all meaning (1e-30,1,1 or 1e-6,1,1e6 spacings).
+constexpr double kMaxSpacingRatio = 1e4;
+/// Largest world coordinate (origin plus extent) a renderer accepts: float depths keep
+/// sub-voxel precision well inside it.
+constexpr double kMaxWorldCoordinate = 1e9;
+
+void validateGeometry(const Volume& v) {
+    for (int a = 0; a < 3; ++a)
+        if (!std::isfinite(v.spacing[a]) || !(v.spacing[a] > 0))
+            throw Error("volume spacing must be finite and > 0");
+    if (!std::isfinite(v.origin.x) || !std::isfinite(v.origin.y) || !std::isfinite(v.origin.z))
+        throw Error(
+            "volume origin is NaN or Inf (check the file's sform/qform, space origin or "
+            "Offset)");
+    const double hi = std::max(v.spacing.x, std::max(v.spacing.y, v.spacing.z));
+    if (hi / v.minSpacing() > kMaxSpacingRatio)
+        throw Error("volume spacing " + std::to_string(v.spacing.x) + ", " +
+                    std::to_string(v.spacing.y) + ", " + std::to_string(v.spacing.z) +
+                    ": the ratio of largest to smallest exceeds 10000:1, which no renderer can "
+                    "sample; check the spacing");
+    for (int a = 0; a < 3; ++a)
+        if (std::abs(v.origin[a]) + v.spacing[a] * double(v.dims[a]) > kMaxWorldCoordinate)
+            throw Error("volume coordinates exceed 1e9 world units (origin " +
+                        std::to_string(v.origin[a]) + " on axis " + std::to_string(a) +
+                        "); check the origin and spacing");
+}
+
 void validateScene(const Volume& v, const RenderSettings& s) {
     if (v.voxelCount() == 0 || v.data.size() != v.voxelCount())
         throw Error("volume is empty or its sample count does not match its dimensions");
+    validateGeometry(v);
     validateFrame(s);
     if (!(s.quality.polynomialTolerance >= 0)) throw Error("polynomial tolerance must be >= 0");
 }

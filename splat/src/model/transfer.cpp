@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "splat/error.h"
+#include "splat/settings.h"
 
 namespace splat {
 
@@ -36,6 +37,11 @@ TransferFunction makePreset(const std::string& name) {
         tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.12f, 0.75f, 0.5f, 0.4f, 0),
                      pt(0.3f, 0.9f, 0.65f, 0.55f, 0.08f), pt(0.6f, 1.0f, 0.85f, 0.75f, 0.3f),
                      pt(1.0f, 1, 1, 1, 0.6f)};
+    } else if (name == "mip-gray" || name == "xray") {
+        // Projections of the density: the points are a grey ramp (used only if an explicit
+        // --mode dvr overrides the preset's mode); the mode comes with the preset.
+        tf.points = {pt(0.0f, 0, 0, 0, 0), pt(1.0f, 1, 1, 1, 0.05f)};
+        tf.mode = name == "xray" ? RenderMode::Xray : RenderMode::Mip;
     } else {
         std::string all;
         for (const auto& n : TransferFunction::presetNames()) all += (all.empty() ? "" : ", ") + n;
@@ -45,10 +51,14 @@ TransferFunction makePreset(const std::string& name) {
     return tf;
 }
 
-void validate(const TransferFunction& tf, const std::string& what) {
+}  // namespace
+
+void TransferFunction::validate(const std::string& what) const {
+    const TransferFunction& tf = *this;
     if (tf.points.empty()) throw Error(what + ": transfer function has no points");
-    if (!(tf.unitDistance > 0) || !std::isfinite(tf.unitDistance))
-        throw Error(what + ": unit_distance must be a positive number");
+    if (!(tf.unitDistance >= kMinUnitDistance && tf.unitDistance <= kMaxUnitDistance))
+        throw Error(what + ": unit_distance must be a number in [1e-6, 1e6] world units (got " +
+                    std::to_string(tf.unitDistance) + ")");
     for (std::size_t n = 0; n < tf.points.size(); ++n) {
         const auto& p = tf.points[n];
         if (!std::isfinite(p.value))
@@ -63,22 +73,56 @@ void validate(const TransferFunction& tf, const std::string& what) {
     }
 }
 
+namespace {
+
+bool endsWith(const std::string& s, const std::string& tail) {
+    return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+std::string readText(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path + ": cannot open transfer function file");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) throw Error(path + ": cannot read transfer function file");
+    return text;
+}
+
 }  // namespace
 
 std::vector<std::string> TransferFunction::presetNames() {
-    return {"ct-bone", "ct-soft", "mri-head", "gray-ramp"};
+    return {"ct-bone", "ct-soft", "mri-head", "gray-ramp", "mip-gray", "xray"};
 }
 
 TransferFunction TransferFunction::preset(const std::string& name) { return makePreset(name); }
 
-TransferFunction TransferFunction::fromJson(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) throw Error(path + ": cannot open transfer function file");
+TransferFunction TransferFunction::fromJson(const std::string& given) {
+    // "FILE.json#Name" picks one preset of a ParaView file.
+    std::string path = given, presetName;
+    const std::size_t hash = given.rfind(".json#");
+    if (hash != std::string::npos) {
+        path = given.substr(0, hash + 5);
+        presetName = given.substr(hash + 6);
+    }
+    const std::string text = readText(path);
     nlohmann::json j;
     try {
-        in >> j;
+        j = nlohmann::json::parse(text);
     } catch (const std::exception& e) {
         throw Error(path + ": not valid JSON (" + std::string(e.what()) + ")");
+    }
+    if (j.is_array() || (j.is_object() && j.contains("RGBPoints")))
+        return fromParaView(text, path, presetName);
+    if (!presetName.empty())
+        throw Error(path + ": '#" + presetName +
+                    "' selects a preset of a ParaView file, but this is the project's format");
+    if (!j.is_object())
+        throw Error(path + ": a transfer function file is a JSON object (or ParaView's array)");
+    static const char* const kKeys[] = {"domain", "unit_distance", "mode", "name", "points"};
+    for (const auto& item : j.items()) {
+        if (std::find_if(std::begin(kKeys), std::end(kKeys),
+                         [&](const char* k) { return item.key() == k; }) == std::end(kKeys))
+            throw Error(path + ": unknown key \"" + item.key() +
+                        "\" (keys: domain, unit_distance, mode, name, points)");
     }
     TransferFunction tf;
     tf.name = path;
@@ -88,6 +132,14 @@ TransferFunction TransferFunction::fromJson(const std::string& path) {
             throw Error(path + ": \"domain\" must be \"absolute\" or \"normalized\"");
         tf.normalized = domain == "normalized";
         tf.unitDistance = j.value("unit_distance", 1.0);
+        if (j.contains("name")) tf.name = j["name"].get<std::string>();
+        if (j.contains("mode")) {
+            try {
+                tf.mode = parseMode(j["mode"].get<std::string>());
+            } catch (const Error& e) {
+                throw Error(path + ": \"mode\": " + e.what());
+            }
+        }
         if (!j.contains("points") || !j["points"].is_array())
             throw Error(path + ": missing \"points\": [[value, r, g, b, a], ...]");
         for (const auto& p : j["points"]) {
@@ -99,14 +151,23 @@ TransferFunction TransferFunction::fromJson(const std::string& path) {
     } catch (const nlohmann::json::exception& e) {
         throw Error(path + ": bad transfer function (" + std::string(e.what()) + ")");
     }
-    validate(tf, path);
+    tf.validate(path);
     return tf;
 }
 
 TransferFunction TransferFunction::load(const std::string& nameOrPath) {
-    if (nameOrPath.size() > 5 && nameOrPath.substr(nameOrPath.size() - 5) == ".json")
+    if (endsWith(nameOrPath, ".json") || nameOrPath.find(".json#") != std::string::npos)
         return fromJson(nameOrPath);
     return preset(nameOrPath);
+}
+
+TransferFunction TransferFunction::rescaledToData() const {
+    if (normalized || points.empty()) return *this;
+    TransferFunction tf = *this;
+    tf.normalized = true;
+    const float lo = points.front().value, span = points.back().value - lo;
+    for (auto& p : tf.points) p.value = span > 0 ? (p.value - lo) / span : 0.0f;
+    return tf;
 }
 
 TransferFunction TransferFunction::resolved(float lo, float hi) const {

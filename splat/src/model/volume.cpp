@@ -11,7 +11,7 @@
 
 namespace splat {
 
-Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::string& what) {
+std::uint64_t checkedVoxelCount(const glm::ivec3& dims, const std::string& what) {
     const char* axis = "xyz";
     for (int a = 0; a < 3; ++a)
         if (dims[a] < 1)
@@ -27,6 +27,12 @@ Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::
                         " are too large (more than 2^32 voxels)");
         count *= std::uint64_t(dims[a]);
     }
+    return count;
+}
+
+Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::string& what) {
+    const char* axis = "xyz";
+    const std::uint64_t count = checkedVoxelCount(dims, what);
     for (int a = 0; a < 3; ++a)
         if (!std::isfinite(spacing[a]) || spacing[a] <= 0) {
             std::ostringstream s;

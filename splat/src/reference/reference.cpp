@@ -39,6 +39,7 @@
 #include <limits>
 #include <vector>
 
+#include "model/clip_region.h"
 #include "model/scene_impl.h"
 #include "model/shading_model.h"
 #include "reference/field.h"
@@ -67,11 +68,15 @@ class Caster {
            const RenderSettings& settings)
         : volume_(volume), camera_(camera), settings_(settings), field_(field) {
         const Quality& q = settings.quality;
-        if (!(q.referenceStep > 0) || !std::isfinite(q.referenceStep))
-            throw Error("reference: referenceStep must be > 0 voxels");
+        if (!(q.referenceStep >= 1e-3) || !std::isfinite(q.referenceStep))
+            throw Error("reference: referenceStep must be finite and >= 0.001 voxels");
         if (!(q.referenceTolerance > 0)) throw Error("reference: referenceTolerance must be > 0");
         if (volume.voxelCount() == 0) throw Error("reference: empty volume");
         invSpacing_ = 1.0 / volume.spacing;
+        const glm::dvec3 pad = field.radius() * volume.spacing;
+        clips_ = settings.clipping.enabled() &&
+                 !containsBox(settings.clipping, volume.world(glm::dvec3(0.0)) - pad,
+                              volume.world(glm::dvec3(volume.dims) - 1.0) + pad);
         stepWorld_ = q.referenceStep * volume.minSpacing();
         preDvr_ = field.fourChannels();
         layout_ = field.layout();
@@ -167,7 +172,12 @@ class Caster {
         const glm::dvec3 p0 = (ray.origin - volume_.origin) * invSpacing_;
         const glm::dvec3 v = ray.dir * invSpacing_;
         const double inf = std::numeric_limits<double>::infinity();
-        raySegments(g, p0, v, camera_.perspective() ? 0.0 : -inf, inf, sc.segments);
+        // Clipping: the ray is cut to the kept region (the field itself is whole).
+        double t0 = camera_.perspective() ? 0.0 : -inf, t1 = inf;
+        if (!clips_ || keptInterval(settings_.clipping, ray.origin, ray.dir, t0, t1))
+            raySegments(g, p0, v, t0, t1, sc.segments);
+        else
+            sc.segments.clear();
         const RenderMode mode = settings_.mode;
         const glm::vec4 bg = settings_.background;
         auto finish = [&](glm::dvec4 c) -> glm::vec4 {
@@ -191,7 +201,10 @@ class Caster {
         sc.cur.resize(ns);
         for (std::size_t s = 0; s < ns; ++s) {
             const double len = sc.segments[s].b - sc.segments[s].a;
-            sc.baseN[s] = 2 * std::max(1, int(std::ceil(len / (2.0 * stepWorld_))));
+            const double half = std::ceil(len / (2.0 * stepWorld_));
+            if (!(half <= double(1 << 28)))  // also NaN: never an unchecked float -> int
+                throw Error("reference: a ray needs more than 2^29 steps; use a larger step");
+            sc.baseN[s] = 2 * std::max(1, int(half));
             sc.old[s].clear();
             sc.cur[s].clear();
         }
@@ -291,7 +304,13 @@ class Caster {
             } else {  // iso
                 const double level0 = settings_.isoLevel;
                 double fPrev = sample(0)[0];
-                for (int idx = 1; idx <= n; ++idx) {
+                // A ray entering the kept region of a clipped volume inside the surface hits
+                // the cut face (the splatters' first sheet has nothing in front either).
+                if (clips_ && s == 0 && level0 > 0 && fPrev >= level0) {
+                    depth = seg.a;
+                    stop = true;
+                }
+                for (int idx = 1; idx <= n && !stop; ++idx) {
                     const double f = sample(idx)[0];
                     if (fPrev < level0 && f >= level0) {
                         depth = bisect(g, p0, v, seg.a + (idx - 1) * h, seg.a + idx * h);
@@ -398,6 +417,7 @@ class Caster {
     bool preDvr_ = false;
     FieldLayout layout_ = FieldLayout::Density;
     bool shadePost_ = false, edgesPost_ = false;
+    bool clips_ = false;  // the kept region cuts the volume (padded by R)
     LightFrame light_;
     float invGradientScale_ = 0;
     const LabelLookup* labels_ = nullptr;

@@ -1,0 +1,448 @@
+// DICOM series through GDCM.
+//
+// Every file's header is read up to the pixel data (SeriesInstanceUID, ImagePositionPatient,
+// ImageOrientationPatient, PixelSpacing, RescaleSlope/Intercept, Rows/Columns); the files
+// of one series are sorted by their position along the slice normal (row direction x
+// column direction), the slice spacing is the mean gap between neighbours (uneven gaps are
+// refused, a gantry tilt is warned about), values become real units (Hounsfield units for
+// CT) through each file's rescale, and the LPS patient coordinates become the RAS world
+// NIfTI uses, so the same orientation code makes a head upright. A folder holding several
+// series needs LoadOptions::dicomSeries (CLI: --series UID).
+#include <gdcmImageReader.h>
+#include <gdcmReader.h>
+#include <gdcmStringFilter.h>
+#include <gdcmTrace.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <sstream>
+
+#include "splat/error.h"
+#include "volume_detail.h"
+
+namespace fs = std::filesystem;
+
+namespace splat::detail {
+namespace {
+
+const gdcm::Tag kPixelData(0x7fe0, 0x0010);
+const gdcm::Tag kSeriesUid(0x0020, 0x000e);
+const gdcm::Tag kSeriesNumber(0x0020, 0x0011);
+const gdcm::Tag kSeriesDescription(0x0008, 0x103e);
+const gdcm::Tag kModality(0x0008, 0x0060);
+const gdcm::Tag kInstanceNumber(0x0020, 0x0013);
+const gdcm::Tag kPosition(0x0020, 0x0032);
+const gdcm::Tag kOrientation(0x0020, 0x0037);
+const gdcm::Tag kPixelSpacing(0x0028, 0x0030);
+const gdcm::Tag kSliceThickness(0x0018, 0x0050);
+const gdcm::Tag kSpacingBetweenSlices(0x0018, 0x0088);
+const gdcm::Tag kRows(0x0028, 0x0010);
+const gdcm::Tag kColumns(0x0028, 0x0011);
+const gdcm::Tag kFrames(0x0028, 0x0008);
+const gdcm::Tag kSamplesPerPixel(0x0028, 0x0002);
+const gdcm::Tag kBitsAllocated(0x0028, 0x0100);
+const gdcm::Tag kSlope(0x0028, 0x1053);
+const gdcm::Tag kIntercept(0x0028, 0x1052);
+
+/// GDCM reports to std::cerr unless told not to; errors reach the user as splat::Error.
+void quietGdcm() {
+    gdcm::Trace::DebugOff();
+    gdcm::Trace::WarningOff();
+    gdcm::Trace::ErrorOff();
+}
+
+/// Decimal numbers of a "a\b\c" value; nullopt when absent, throws when malformed.
+std::optional<std::vector<double>> numbersOf(gdcm::StringFilter& sf, const gdcm::DataSet& ds,
+                                             const gdcm::Tag& tag, const std::string& what,
+                                             const char* field) {
+    if (!ds.FindDataElement(tag) || ds.GetDataElement(tag).IsEmpty()) return std::nullopt;
+    std::string s = sf.ToString(tag);
+    for (char& c : s)
+        if (c == '\\') c = ' ';
+    std::vector<double> out;
+    const char* p = s.c_str();
+    while (true) {
+        while (*p == ' ') ++p;
+        if (!*p) break;
+        char* end = nullptr;
+        double v = std::strtod(p, &end);
+        if (end == p || !std::isfinite(v))
+            throw Error(what + ": bad DICOM " + field + " '" + s.substr(0, 60) + "'");
+        out.push_back(v);
+        p = end;
+    }
+    if (out.empty()) return std::nullopt;
+    return out;
+}
+
+std::string textOf(gdcm::StringFilter& sf, const gdcm::DataSet& ds, const gdcm::Tag& tag) {
+    if (!ds.FindDataElement(tag) || ds.GetDataElement(tag).IsEmpty()) return "";
+    return trim(std::string(sf.ToString(tag).c_str()));  // stops at an embedded NUL
+}
+
+/// What one file's header says, before any pixel is read.
+struct SliceInfo {
+    fs::path path;
+    std::string uid, description, modality;
+    int seriesNumber = -1, instance = -1;
+    int rows = 0, columns = 0, frames = 1, samples = 1, bitsAllocated = 16;
+    std::uint64_t fileSize = 0;
+    std::optional<glm::dvec3> position;
+    std::optional<std::vector<double>> orientation, pixelSpacing;
+    std::optional<double> thickness, between;
+    double slope = 1, intercept = 0;
+};
+
+int intOf(const std::optional<std::vector<double>>& v, int fallback, const std::string& what,
+          const char* field) {
+    if (!v) return fallback;
+    const double d = v->front();
+    if (!(d >= -2147483648.0 && d <= 2147483647.0) || d != std::floor(d))
+        throw Error(what + ": bad DICOM " + field + " " + std::to_string(d));
+    return int(d);
+}
+
+/// GDCM reports some problems by throwing (gdcm::Exception is a std::exception): they
+/// become splat::Error naming the file, like every other problem.
+template <typename F>
+auto guarded(const fs::path& p, F f) {
+    try {
+        return f();
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw Error(displayName(p) + ": not a readable DICOM file (" +
+                    std::string(e.what()).substr(0, 120) + ")");
+    }
+}
+
+SliceInfo readInfoUnguarded(const fs::path& p) {
+    const std::string name = displayName(p);
+    const std::uint64_t fileSize = regularFileSize(p);
+    gdcm::Reader reader;
+    reader.SetFileName(p.string().c_str());
+    if (!reader.ReadUpToTag(kPixelData)) throw Error(name + ": not a readable DICOM file");
+    const gdcm::DataSet& ds = reader.GetFile().GetDataSet();
+    gdcm::StringFilter sf;
+    sf.SetFile(reader.GetFile());
+    SliceInfo s;
+    s.path = p;
+    s.fileSize = fileSize;
+    s.uid = textOf(sf, ds, kSeriesUid);
+    s.description = textOf(sf, ds, kSeriesDescription);
+    s.modality = textOf(sf, ds, kModality);
+    s.seriesNumber =
+        intOf(numbersOf(sf, ds, kSeriesNumber, name, "SeriesNumber"), -1, name, "SeriesNumber");
+    s.instance = intOf(numbersOf(sf, ds, kInstanceNumber, name, "InstanceNumber"), -1, name,
+                       "InstanceNumber");
+    s.rows = intOf(numbersOf(sf, ds, kRows, name, "Rows"), 0, name, "Rows");
+    s.columns = intOf(numbersOf(sf, ds, kColumns, name, "Columns"), 0, name, "Columns");
+    s.frames = intOf(numbersOf(sf, ds, kFrames, name, "NumberOfFrames"), 1, name, "NumberOfFrames");
+    s.samples = intOf(numbersOf(sf, ds, kSamplesPerPixel, name, "SamplesPerPixel"), 1, name,
+                      "SamplesPerPixel");
+    s.bitsAllocated =
+        intOf(numbersOf(sf, ds, kBitsAllocated, name, "BitsAllocated"), 16, name, "BitsAllocated");
+    if (auto v = numbersOf(sf, ds, kPosition, name, "ImagePositionPatient")) {
+        if (v->size() != 3) throw Error(name + ": DICOM ImagePositionPatient needs 3 numbers");
+        s.position = glm::dvec3((*v)[0], (*v)[1], (*v)[2]);
+    }
+    s.orientation = numbersOf(sf, ds, kOrientation, name, "ImageOrientationPatient");
+    if (s.orientation && s.orientation->size() != 6)
+        throw Error(name + ": DICOM ImageOrientationPatient needs 6 numbers");
+    s.pixelSpacing = numbersOf(sf, ds, kPixelSpacing, name, "PixelSpacing");
+    if (s.pixelSpacing &&
+        (s.pixelSpacing->size() != 2 || !((*s.pixelSpacing)[0] > 0) || !((*s.pixelSpacing)[1] > 0)))
+        throw Error(name + ": DICOM PixelSpacing must be two numbers > 0");
+    if (auto v = numbersOf(sf, ds, kSliceThickness, name, "SliceThickness"))
+        s.thickness = v->front();
+    if (auto v = numbersOf(sf, ds, kSpacingBetweenSlices, name, "SpacingBetweenSlices"))
+        s.between = v->front();
+    if (auto v = numbersOf(sf, ds, kSlope, name, "RescaleSlope")) s.slope = v->front();
+    if (auto v = numbersOf(sf, ds, kIntercept, name, "RescaleIntercept")) s.intercept = v->front();
+    return s;
+}
+
+SliceInfo readInfo(const fs::path& p) {
+    return guarded(p, [&] { return readInfoUnguarded(p); });
+}
+
+std::optional<SampleType> gdcmSampleType(const gdcm::PixelFormat& pf) {
+    switch (pf.GetScalarType()) {
+        case gdcm::PixelFormat::UINT8:
+            return SampleType::U8;
+        case gdcm::PixelFormat::INT8:
+            return SampleType::I8;
+        case gdcm::PixelFormat::UINT16:
+            return SampleType::U16;
+        case gdcm::PixelFormat::INT16:
+            return SampleType::I16;
+        case gdcm::PixelFormat::UINT32:
+            return SampleType::U32;
+        case gdcm::PixelFormat::INT32:
+            return SampleType::I32;
+        case gdcm::PixelFormat::FLOAT32:
+            return SampleType::F32;
+        case gdcm::PixelFormat::FLOAT64:
+            return SampleType::F64;
+        default:
+            return std::nullopt;
+    }
+}
+
+/// Reads the pixels of one single-frame slice into `out` (columns x rows floats, rescaled).
+void readPixelsUnguarded(const SliceInfo& s, float* out);
+void readPixels(const SliceInfo& s, float* out) {
+    guarded(s.path, [&] {
+        readPixelsUnguarded(s, out);
+        return 0;
+    });
+}
+
+void readPixelsUnguarded(const SliceInfo& s, float* out) {
+    const std::string name = displayName(s.path);
+    gdcm::ImageReader reader;
+    reader.SetFileName(s.path.string().c_str());
+    if (!reader.Read()) throw Error(name + ": cannot read the DICOM pixel data");
+    const gdcm::Image& image = reader.GetImage();
+    const gdcm::PixelFormat& pf = image.GetPixelFormat();
+    auto type = gdcmSampleType(pf);
+    if (!type || pf.GetSamplesPerPixel() != 1)
+        throw Error(name + ": DICOM pixel format " + pf.GetScalarTypeAsString() + " with " +
+                    std::to_string(pf.GetSamplesPerPixel()) +
+                    " samples per pixel is not supported (need one scalar sample)");
+    const std::uint64_t count = std::uint64_t(s.columns) * std::uint64_t(s.rows);
+    if (image.GetNumberOfDimensions() < 2 || image.GetDimension(0) != unsigned(s.columns) ||
+        image.GetDimension(1) != unsigned(s.rows))
+        throw Error(name + ": DICOM image size disagrees with Rows/Columns");
+    const std::uint64_t bytes = checkedMul(count, sampleSize(*type), name);
+    if (image.GetBufferLength() != bytes)
+        throw Error(name + ": DICOM pixel data holds " + std::to_string(image.GetBufferLength()) +
+                    " bytes, Rows x Columns needs " + std::to_string(bytes));
+    std::vector<unsigned char> buffer(bytes);
+    if (!image.GetBuffer(reinterpret_cast<char*>(buffer.data())))
+        throw Error(name + ": cannot decode the DICOM pixel data");
+    decodeSamples(buffer.data(), std::size_t(count), *type, false, out);  // GDCM: host order
+    if (s.slope != 1.0 || s.intercept != 0.0)
+        for (std::size_t i = 0; i < count; ++i) out[i] = float(s.slope * out[i] + s.intercept);
+}
+
+std::string fmt(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    return buf;
+}
+
+std::vector<SliceInfo> readInfos(const std::vector<fs::path>& files) {
+    quietGdcm();
+    std::vector<SliceInfo> infos;
+    infos.reserve(files.size());
+    for (const fs::path& p : files) infos.push_back(readInfo(p));
+    return infos;
+}
+
+std::vector<DicomSeriesInfo> groupSeries(const std::vector<SliceInfo>& infos) {
+    std::map<std::string, DicomSeriesInfo> byUid;
+    for (const SliceInfo& s : infos) {
+        DicomSeriesInfo& d = byUid[s.uid];
+        if (d.files == 0) {
+            d.uid = s.uid;
+            d.description = s.description;
+            d.modality = s.modality;
+            d.seriesNumber = s.seriesNumber;
+            d.rows = s.rows;
+            d.columns = s.columns;
+        }
+        ++d.files;
+    }
+    std::vector<DicomSeriesInfo> out;
+    for (auto& [uid, d] : byUid) out.push_back(d);
+    std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+        return a.seriesNumber != b.seriesNumber ? a.seriesNumber < b.seriesNumber : a.uid < b.uid;
+    });
+    return out;
+}
+
+}  // namespace
+
+Volume loadDicomFiles(const std::string& name, const std::vector<fs::path>& files,
+                      const LoadOptions& options) {
+    if (files.empty()) throw Error(name + ": no DICOM files");
+    std::vector<SliceInfo> all = readInfos(files);
+
+    // One series.
+    std::vector<DicomSeriesInfo> series = groupSeries(all);
+    std::string uid = options.dicomSeries;
+    if (uid.empty()) {
+        if (series.size() > 1) {
+            std::string list;
+            for (const auto& d : series) list += (list.empty() ? "" : ", ") + d.uid;
+            throw Error(name + ": holds " + std::to_string(series.size()) +
+                        " DICOM series; choose one with --series UID (" + list +
+                        "; `splat info` lists them)");
+        }
+        uid = series.front().uid;
+    } else if (std::none_of(series.begin(), series.end(),
+                            [&](const auto& d) { return d.uid == uid; })) {
+        throw Error(name + ": no DICOM series with SeriesInstanceUID " + uid);
+    }
+    std::vector<SliceInfo> slices;
+    for (SliceInfo& s : all)
+        if (s.uid == uid) slices.push_back(std::move(s));
+
+    const SliceInfo& first = slices.front();
+    for (const SliceInfo& s : slices) {
+        const std::string sn = displayName(s.path);
+        if (s.frames != 1)
+            throw Error(sn + ": multi-frame DICOM (" + std::to_string(s.frames) +
+                        " frames) is not supported");
+        if (s.samples != 1)
+            throw Error(sn + ": DICOM with " + std::to_string(s.samples) +
+                        " samples per pixel is not supported (need scalar data)");
+        if (s.rows < 1 || s.columns < 1)
+            throw Error(sn + ": DICOM file has no Rows/Columns (no image?)");
+        // The pixels a slice declares must fit its file (with room for 64:1 compression):
+        // a 100-byte file cannot make us allocate gigabytes.
+        const std::uint64_t pixelBytes =
+            checkedMul(checkedMul(std::uint64_t(s.rows), std::uint64_t(s.columns), sn),
+                       std::uint64_t(std::clamp(s.bitsAllocated, 8, 64) / 8), sn);
+        if (pixelBytes > 64 * s.fileSize + (1u << 20))
+            throw Error(sn + ": DICOM Rows x Columns " + std::to_string(s.rows) + " x " +
+                        std::to_string(s.columns) + " needs more pixel data than the " +
+                        std::to_string(s.fileSize) + "-byte file can hold");
+        if (s.rows != first.rows || s.columns != first.columns)
+            throw Error(sn + ": slice is " + std::to_string(s.columns) + " x " +
+                        std::to_string(s.rows) + ", the first slice is " +
+                        std::to_string(first.columns) + " x " + std::to_string(first.rows));
+    }
+    if (slices.size() > std::size_t(INT32_MAX)) throw Error(name + ": too many slices");
+    const glm::ivec3 dims(first.columns, first.rows, int(slices.size()));
+    checkedVoxelCount(dims, name);
+    std::vector<std::string> notes;
+
+    // In-plane spacing: PixelSpacing is (row spacing, column spacing) = (dy, dx).
+    double dx = 1, dy = 1;
+    if (first.pixelSpacing) {
+        dy = (*first.pixelSpacing)[0];
+        dx = (*first.pixelSpacing)[1];
+        for (const SliceInfo& s : slices)
+            if (!s.pixelSpacing || *s.pixelSpacing != *first.pixelSpacing)
+                throw Error(displayName(s.path) + ": DICOM PixelSpacing differs between slices");
+    } else {
+        notes.push_back("DICOM: no PixelSpacing, 1 x 1 mm pixels assumed");
+    }
+
+    // Order and slice spacing from the geometry when every slice has it.
+    const bool geometry = std::all_of(slices.begin(), slices.end(), [](const SliceInfo& s) {
+        return s.position && s.orientation;
+    });
+    glm::dmat3 M(1.0);
+    glm::dvec3 t(0.0);
+    std::string what = "DICOM ImageOrientationPatient";
+    if (geometry) {
+        const std::vector<double>& o = *first.orientation;
+        glm::dvec3 r(o[0], o[1], o[2]), c(o[3], o[4], o[5]);
+        if (!(glm::length(r) > 0.5) || !(glm::length(c) > 0.5) ||
+            std::abs(glm::dot(glm::normalize(r), glm::normalize(c))) > 1e-3)
+            throw Error(displayName(first.path) +
+                        ": DICOM ImageOrientationPatient is not two orthogonal unit vectors");
+        r = glm::normalize(r);
+        c = glm::normalize(c);
+        const glm::dvec3 n = glm::cross(r, c);
+        for (const SliceInfo& s : slices) {
+            const std::vector<double>& so = *s.orientation;
+            for (int i = 0; i < 6; ++i)
+                if (std::abs(so[std::size_t(i)] - o[std::size_t(i)]) > 1e-4)
+                    throw Error(displayName(s.path) +
+                                ": DICOM ImageOrientationPatient differs between slices");
+        }
+        std::stable_sort(slices.begin(), slices.end(), [&](const SliceInfo& a, const SliceInfo& b) {
+            return glm::dot(*a.position, n) < glm::dot(*b.position, n);
+        });
+        double gap = 1;
+        glm::dvec3 step = n;
+        if (slices.size() > 1) {
+            double lo = INFINITY, hi = 0;
+            for (std::size_t k = 1; k < slices.size(); ++k) {
+                const double g = glm::dot(*slices[k].position - *slices[k - 1].position, n);
+                lo = std::min(lo, g);
+                hi = std::max(hi, g);
+            }
+            if (!(lo > 1e-6))
+                throw Error(name + ": two DICOM slices of series " + uid +
+                            " lie at the same position (several acquisitions in one series?)");
+            if (hi > lo * 1.01 + 1e-4)
+                throw Error(name + ": uneven DICOM slice gaps in series " + uid + " (from " +
+                            fmt(lo) + " to " + fmt(hi) +
+                            " mm: missing slices?); a volume needs one slice spacing");
+            const glm::dvec3 span = *slices.back().position - *slices.front().position;
+            gap = glm::dot(span, n) / double(slices.size() - 1);
+            step = span / double(slices.size() - 1);
+            const double tilt = std::acos(std::min(1.0, glm::dot(glm::normalize(step), n)));
+            if (tilt > 1e-3)
+                notes.push_back("DICOM gantry tilt of " + fmt(tilt * 180.0 / M_PI) +
+                                " degrees: slices are stacked along the normal, not sheared");
+        } else if (first.between && *first.between > 0) {
+            gap = *first.between;
+        } else if (first.thickness && *first.thickness > 0) {
+            gap = *first.thickness;
+        }
+        // Columns (index x) run along r, rows (index y) along c, slices along n; LPS
+        // patient coordinates become RAS (x and y negated), the convention of NIfTI.
+        const glm::dmat3 lpsToRas(glm::dvec3(-1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, 1));
+        M = lpsToRas * glm::dmat3(r * dx, c * dy, n * gap);
+        t = lpsToRas * *slices.front().position;
+    } else {
+        const bool numbered = std::all_of(slices.begin(), slices.end(),
+                                          [](const SliceInfo& s) { return s.instance >= 0; });
+        if (numbered)
+            std::stable_sort(
+                slices.begin(), slices.end(),
+                [](const SliceInfo& a, const SliceInfo& b) { return a.instance < b.instance; });
+        double gap = 1;
+        if (first.between && *first.between > 0)
+            gap = *first.between;
+        else if (first.thickness && *first.thickness > 0)
+            gap = *first.thickness;
+        M = glm::dmat3(glm::dvec3(dx, 0, 0), glm::dvec3(0, dy, 0), glm::dvec3(0, 0, gap));
+        what = "DICOM spacing";
+        notes.push_back(std::string("DICOM: no ImagePositionPatient/ImageOrientationPatient, "
+                                    "slices ordered by ") +
+                        (numbered ? "InstanceNumber" : "file name") + ", slice spacing " +
+                        fmt(gap) + " assumed, orientation unknown");
+    }
+
+    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
+    const std::size_t plane = std::size_t(dims.x) * std::size_t(dims.y);
+    for (std::size_t k = 0; k < slices.size(); ++k)
+        readPixels(slices[k], v.data.data() + k * plane);
+    std::string modality = first.modality.empty() ? "" : first.modality + " ";
+    v.source =
+        "DICOM " + modality + "series, " + std::to_string(slices.size()) + " files (" + name + ")";
+    applyOrientation(v, M, t, what);
+    for (const std::string& n : notes) addNote(v, n);
+    return v;
+}
+
+}  // namespace splat::detail
+
+namespace splat {
+
+std::vector<DicomSeriesInfo> listDicomSeries(const std::string& folder) {
+    const fs::path dir(folder);
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) return {};
+    std::vector<fs::path> files;
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+        if (!entry.is_regular_file()) continue;
+        if (entry.path().filename().string().starts_with(".")) continue;
+        if (detail::isDicomFile(entry.path())) files.push_back(entry.path());
+    }
+    if (ec) throw Error(folder + ": cannot list folder (" + ec.message() + ")");
+    std::sort(files.begin(), files.end());
+    return detail::groupSeries(detail::readInfos(files));
+}
+
+}  // namespace splat

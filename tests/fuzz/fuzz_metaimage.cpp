@@ -1,0 +1,11 @@
+// libFuzzer target: MetaImage. An input holding the data marker (fuzz_util.h) is a .mhd
+// header plus its data file "data.raw"; otherwise a single .mha.
+#include "fuzz_util.h"
+#include "splat/volume_io.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    const auto p = splat::fuzz::writeHeaderAndData(
+        std::string_view(reinterpret_cast<const char*>(data), size), "in.mha", "in.mhd");
+    splat::fuzz::expectOnlySplatErrors([&] { splat::loadVolume(p.string()); });
+    return 0;
+}

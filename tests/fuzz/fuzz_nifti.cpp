@@ -1,0 +1,10 @@
+// libFuzzer target: NIfTI-1/NIfTI-2/ANALYZE single files (.nii) from the fuzzer's bytes.
+#include "fuzz_util.h"
+#include "splat/volume_io.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    const auto p = splat::fuzz::writeFile(
+        "in.nii", std::string_view(reinterpret_cast<const char*>(data), size));
+    splat::fuzz::expectOnlySplatErrors([&] { splat::loadVolume(p.string()); });
+    return 0;
+}
