@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace splat {
 
@@ -67,11 +68,14 @@ void forTilesOf(const PixelRect& r, const TileGrid& g, F&& f) {
 }
 }  // namespace
 
-std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order, std::size_t o0,
-                     std::size_t o1, const TileGrid& grid,
+std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
+                     const std::vector<std::uint32_t>& runs, const TileGrid& grid,
                      const std::vector<TileAccumulator>& tiles, bool cull, ChunkBins& out) {
-    const std::size_t n = o1 - o0, tileCount = std::size_t(grid.count());
-    const std::size_t part = (n + kParts - 1) / kParts;
+    const std::size_t n = runs.empty() ? 0 : runs.back(), tileCount = std::size_t(grid.count());
+    const std::size_t runCount = runs.empty() ? 0 : runs.size() - 1;
+    const std::size_t runsPerPart = (runCount + kParts - 1) / kParts;
+    // Part c: runs [c runsPerPart, (c + 1) runsPerPart), positions partStart(c) ..
+    auto partStart = [&](std::size_t c) { return runs[std::min(runCount, c * runsPerPart)]; };
     out.sx.resize(n);
     out.sy.resize(n);
     out.rect.resize(n);
@@ -80,24 +84,52 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order, s
     out.counts.assign(kParts * tileCount, 0);
     const Occlusion occlusion(grid, tiles, cull);
     std::vector<std::size_t> hidden(kParts, 0);
-    // Pass 1: project, and count the tiles where each splat is visible.
+    const bool runBoxes = cull && !projector.perspective();
+    // Pass 1: project, and count the tiles where each splat is visible. A run (splats of one
+    // row, between its first and last) whose box is hidden everywhere is skipped whole.
     tbb::parallel_for(std::size_t(0), kParts, [&](std::size_t c) {
         std::uint32_t* cnt = &out.counts[c * tileCount];
-        const std::size_t e = std::min(n, (c + 1) * part);
+        const std::size_t re = std::min(runCount, (c + 1) * runsPerPart);
         std::size_t h = 0;
-        for (std::size_t q = c * part; q < e; ++q) {
-            const PixelRect r = projector.project(order[o0 + q], out.sx[q], out.sy[q],
-                                                  projector.perspective() ? &out.each[q] : nullptr);
-            out.rect[q] = r;
-            std::uint32_t bits = 0;
-            if (!r.empty())
-                forTilesOf(r, grid, [&](int tx, int ty, int k) {
-                    const bool v = k >= kMaskTiles || occlusion.visible(r, tx, ty);
-                    cnt[ty * grid.tilesX + tx] += v;
-                    bits |= std::uint32_t(v) << std::min(k, kMaskTiles);
-                });
-            out.visible[q] = bits;
-            h += bits == 0 && !r.empty();
+        for (std::size_t run = std::min(runCount, c * runsPerPart); run < re; ++run) {
+            const std::size_t a = runs[run], b = runs[run + 1];
+            if (runBoxes && b - a >= 2) {
+                float xa, ya, xb, yb;
+                projector.project(order[a], xa, ya, nullptr);
+                projector.project(order[b - 1], xb, yb, nullptr);
+                // Every centre of the run lies between the two ends: one box (widened by a
+                // pixel against rounding) holds all their footprint boxes.
+                footprint::EllipticalFootprint e = projector.shared();
+                e.halfWidth += 0.5f * std::abs(xa - xb) + 1.0f;
+                e.halfHeight += 0.5f * std::abs(ya - yb) + 1.0f;
+                const PixelRect box =
+                    footprintRect(0.5f * (xa + xb), 0.5f * (ya + yb), e, grid.width, grid.height);
+                bool any = box.empty();
+                if (!box.empty())
+                    forTilesOf(box, grid, [&](int tx, int ty, int k) {
+                        any |= k >= kMaskTiles || occlusion.visible(box, tx, ty);
+                    });
+                if (!any) {
+                    for (std::size_t q = a; q < b; ++q) out.visible[q] = 0;
+                    h += b - a;
+                    continue;
+                }
+            }
+            for (std::size_t q = a; q < b; ++q) {
+                const PixelRect r =
+                    projector.project(order[q], out.sx[q], out.sy[q],
+                                      projector.perspective() ? &out.each[q] : nullptr);
+                out.rect[q] = r;
+                std::uint32_t bits = 0;
+                if (!r.empty())
+                    forTilesOf(r, grid, [&](int tx, int ty, int k) {
+                        const bool v = k >= kMaskTiles || occlusion.visible(r, tx, ty);
+                        cnt[ty * grid.tilesX + tx] += v;
+                        bits |= std::uint32_t(v) << std::min(k, kMaskTiles);
+                    });
+                out.visible[q] = bits;
+                h += bits == 0 && !r.empty();
+            }
         }
         hidden[c] = h;
     });
@@ -117,11 +149,11 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order, s
     // Pass 2: the records.
     tbb::parallel_for(std::size_t(0), kParts, [&](std::size_t c) {
         std::uint32_t* next = &out.counts[c * tileCount];
-        const std::size_t e = std::min(n, (c + 1) * part);
-        for (std::size_t q = c * part; q < e; ++q) {
+        const std::size_t e = partStart(c + 1);
+        for (std::size_t q = partStart(c); q < e; ++q) {
             const std::uint32_t bits = out.visible[q];
             if (bits == 0) continue;
-            const SplatRecord rec{order[o0 + q], std::uint32_t(q), out.sx[q], out.sy[q]};
+            const SplatRecord rec{order[q], std::uint32_t(q), out.sx[q], out.sy[q]};
             forTilesOf(out.rect[q], grid, [&](int tx, int ty, int k) {
                 if (bits >> std::min(k, kMaskTiles) & 1)
                     out.records[next[ty * grid.tilesX + tx]++] = rec;

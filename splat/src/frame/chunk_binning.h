@@ -37,12 +37,14 @@ struct VisitOrder {
 };
 
 /// What a streaming splatter hands the chunked tile stage (tile_driver.h): `count` chunks
-/// of whole sheets in visiting order; gather(c, ids) lists chunk c's splats in any order
-/// (binning sorts each tile's records by sheet, stably). Its cutter spans one sheet per
+/// of whole sheets in visiting order; gather(c, ids, runs) lists chunk c's splats in any
+/// order (binning sorts each tile's records by sheet, stably), cut into runs along volume
+/// rows (binChunk). Its cutter spans one sheet per
 /// splat (a ring of one), so no sheet is pending between chunks.
 struct SheetChunks {
     std::size_t count = 0;
-    std::function<void(std::size_t, std::vector<std::uint32_t>&)> gather;
+    std::function<void(std::size_t, std::vector<std::uint32_t>&, std::vector<std::uint32_t>&)>
+        gather;
 };
 
 /// One chunk's splats binned to tiles (arrays reused from chunk to chunk and frame to frame).
@@ -55,14 +57,18 @@ struct ChunkBins {
     std::vector<std::uint32_t> visible;                ///< scratch: tiles where visible
     std::vector<std::uint32_t> counts;                 ///< scratch: per part and tile
     std::vector<std::uint32_t> ids;                    ///< scratch: the chunk's splats
+    std::vector<std::uint32_t> runs;                   ///< scratch: their runs
 };
 
-/// Projects the splats order[o0, o1) and bins the visible ones into `out`. `tiles` holds
+/// Projects the splats order[0, runs.back()) and bins the visible ones into `out`. `runs`
+/// cuts them into runs (run r: positions [runs[r], runs[r + 1])) of splats on one segment
+/// of a volume row, first and last at its ends: with `cull`, a run whose box is hidden in
+/// every tile it touches is skipped without projecting its inner splats. `tiles` holds
 /// each tile's compositing state (row-major over `grid`); with `cull`, a splat is left out
 /// of every tile that is opaque over its footprint box there. Returns the splats left out
 /// of every tile they touch.
-std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order, std::size_t o0,
-                     std::size_t o1, const TileGrid& grid,
+std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
+                     const std::vector<std::uint32_t>& runs, const TileGrid& grid,
                      const std::vector<TileAccumulator>& tiles, bool cull, ChunkBins& out);
 
 }  // namespace splat

@@ -138,22 +138,29 @@ class AxisAligned final : public Splatter {
         const bool ascending = plan.ascending;
         work.chunks.count = slabs;
         work.chunks.gather = [&sc, &cells, m, slabs, ascending](std::size_t c,
-                                                                std::vector<std::uint32_t>& ids) {
+                                                                std::vector<std::uint32_t>& ids,
+                                                                std::vector<std::uint32_t>& runs) {
             const glm::ivec3 d = sc.volume->dims;
             const std::size_t slab = ascending ? c : slabs - 1 - c, cx = std::size_t(sc.cellsX());
             const std::size_t q0 = slab * kWidth, q1 = std::min<std::size_t>(q0 + kWidth, d[m]);
             ids.clear();
-            auto add = [&](std::size_t a, std::size_t b) {
-                for (std::size_t q = cells[a]; q < cells[b]; ++q) ids.push_back(std::uint32_t(q));
+            runs.assign(1, 0);
+            // One run per non-empty cell: its splats lie on one row between its first and last.
+            auto add = [&](std::size_t cell) {
+                if (cells[cell] == cells[cell + 1]) return;
+                for (std::size_t q = cells[cell]; q < cells[cell + 1]; ++q)
+                    ids.push_back(std::uint32_t(q));
+                runs.push_back(std::uint32_t(ids.size()));
             };
             const std::size_t ny = std::size_t(d.y), rows = ny * std::size_t(d.z);
             if (m == 2) {
-                add(q0 * ny * cx, q1 * ny * cx);
+                for (std::size_t cell = q0 * ny * cx; cell < q1 * ny * cx; ++cell) add(cell);
             } else if (m == 1) {
                 for (std::size_t k = 0; k < std::size_t(d.z); ++k)
-                    add((k * ny + q0) * cx, (k * ny + q1) * cx);
+                    for (std::size_t cell = (k * ny + q0) * cx; cell < (k * ny + q1) * cx; ++cell)
+                        add(cell);
             } else {
-                for (std::size_t r = 0; r < rows; ++r) add(r * cx + slab, r * cx + slab + 1);
+                for (std::size_t r = 0; r < rows; ++r) add(r * cx + slab);
             }
         };
         stats.sheetAxis = m;
