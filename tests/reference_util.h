@@ -50,16 +50,14 @@ inline Image referenceImage(const Volume& volume, RenderSettings settings,
 inline SplatList splatsByHand(const Volume& v, float rhoPerUnit = 1.0f,
                               const glm::vec3& colour = glm::vec3(1.0f)) {
     SplatList s;
+    s.origin = v.origin;
+    s.spacing = v.spacing;
     for (int k = 0; k < v.dims.z; ++k)
         for (int j = 0; j < v.dims.y; ++j)
             for (int i = 0; i < v.dims.x; ++i) {
                 const float d = v.at(i, j, k);
                 ++s.voxels;
                 if (d == 0.0f) continue;
-                const glm::dvec3 w = v.world(glm::dvec3(i, j, k));
-                s.x.push_back(float(w.x));
-                s.y.push_back(float(w.y));
-                s.z.push_back(float(w.z));
                 s.i.push_back(std::uint16_t(i));
                 s.j.push_back(std::uint16_t(j));
                 s.k.push_back(std::uint16_t(k));

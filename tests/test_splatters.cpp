@@ -367,7 +367,7 @@ TEST_CASE("shading: normals point out of a sphere; ambient 1 reproduces the unsh
     const glm::dvec3 c = v.center();
     int checked = 0;
     for (std::size_t n = 0; n < s.size(); n += 7) {
-        const glm::dvec3 out = glm::dvec3(s.x[n], s.y[n], s.z[n]) - c;
+        const glm::dvec3 out = s.world(n) - c;
         if (glm::length(out) < 3.0 || glm::length(out) > 10.0) continue;
         const double cosine = glm::dot(glm::normalize(out), glm::dvec3(s.nx[n], s.ny[n], s.nz[n]));
         REQUIRE(cosine > 0.99);  // -grad of a Gaussian blob points away from its centre

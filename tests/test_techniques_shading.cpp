@@ -169,7 +169,7 @@ TEST_CASE("gradients: the splatted central differences against the analytic grad
     const glm::dvec3 c = v.center();
     double worstAngle = 0;
     for (std::size_t q = 0; q < splats.size(); q += 5) {
-        const glm::dvec3 p(splats.x[q], splats.y[q], splats.z[q]);
+        const glm::dvec3 p = splats.world(q);
         const glm::dvec3 d = p - c;
         const double r = glm::length(d);
         if (r < 2 || r > 10) continue;

@@ -15,11 +15,26 @@
 namespace splat {
 
 struct SplatList {
-    std::vector<float> x, y, z;          ///< world position of the voxel
     std::vector<std::uint16_t> i, j, k;  ///< index position
-    std::vector<float> density;          ///< d_i
-    std::vector<float> extinction;       ///< rho_i = f_rho(d_i), per world unit (pre)
-    std::vector<float> r, g, b;          ///< premultiplied emission e_i = colour * rho_i (pre)
+    /// The volume's grid: a splat's world position is origin + spacing (i, j, k), computed
+    /// when needed (world()) rather than stored beside the index position.
+    glm::dvec3 origin{0.0}, spacing{1.0};
+    std::vector<float> density;     ///< d_i
+    std::vector<float> extinction;  ///< rho_i = f_rho(d_i), per world unit (pre)
+    std::vector<float> r, g, b;     ///< premultiplied emission e_i = colour * rho_i (pre)
+    /// Emission by value (ClassifyOptions::compactEmission): when rho_i and e_i depend on d_i
+    /// alone and the splats take at most 65536 distinct values, `palette` holds
+    /// (rho, e_r, e_g, e_b) per distinct value, `emissionIndex` each splat's entry, and
+    /// extinction, r, g, b stay empty (2 bytes per splat instead of 16). Read emission(n).
+    std::vector<glm::vec4> palette;
+    std::vector<std::uint16_t> emissionIndex;
+    bool paletted() const { return !palette.empty(); }
+    /// (rho_n, e_r, e_g, e_b) of splat n, from the palette or the arrays.
+    glm::vec4 emission(std::size_t n) const {
+        return paletted() ? palette[emissionIndex[n]] : glm::vec4(extinction[n], r[n], g[n], b[n]);
+    }
+    /// Fills extinction, r, g, b from the palette and drops it (for code that needs arrays).
+    void expandEmission();
     /// Unit normals -grad d / |grad d| (central differences in world units), only when
     /// classify() was asked for them (shading); empty otherwise.
     std::vector<float> nx, ny, nz;
@@ -33,7 +48,12 @@ struct SplatList {
     /// shown), only when the scene has labels.
     std::vector<float> label;
     std::size_t voxels = 0;  ///< voxels considered
-    std::size_t size() const { return x.size(); }
+    std::size_t size() const { return i.size(); }
+    /// World position of splat n.
+    glm::dvec3 world(std::size_t n) const {
+        return origin + spacing * glm::dvec3(double(i[n]), double(j[n]), double(k[n]));
+    }
+    /// Bytes held per splat by the arrays in use, times the splat count.
     std::size_t bytes() const;
 };
 
@@ -47,6 +67,8 @@ struct ClassifyOptions {
     /// carrying their label (so the background competes at region borders); without a label
     /// volume the scene volume holds the labels and has no intensity part.
     const Labels* labels = nullptr;
+    /// Store emission by value (SplatList::palette) where it can be: a Scene's own list.
+    bool compactEmission = false;
 };
 
 /// The shown label (Labels::shown) of every voxel of the label volume, 0 elsewhere.

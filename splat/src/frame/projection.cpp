@@ -8,21 +8,6 @@
 
 namespace splat {
 
-namespace {
-// Pixel centres px + 0.5 within [sx - halfWidth, sx + halfWidth], clamped to the image.
-PixelRect coveredPixels(float sx, float sy, const footprint::EllipticalFootprint& e, int width,
-                        int height) {
-    const float fx0 = std::ceil(sx - e.halfWidth - 0.5f), fx1 = std::floor(sx + e.halfWidth - 0.5f);
-    const float fy0 = std::ceil(sy - e.halfHeight - 0.5f),
-                fy1 = std::floor(sy + e.halfHeight - 0.5f);
-    if (!(fx1 >= 0.0f) || !(fy1 >= 0.0f) || !(fx0 <= float(width - 1)) ||
-        !(fy0 <= float(height - 1)))
-        return {1, 1, 0, 0};
-    return {int(std::max(fx0, 0.0f)), int(std::max(fy0, 0.0f)),
-            int(std::min(fx1, float(width - 1))), int(std::min(fy1, float(height - 1)))};
-}
-}  // namespace
-
 void projectSplats(const SplatList& splats, const Camera& camera, const glm::dvec3& spacing,
                    double radius, ProjectedSplats& p) {
     const std::size_t n = splats.size();
@@ -47,7 +32,7 @@ void projectSplats(const SplatList& splats, const Camera& camera, const glm::dve
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t s = r.begin(); s != r.end(); ++s) {
-                const glm::dvec3 w(splats.x[s], splats.y[s], splats.z[s]);
+                const glm::dvec3 w = splats.world(s);
                 const glm::dvec3 q = camera.project(w);
                 p.sx[s] = float(q.x);
                 p.sy[s] = float(q.y);
@@ -61,10 +46,40 @@ void projectSplats(const SplatList& splats, const Camera& camera, const glm::dve
                 }
                 p.rect[s] = p.perspective && !(q.z > 0.0)
                                 ? PixelRect{1, 1, 0, 0}
-                                : coveredPixels(p.sx[s], p.sy[s], p.ellipse(s), camera.width(),
+                                : footprintRect(p.sx[s], p.sy[s], p.ellipse(s), camera.width(),
                                                 camera.height());
             }
         });
+}
+
+SplatProjector::SplatProjector(const SplatList& splats, const Camera& camera,
+                               const glm::dvec3& spacing, double radius)
+    : splats_(splats),
+      camera_(camera),
+      spacing_(spacing),
+      radius_(radius),
+      perspective_(camera.perspective()),
+      width_(camera.width()),
+      height_(camera.height()),
+      cx_(0.5 * camera.width()),
+      cy_(0.5 * camera.height()),
+      rx_(camera.right / camera.pixelSize),
+      ry_(camera.up / camera.pixelSize) {
+    if (!perspective_)
+        shared_ =
+            footprint::ellipticalFootprint(spacing, camera.right * camera.pixelSize,
+                                           -camera.up * camera.pixelSize, camera.view, radius);
+}
+
+PixelRect SplatProjector::projectPerspective(const glm::dvec3& w, float& sx, float& sy,
+                                             footprint::EllipticalFootprint& e) const {
+    const glm::dvec3 q = camera_.project(w);
+    sx = float(q.x);
+    sy = float(q.y);
+    e = footprint::perspectiveFootprint(spacing_, camera_.eye, camera_.right, camera_.up,
+                                        camera_.view, camera_.focal, camera_.pixelSize, w, radius_);
+    if (!(q.z > 0.0)) return {1, 1, 0, 0};
+    return footprintRect(sx, sy, e, width_, height_);
 }
 
 }  // namespace splat

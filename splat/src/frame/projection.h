@@ -2,6 +2,9 @@
 // Pipeline stage "project": splat centres to screen positions and depths, and the
 // elliptical footprint of each splat (one shared ellipse for orthographic views, a local
 // affine approximation per splat for perspective ones).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "footprint/ellipse.h"
@@ -16,6 +19,20 @@ struct PixelRect {
     int x0, y0, x1, y1;
     bool empty() const { return x0 > x1 || y0 > y1; }
 };
+
+/// Pixel centres px + 0.5 within [sx - halfWidth, sx + halfWidth] (and likewise in y),
+/// clamped to a width x height image.
+inline PixelRect footprintRect(float sx, float sy, const footprint::EllipticalFootprint& e,
+                               int width, int height) {
+    const float fx0 = std::ceil(sx - e.halfWidth - 0.5f), fx1 = std::floor(sx + e.halfWidth - 0.5f);
+    const float fy0 = std::ceil(sy - e.halfHeight - 0.5f),
+                fy1 = std::floor(sy + e.halfHeight - 0.5f);
+    if (!(fx1 >= 0.0f) || !(fy1 >= 0.0f) || !(fx0 <= float(width - 1)) ||
+        !(fy0 <= float(height - 1)))
+        return {1, 1, 0, 0};
+    return {int(std::max(fx0, 0.0f)), int(std::max(fy0, 0.0f)),
+            int(std::min(fx1, float(width - 1))), int(std::min(fy1, float(height - 1)))};
+}
 
 struct ProjectedSplats {
     std::vector<float> sx, sy;  ///< continuous pixel position of the centre
@@ -37,5 +54,43 @@ struct ProjectedSplats {
 /// an empty rectangle.
 void projectSplats(const SplatList& splats, const Camera& camera, const glm::dvec3& spacing,
                    double radius, ProjectedSplats& out);
+
+/// Projects one splat at a time, for the splatters that project chunk by chunk (only the
+/// splats that are not hidden yet): the same screen positions and footprints as
+/// projectSplats.
+class SplatProjector {
+  public:
+    SplatProjector(const SplatList& splats, const Camera& camera, const glm::dvec3& spacing,
+                   double radius);
+    bool perspective() const { return perspective_; }
+    /// The footprint every splat shares (orthographic views).
+    const footprint::EllipticalFootprint& shared() const { return shared_; }
+    /// Screen position of splat `id` and (perspective) its own footprint in `*each`; returns
+    /// its footprint's pixel box (empty for a perspective splat behind the eye).
+    PixelRect project(std::uint32_t id, float& sx, float& sy,
+                      footprint::EllipticalFootprint* each) const {
+        const glm::dvec3 w = splats_.world(id);
+        if (!perspective_) {
+            const glm::dvec3 d = w - camera_.eye;
+            sx = float(cx_ + glm::dot(d, rx_));
+            sy = float(cy_ - glm::dot(d, ry_));
+            return footprintRect(sx, sy, shared_, width_, height_);
+        }
+        return projectPerspective(w, sx, sy, *each);
+    }
+
+  private:
+    PixelRect projectPerspective(const glm::dvec3& w, float& sx, float& sy,
+                                 footprint::EllipticalFootprint& e) const;
+    const SplatList& splats_;
+    const Camera& camera_;
+    glm::dvec3 spacing_;
+    double radius_;
+    bool perspective_;
+    int width_, height_;
+    double cx_, cy_;
+    glm::dvec3 rx_, ry_;  ///< right / pixelSize, up / pixelSize
+    footprint::EllipticalFootprint shared_;
+};
 
 }  // namespace splat

@@ -28,7 +28,8 @@ double msSince(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-/// Emission to splat: the list's own, or (shaded scenes) this view's shaded emission.
+/// Emission to splat: null (the list's own, SplatList::emission) or (shaded scenes) this
+/// view's shaded emission.
 struct Emission {
     const float *r, *g, *b;
 };
@@ -38,7 +39,7 @@ struct Emission {
 Emission shade(const Scene::Impl& scene, const Camera& camera, FrameWorkspace& work,
                RenderStats& stats) {
     const SplatList& s = scene.splats;
-    if (!scene.shaded()) return {s.r.data(), s.g.data(), s.b.data()};
+    if (!scene.shaded()) return {nullptr, nullptr, nullptr};  // the list's own (emission())
     const auto start = Clock::now();
     shadeEmission(s, scene.settings.shading, camera.view, work.r, work.g, work.b);
     stats.shadeMs = msSince(start);
@@ -124,9 +125,9 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
         s.renderer == RendererKind::Axis ? axisAlignedSplatter() : imageAlignedSplatter();
     const WorkspaceLease work(scene);
     const Emission e = shade(scene, camera, *work, stats);
-    project(scene, camera, *work, stats);
+    if (!splatter.streams()) project(scene, camera, *work, stats);
     const SheetPlan plan = order(splatter, scene, camera, s, *work, stats);
-    bin(camera, s, *work, stats);
+    if (!splatter.streams()) bin(camera, s, *work, stats);
     PolicyContext ctx = policyContext(scene, camera, s);
     // Issue 13: clipping cuts the sheets at the planes and box per pixel (frame/clip_cut.h).
     const ClipCut cut(s.clipping, camera, plan, *scene.volume, scene.kernel.radius(),
@@ -166,6 +167,7 @@ Image referenceFrame(const Scene::Impl& scene, const Camera& camera, const Rende
                                scene.splats.gradientScale, labelLookup(scene));
     // Shaded emission depends on the view: the field is made for this frame.
     SplatList lit = scene.splats;
+    lit.expandEmission();
     shadeEmission(scene.splats, scene.settings.shading, camera.view, lit.r, lit.g, lit.b);
     const ReferenceField field(*scene.volume, lit, scene.kernel, FieldLayout::Emission);
     return renderReference(*scene.volume, field, camera, s, &stats, depth,
@@ -187,7 +189,7 @@ bool needsExactPath(const Scene::Impl& scene, const Camera& camera) {
         tbb::blocked_range<std::size_t>(0, s.size(), 8192), false,
         [&](const tbb::blocked_range<std::size_t>& r, bool found) {
             for (std::size_t n = r.begin(); n != r.end() && !found; ++n) {
-                const glm::dvec3 w(s.x[n], s.y[n], s.z[n]);
+                const glm::dvec3 w = s.world(n);
                 const double depth = glm::dot(w - eye, view);
                 // Kernels entirely behind the eye contribute nothing to any ray.
                 if (depth > -bound && depth < nearest) found = true;

@@ -6,6 +6,7 @@
 // in the weight a kernel piece gets (its whole footprint, or its slab section) and in which
 // sheet it falls into (splat/src/splatters/).
 #include <algorithm>
+#include <stdexcept>
 #include <vector>
 
 #include "footprint/ellipse.h"
@@ -31,6 +32,29 @@ class SheetBuffer {
     }
 
     bool dirty() const { return dx0_ <= dx1_; }
+
+    /// Re-targets a clean sheet to the tile at (ox, oy) of size w x h, no larger than the
+    /// tile it was made for (the streaming splatters reuse one sheet per thread for every
+    /// tile instead of clearing a fresh one per tile and chunk).
+    void moveTo(int ox, int oy, int w, int h) {
+        if (((w + 7) & ~7) > stride_ || std::size_t(stride_) * h + kPlanePad > plane_)
+            throw std::logic_error("SheetBuffer::moveTo: tile larger than the sheet");
+        ox_ = ox;
+        oy_ = oy;
+        w_ = w;
+        h_ = h;
+    }
+
+    /// Clears whatever the sheet holds without compositing it.
+    void discard() {
+        if (!dirty()) return;
+        for (int c = 0; c < NCh; ++c)
+            for (int y = dy0_; y <= dy1_; ++y) {
+                float* row = &v_[c * plane_ + std::size_t(y) * stride_];
+                std::fill(row + dx0_, row + dx1_ + 1, 0.0f);
+            }
+        clearDirty();
+    }
 
     /// Adds values[c] * weight(r2, dx, dy) to every pixel of `rect` (image coordinates,
     /// inside this tile), where (dx, dy) is the pixel centre's offset from the splat

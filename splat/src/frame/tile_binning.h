@@ -19,18 +19,29 @@ struct TileGrid {
           height(h),
           tileSize(tile),
           tilesX((w + tile - 1) / tile),
-          tilesY((h + tile - 1) / tile) {}
+          tilesY((h + tile - 1) / tile),
+          magic_((std::uint64_t(1) << 32) / std::uint64_t(tile) + 1) {}
     int count() const { return tilesX * tilesY; }
+    /// Tile column (or row) of pixel column (or row) p >= 0: p / tileSize by a multiply
+    /// (exact for p < 2^20, far beyond the largest image), as binning does it per splat.
+    int tileOf(int p) const { return int((std::uint64_t(p) * magic_) >> 32); }
+
+  private:
+    std::uint64_t magic_ = 0;
 };
 
-/// The part of a rectangle inside tile `t`.
-inline PixelRect clipToTile(PixelRect r, const TileGrid& g, int t) {
-    const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
+/// The part of a rectangle inside the tile whose top-left pixel is (ox, oy).
+inline PixelRect clipToTile(PixelRect r, const TileGrid& g, int ox, int oy) {
     r.x0 = std::max(r.x0, ox);
     r.y0 = std::max(r.y0, oy);
     r.x1 = std::min(r.x1, std::min(ox + g.tileSize, g.width) - 1);
     r.y1 = std::min(r.y1, std::min(oy + g.tileSize, g.height) - 1);
     return r;
+}
+
+/// The part of a rectangle inside tile `t`.
+inline PixelRect clipToTile(PixelRect r, const TileGrid& g, int t) {
+    return clipToTile(r, g, (t % g.tilesX) * g.tileSize, (t / g.tilesX) * g.tileSize);
 }
 
 struct TileBins {

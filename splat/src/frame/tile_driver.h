@@ -13,13 +13,16 @@
 // spans, and how its kernel is cut into them; that is all that differs between the
 // axis-aligned (one sheet: the whole footprint) and the image-aligned splatter (every slab
 // it crosses: slab sections).
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <type_traits>
 #include <vector>
 
+#include "frame/chunk_binning.h"
 #include "frame/compositing.h"
 #include "frame/projection.h"
 #include "frame/sheet_buffer.h"
@@ -55,10 +58,13 @@ struct TileInputs {
     const ProjectedSplats& proj;
     const TileBins& bins;
     const SheetPlan& plan;
-    const float *er, *eg, *eb;      ///< emission to splat: the list's own or this view's shaded
+    const float *er, *eg, *eb;      ///< this view's shaded emission; null: the list's own
     const PolicyContext& policy;    ///< the frame's compositing policy and its parameters
     Image* isoPositions = nullptr;  ///< iso: per pixel, the hit's fractional sheet position
 };
+
+/// Most sheets one splat may span (the image-aligned splatter's limit) plus one.
+inline constexpr std::uint32_t kMaxRing = 8194;
 
 /// Per-tile counters, summed into RenderStats.
 struct TileCounters {
@@ -86,16 +92,15 @@ std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& 
 template <class Policy>
 inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Policy::kChannels]) {
     const SplatList& s = in.scene.splats;
-    if constexpr (Policy::kSource == SheetSource::Emission) {
-        v[0] = s.extinction[id];
-        v[1] = in.er[id];
-        v[2] = in.eg[id];
-        v[3] = in.eb[id];
-    } else if constexpr (Policy::kSource == SheetSource::Labels) {
-        v[0] = s.extinction[id];
-        v[1] = in.er[id];
-        v[2] = in.eg[id];
-        v[3] = in.eb[id];
+    if constexpr (Policy::kSource == SheetSource::Emission ||
+                  Policy::kSource == SheetSource::Labels) {
+        const glm::vec4 e = s.emission(id);
+        v[0] = e.x;
+        v[1] = in.er ? in.er[id] : e.y;
+        v[2] = in.er ? in.eg[id] : e.z;
+        v[3] = in.er ? in.eb[id] : e.w;
+    }
+    if constexpr (Policy::kSource == SheetSource::Labels) {
         v[4] = 1.0f;  // every splat competes for the pixel's label, the background too
         v[5] = s.label[id];
     } else if constexpr (Policy::kSource == SheetSource::DensityGradient) {
@@ -103,49 +108,80 @@ inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Polic
         v[1] = s.gx[id];
         v[2] = s.gy[id];
         v[3] = s.gz[id];
-    } else {
+    } else if constexpr (Policy::kSource == SheetSource::Density) {
         v[0] = s.density[id];
     }
 }
 
-/// The sweep of one tile (see the file comment).
-template <class Policy, class Cutter>
-void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter, int t,
-               TileAccumulator& acc, const float* tileScale, TileCounters& cnt) {
-    constexpr int NCh = Policy::kChannels;
-    const TileBins& bins = in.bins;
-    const int ox = (t % bins.grid.tilesX) * bins.grid.tileSize;
-    const int oy = (t / bins.grid.tilesX) * bins.grid.tileSize;
-    const std::uint32_t ring = in.plan.ring;
-    std::vector<SheetBuffer<NCh>> sheets;
-    sheets.reserve(ring);
-    for (std::uint32_t k = 0; k < ring; ++k) sheets.emplace_back(ox, oy, acc.width(), acc.height());
-    std::vector<SheetBuffer<NCh>*> target(ring);
-    std::uint32_t next = bins.begin[t];
-    const std::uint32_t end = bins.begin[t + 1];
+/// A tile's list of splats as the whole-frame stages made it (projectSplats, binToTiles).
+struct BinnedSplats {
+    const TileInputs& in;
+    int t;
+    std::uint32_t begin() const { return in.bins.begin[t]; }
+    std::uint32_t end() const { return in.bins.begin[t + 1]; }
+    std::uint32_t id(std::uint32_t q) const { return in.bins.splats[q]; }
+    float sx(std::uint32_t q) const { return in.proj.sx[id(q)]; }
+    float sy(std::uint32_t q) const { return in.proj.sy[id(q)]; }
+    PixelRect rect(std::uint32_t q) const { return in.proj.rect[id(q)]; }
+    const footprint::EllipticalFootprint& ellipse(std::uint32_t q) const {
+        return in.proj.ellipse(id(q));
+    }
+};
+
+/// A tile's records of one chunk (chunk_binning.h).
+struct ChunkRecords {
+    const ChunkBins& bins;
+    const SplatProjector& projector;
+    const TileGrid& grid;
+    int t;
+    std::uint32_t begin() const { return bins.begin[t]; }
+    std::uint32_t end() const { return bins.begin[t + 1]; }
+    std::uint32_t id(std::uint32_t q) const { return bins.records[q].id; }
+    float sx(std::uint32_t q) const { return bins.records[q].sx; }
+    float sy(std::uint32_t q) const { return bins.records[q].sy; }
+    const footprint::EllipticalFootprint& ellipse(std::uint32_t q) const {
+        return projector.perspective() ? bins.each[bins.records[q].local] : projector.shared();
+    }
+    PixelRect rect(std::uint32_t q) const {
+        return footprintRect(sx(q), sy(q), ellipse(q), grid.width, grid.height);
+    }
+};
+
+/// The sweep of one tile's list `src` (see the file comment) through a ring of `ring`
+/// sheet buffers of this tile (clean on entry; every sheet is flushed before return).
+template <class Policy, class Cutter, class Source, int NCh = Policy::kChannels>
+void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter, const Source& src,
+               const TileGrid& grid, int t, TileAccumulator& acc, SheetBuffer<NCh>* const* sheets,
+               std::uint32_t ring, const float* tileScale, TileCounters& cnt) {
+    const int ox = (t % grid.tilesX) * grid.tileSize;
+    const int oy = (t / grid.tilesX) * grid.tileSize;
+    SheetBuffer<NCh>* target[kMaxRing];
+    std::uint32_t next = src.begin();
+    const std::uint32_t end = src.end();
+    if (next == end) return;
     // Sweep position (sheet index in visiting order) and the last position that has
     // contributions pending in the ring.
-    std::uint32_t step = cutter.key(bins.splats[next]), pendingEnd = step;
+    std::uint32_t step = cutter.key(src.id(next)), pendingEnd = step;
     bool pending = false;
     while (next < end || pending) {
-        if (!pending) step = std::max(step, cutter.key(bins.splats[next]));  // skip empty sheets
-        for (; next < end && cutter.key(bins.splats[next]) == step; ++next) {
-            const std::uint32_t id = bins.splats[next];
-            const PixelRect r = clipToTile(in.proj.rect[id], bins.grid, t);
+        if (!pending) step = std::max(step, cutter.key(src.id(next)));  // skip empty sheets
+        for (; next < end && cutter.key(src.id(next)) == step; ++next) {
+            const std::uint32_t id = src.id(next);
+            const PixelRect r = clipToTile(src.rect(next), grid, ox, oy);
             if (acc.rectOpaque(r.x0 - ox, r.y0 - oy, r.x1 - ox, r.y1 - oy)) {
                 ++cnt.culled;
                 continue;
             }
             const std::uint32_t n = cutter.span(id);
-            for (std::uint32_t j = 0; j < n; ++j) target[j] = &sheets[(step + j) % ring];
+            for (std::uint32_t j = 0; j < n; ++j) target[j] = sheets[(step + j) % ring];
             float v[NCh];
             splatValues<Policy>(in, id, v);
-            cnt.footprintPixels += cutter.cut(target.data(), id, v, in.proj.sx[id], in.proj.sy[id],
-                                              in.proj.ellipse(id), r);
+            cnt.footprintPixels +=
+                cutter.cut(target, id, v, src.sx(next), src.sy(next), src.ellipse(next), r);
             pendingEnd = std::max(pendingEnd, step + n - 1);
             pending = true;
         }
-        SheetBuffer<NCh>& sheet = sheets[step % ring];
+        SheetBuffer<NCh>& sheet = *sheets[step % ring];
         if (sheet.dirty()) {
             acc.setSheet(step);
             sheet.flush(acc, policy, in.plan.pathLength, tileScale);
@@ -158,6 +194,40 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
             break;
         }
     }
+    if (pending)  // stopped early: leave the ring clean for the next use
+        for (std::uint32_t k = 0; k < ring; ++k) sheets[k]->discard();
+}
+
+/// The tile's part of the perspective path-length scales (empty for orthographic views).
+inline std::vector<float> tilePathScale(const std::vector<float>& pathScale, const TileGrid& g,
+                                        int t) {
+    std::vector<float> tileScale;
+    if (pathScale.empty()) return tileScale;
+    const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
+    const int w = std::min(g.tileSize, g.width - ox), h = std::min(g.tileSize, g.height - oy);
+    tileScale.resize(std::size_t(w) * h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            tileScale[std::size_t(y) * w + x] = pathScale[std::size_t(oy + y) * g.width + ox + x];
+    return tileScale;
+}
+
+inline TileAccumulator makeTileAccumulator(const TileInputs& in, const TileGrid& g, int t,
+                                           bool terminates, bool surface) {
+    const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
+    const int w = std::min(g.tileSize, g.width - ox), h = std::min(g.tileSize, g.height - oy);
+    TileAccumulator acc(w, h, in.settings.order,
+                        terminates ? in.settings.quality.earlyTermination : 0.0, surface);
+    acc.setOrigin(ox, oy, g.width);  // issue 13: per-pixel clip cut
+    return acc;
+}
+
+inline void addCounters(RenderStats* stats, const std::vector<TileCounters>& counters) {
+    for (const auto& c : counters) {
+        stats->footprintPixels += c.footprintPixels;
+        stats->sheets += c.sheets;
+        stats->culledSplats += c.culled;
+    }
 }
 
 /// Runs sweepTile over every tile in parallel and writes the tiles into the (partial)
@@ -165,6 +235,7 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
 template <class Policy, class Cutter>
 Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& cutter,
                      RenderStats* stats) {
+    constexpr int NCh = Policy::kChannels;
     const auto start = std::chrono::steady_clock::now();
     const TileGrid& g = in.bins.grid;
     const std::vector<float> pathScale = perspectivePathScale(in.camera, in.plan.normal);
@@ -173,22 +244,20 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
     tbb::parallel_for(0, g.count(), 1, [&](int t) {
         const DenormalsAreZero ftz;  // footprint tails must not hit slow denormal paths
         const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
-        const int w = std::min(g.tileSize, g.width - ox), h = std::min(g.tileSize, g.height - oy);
         constexpr bool surface = kSurfacePolicy<Policy>;  // issue 13: also when clipped
-        TileAccumulator acc(w, h, in.settings.order,
-                            Policy::kTerminates ? in.settings.quality.earlyTermination : 0.0,
-                            surface);
-        acc.setOrigin(ox, oy, g.width);  // issue 13: per-pixel clip cut
+        TileAccumulator acc = makeTileAccumulator(in, g, t, Policy::kTerminates, surface);
         if (in.bins.begin[t] != in.bins.begin[t + 1]) {
-            std::vector<float> tileScale;
-            if (!pathScale.empty()) {
-                tileScale.resize(std::size_t(w) * h);
-                for (int y = 0; y < h; ++y)
-                    for (int x = 0; x < w; ++x)
-                        tileScale[y * w + x] = pathScale[std::size_t(oy + y) * g.width + ox + x];
+            const std::uint32_t ring = in.plan.ring;
+            std::vector<SheetBuffer<NCh>> sheets;
+            sheets.reserve(ring);
+            std::vector<SheetBuffer<NCh>*> ptr(ring);
+            for (std::uint32_t k = 0; k < ring; ++k) {
+                sheets.emplace_back(ox, oy, acc.width(), acc.height());
+                ptr[k] = &sheets.back();
             }
-            sweepTile(in, policy, cutter, t, acc, tileScale.empty() ? nullptr : tileScale.data(),
-                      counters[t]);
+            const std::vector<float> tileScale = tilePathScale(pathScale, g, t);
+            sweepTile(in, policy, cutter, BinnedSplats{in, t}, g, t, acc, ptr.data(), ring,
+                      tileScale.empty() ? nullptr : tileScale.data(), counters[t]);
         }
         acc.resolve(image, ox, oy, in.settings.mode);
         if (surface && in.isoPositions) acc.resolvePositions(*in.isoPositions, ox, oy);
@@ -198,11 +267,100 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
         stats->tilesMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
-        for (const auto& c : counters) {
-            stats->footprintPixels += c.footprintPixels;
-            stats->sheets += c.sheets;
-            stats->culledSplats += c.culled;
-        }
+        addCounters(stats, counters);
+    }
+    return image;
+}
+
+/// Sorts records [first, last) stably by the cutter's sheet key (a counting sort: a chunk
+/// spans few sheets).
+template <class Cutter>
+void sortBySheet(const Cutter& cutter, SplatRecord* first, SplatRecord* last,
+                 std::vector<SplatRecord>& scratch) {
+    if (last - first < 2) return;
+    std::uint32_t lo = cutter.key(first->id), hi = lo;
+    bool sorted = true;
+    for (SplatRecord* r = first + 1; r != last; ++r) {
+        const std::uint32_t k = cutter.key(r->id);
+        sorted &= k >= cutter.key((r - 1)->id);
+        lo = std::min(lo, k);
+        hi = std::max(hi, k);
+    }
+    if (sorted) return;
+    std::vector<std::uint32_t> start(std::size_t(hi - lo) + 2, 0);
+    for (SplatRecord* r = first; r != last; ++r) ++start[cutter.key(r->id) - lo + 1];
+    for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
+    scratch.resize(std::size_t(last - first));
+    for (SplatRecord* r = first; r != last; ++r) scratch[start[cutter.key(r->id) - lo]++] = *r;
+    std::copy(scratch.begin(), scratch.end(), first);
+}
+
+/// Stages "project", "bin" and "tiles" chunk by chunk, front to back (chunk_binning.h): the
+/// tiles keep their compositing state from chunk to chunk, and a chunk's splats are binned
+/// only where that state is not yet opaque.
+template <class Policy, class Cutter>
+Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& cutter,
+                      const SheetChunks& sc, ChunkBins& bins, RenderStats* stats) {
+    constexpr int NCh = Policy::kChannels;
+    using Clock = std::chrono::steady_clock;
+    auto ms = [](Clock::time_point a, Clock::time_point b) {
+        return std::chrono::duration<double, std::milli>(b - a).count();
+    };
+    const TileGrid g(in.camera.width(), in.camera.height(), in.settings.quality.tileSize);
+    const SplatProjector projector(in.scene.splats, in.camera, in.scene.volume->spacing,
+                                   in.scene.kernel.radius());
+    const std::vector<float> pathScale = perspectivePathScale(in.camera, in.plan.normal);
+    constexpr bool surface = kSurfacePolicy<Policy>;
+    const bool cull = Policy::kTerminates && in.settings.order == CompositeOrder::FrontToBack &&
+                      in.settings.quality.earlyTermination > 0;
+    std::vector<TileAccumulator> tiles;
+    tiles.reserve(std::size_t(g.count()));
+    for (int t = 0; t < g.count(); ++t)
+        tiles.push_back(makeTileAccumulator(in, g, t, Policy::kTerminates, surface));
+    std::vector<TileCounters> counters(std::size_t(g.count()));
+    // One clean sheet per worker thread, moved to the tile it sweeps (a sweep leaves it clean).
+    tbb::enumerable_thread_specific<std::unique_ptr<SheetBuffer<NCh>>> scratch;
+    double binMs = 0, tilesMs = 0;
+    std::size_t hidden = 0;
+    tbb::enumerable_thread_specific<std::vector<SplatRecord>> sortScratch;
+    for (std::size_t c = 0; c < sc.count; ++c) {
+        const auto t0 = Clock::now();
+        sc.gather(c, bins.ids, bins.runs);
+        hidden += binChunk(projector, VisitOrder{&bins.ids, bins.ids.size(), false}, bins.runs, g,
+                           tiles, cull, bins);
+        const auto t1 = Clock::now();
+        tbb::parallel_for(0, g.count(), 1, [&](int t) {
+            if (bins.begin[t] == bins.begin[t + 1]) return;
+            const DenormalsAreZero ftz;
+            const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
+            sortBySheet(cutter, &bins.records[bins.begin[t]], &bins.records[bins.begin[t + 1]],
+                        sortScratch.local());
+            TileAccumulator& acc = tiles[std::size_t(t)];
+            std::unique_ptr<SheetBuffer<NCh>>& sheet = scratch.local();
+            if (!sheet) sheet = std::make_unique<SheetBuffer<NCh>>(ox, oy, g.tileSize, g.tileSize);
+            sheet->moveTo(ox, oy, acc.width(), acc.height());
+            SheetBuffer<NCh>* ring[1] = {sheet.get()};
+            const std::vector<float> tileScale = tilePathScale(pathScale, g, t);
+            sweepTile(in, policy, cutter, ChunkRecords{bins, projector, g, t}, g, t, acc, ring, 1,
+                      tileScale.empty() ? nullptr : tileScale.data(), counters[std::size_t(t)]);
+        });
+        binMs += ms(t0, t1);
+        tilesMs += ms(t1, Clock::now());
+    }
+    const auto t2 = Clock::now();
+    Image image(g.width, g.height);
+    tbb::parallel_for(0, g.count(), 1, [&](int t) {
+        const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
+        tiles[std::size_t(t)].resolve(image, ox, oy, in.settings.mode);
+        if (surface && in.isoPositions)
+            tiles[std::size_t(t)].resolvePositions(*in.isoPositions, ox, oy);
+    });
+    if (stats) {
+        stats->pathScalePixels = pathScale.size();
+        stats->binMs = binMs;  // projection and binning of the chunks
+        stats->tilesMs = tilesMs + ms(t2, Clock::now());
+        stats->culledSplats += hidden;
+        addCounters(stats, counters);
     }
     return image;
 }
@@ -210,8 +368,17 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
 /// rasterizeTiles with the compositing policy of the frame's mode.
 template <class Cutter>
 Image rasterizeWithPolicy(const TileInputs& in, const Cutter& cutter, RenderStats* stats) {
-    return withPolicy(in.policy,
-                      [&](const auto& policy) { return rasterizeTiles(in, policy, cutter, stats); });
+    return withPolicy(
+        in.policy, [&](const auto& policy) { return rasterizeTiles(in, policy, cutter, stats); });
+}
+
+/// rasterizeChunks with the compositing policy of the frame's mode.
+template <class Cutter>
+Image rasterizeChunksWithPolicy(const TileInputs& in, const Cutter& cutter, const SheetChunks& sc,
+                                ChunkBins& bins, RenderStats* stats) {
+    return withPolicy(in.policy, [&](const auto& policy) {
+        return rasterizeChunks(in, policy, cutter, sc, bins, stats);
+    });
 }
 
 }  // namespace splat

@@ -18,6 +18,7 @@ namespace splat {
 namespace {
 
 constexpr int kBrick = 8;
+constexpr std::size_t kPaletteSize = 65536;  // entries a 16-bit emission index can address
 
 // Post-classification and the transfer-function-free modes need every non-zero voxel
 // whose neighbourhood can become visible. A brick is needed when the transfer function
@@ -85,10 +86,11 @@ void shadeEmission(const SplatList& s, const Shading& sh, const glm::dvec3& view
                               const LightTerms t =
                                   hasNormals ? blinnPhong(sh, light, s.nx[q], s.ny[q], s.nz[q])
                                              : LightTerms{sh.ambient + sh.diffuse, sh.specular};
-                              const float spec = t.specular * s.extinction[q];
-                              r[q] = s.r[q] * t.diffuse + spec;
-                              g[q] = s.g[q] * t.diffuse + spec;
-                              b[q] = s.b[q] * t.diffuse + spec;
+                              const glm::vec4 e = s.emission(q);
+                              const float spec = t.specular * e.x;
+                              r[q] = e.y * t.diffuse + spec;
+                              g[q] = e.z * t.diffuse + spec;
+                              b[q] = e.w * t.diffuse + spec;
                           }
                       });
 }
@@ -150,8 +152,28 @@ float maxGradientMagnitude(const Volume& v) {
         [](float a, float b) { return std::max(a, b); });
 }
 
+void SplatList::expandEmission() {
+    if (!paletted()) return;
+    const std::size_t n = size();
+    for (auto* a : {&extinction, &r, &g, &b}) a->resize(n);
+    for (std::size_t q = 0; q < n; ++q) {
+        const glm::vec4 e = palette[emissionIndex[q]];
+        extinction[q] = e.x;
+        r[q] = e.y;
+        g[q] = e.z;
+        b[q] = e.w;
+    }
+    palette.clear();
+    std::vector<std::uint16_t>().swap(emissionIndex);
+}
+
 std::size_t SplatList::bytes() const {
-    return size() * (3 * sizeof(float) + 3 * sizeof(std::uint16_t) + 5 * sizeof(float));
+    std::size_t total = 0;
+    for (const auto* a : {&i, &j, &k, &emissionIndex}) total += a->size() * sizeof(std::uint16_t);
+    total += palette.size() * sizeof(glm::vec4);
+    for (const auto* a : {&density, &extinction, &r, &g, &b, &nx, &ny, &nz, &gx, &gy, &gz, &label})
+        total += a->size() * sizeof(float);
+    return total;
 }
 
 SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
@@ -213,20 +235,64 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
 
     // Two passes over z-slices (count, then fill) keep the list in (k, j, i) order for
     // any thread count.
+    // Emission depends on the value alone unless edge enhancement scales it per voxel: then
+    // the distinct kept values (gathered by the count pass) may index a palette.
+    const bool byValue = options.compactEmission && !edges;
+    std::vector<std::vector<float>> sliceValues(byValue ? std::size_t(d.z) : 0);
     std::vector<std::size_t> count(std::size_t(d.z) + 1, 0);
     tbb::parallel_for(0, d.z, [&](int k) {
         std::size_t n = 0;
+        std::vector<float> values;
         for (int j = 0; j < d.y; ++j)
-            for (int i = 0; i < d.x; ++i) n += keep(i, j, k, volume.at(i, j, k));
+            for (int i = 0; i < d.x; ++i) {
+                const float value = volume.at(i, j, k);
+                if (!keep(i, j, k, value)) continue;
+                ++n;
+                if (byValue && (values.empty() || values.back() != value)) values.push_back(value);
+            }
+        if (byValue) {
+            std::sort(values.begin(), values.end());
+            values.erase(std::unique(values.begin(), values.end()), values.end());
+            sliceValues[std::size_t(k)] = std::move(values);
+        }
         count[std::size_t(k) + 1] = n;
     });
     for (int k = 0; k < d.z; ++k) count[std::size_t(k) + 1] += count[std::size_t(k)];
+    std::vector<float> distinct;
+    for (auto& v : sliceValues) {
+        distinct.insert(distinct.end(), v.begin(), v.end());
+        std::vector<float>().swap(v);
+        if (distinct.size() > (std::size_t(1) << 20)) {  // keep the merge small
+            std::sort(distinct.begin(), distinct.end());
+            distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+            if (distinct.size() > kPaletteSize) break;
+        }
+    }
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    const bool paletted = byValue && count.back() > 0 && distinct.size() <= kPaletteSize;
+    // (rho, e) of a voxel of value `value` (its edge factor, if any, applied by the caller).
+    auto emissionOf = [&](float value) {
+        if (!(usesTf && intensity)) return glm::vec4(0.0f);
+        const glm::vec4 c = tf.sample(value);
+        const float rho = tf.extinctionFromOpacity(c.a);
+        return glm::vec4(rho, c.r * rho, c.g * rho, c.b * rho);
+    };
 
     SplatList s;
     s.gradientScale = maxGradient;
     const std::size_t n = count.back();
     s.voxels = volume.voxelCount();
-    for (auto* a : {&s.x, &s.y, &s.z, &s.density, &s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
+    s.origin = volume.origin;
+    s.spacing = volume.spacing;
+    s.density.resize(n);
+    if (paletted) {
+        s.palette.resize(distinct.size());
+        for (std::size_t q = 0; q < distinct.size(); ++q) s.palette[q] = emissionOf(distinct[q]);
+        s.emissionIndex.resize(n);
+    } else {
+        for (auto* a : {&s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
+    }
     for (auto* a : {&s.i, &s.j, &s.k}) a->resize(n);
     if (normals)
         for (auto* a : {&s.nx, &s.ny, &s.nz}) a->resize(n);
@@ -239,25 +305,27 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
             for (int i = 0; i < d.x; ++i) {
                 const float value = volume.at(i, j, k);
                 if (!keep(i, j, k, value)) continue;
-                const glm::dvec3 w = volume.world(glm::dvec3(i, j, k));
-                s.x[o] = float(w.x);
-                s.y[o] = float(w.y);
-                s.z[o] = float(w.z);
                 s.i[o] = std::uint16_t(i);
                 s.j[o] = std::uint16_t(j);
                 s.k[o] = std::uint16_t(k);
                 s.density[o] = value;
                 if (labelled) s.label[o] = float(shown[volume.index(i, j, k)]);
-                if (usesTf && intensity) {
-                    const glm::vec4 c = tf.sample(value);
-                    float rho = tf.extinctionFromOpacity(c.a);
-                    if (edges) rho *= edgeOf(i, j, k);
-                    s.extinction[o] = rho;
-                    s.r[o] = c.r * rho;
-                    s.g[o] = c.g * rho;
-                    s.b[o] = c.b * rho;
+                if (paletted) {
+                    s.emissionIndex[o] =
+                        std::uint16_t(std::lower_bound(distinct.begin(), distinct.end(), value) -
+                                      distinct.begin());
                 } else {
-                    s.extinction[o] = s.r[o] = s.g[o] = s.b[o] = 0.0f;
+                    glm::vec4 e = emissionOf(value);
+                    if (edges && e.x != 0.0f) {
+                        const float f = edgeOf(i, j, k);
+                        const glm::vec4 c = tf.sample(value);
+                        e.x *= f;
+                        e = glm::vec4(e.x, c.r * e.x, c.g * e.x, c.b * e.x);
+                    }
+                    s.extinction[o] = e.x;
+                    s.r[o] = e.y;
+                    s.g[o] = e.z;
+                    s.b[o] = e.w;
                 }
                 if (normals) {
                     const glm::dvec3 n = normalAt(volume, i, j, k);

@@ -126,6 +126,7 @@ Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
     options.gradients = needsGradients();
     if (s.mode == RenderMode::Dvr) options.edges = s.edges;
     options.clipping = s.clipping;
+    options.compactEmission = true;
     if (s.labels.enabled) {
         if (s.mode != RenderMode::Dvr || s.classification != Classification::Pre)
             throw Error(
@@ -148,22 +149,43 @@ Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
     }
 }
 
-const std::vector<std::uint32_t>& Scene::Impl::sliceOrder(int axis) const {
+const Scene::Impl::SliceOrder& Scene::Impl::sliceOrder(int axis) const {
     std::lock_guard<std::mutex> lock(lazyMutex_);
     if (!sliceOrder_[axis]) {
         const std::vector<std::uint16_t>& index =
             axis == 0 ? splats.i : (axis == 1 ? splats.j : splats.k);
-        auto order = std::make_unique<std::vector<std::uint32_t>>();
-        if (axis == 2) {  // the list is in (k, j, i) order already
-            order->resize(index.size());
-            for (std::size_t n = 0; n < index.size(); ++n) (*order)[n] = std::uint32_t(n);
-        } else {
-            orderByKey(std::vector<std::uint32_t>(index.begin(), index.end()),
-                       std::uint32_t(volume->dims[axis]), nullptr, *order);
+        auto o = std::make_unique<SliceOrder>();
+        // Counting sort on the 16-bit slice indices (no widened copy of the keys).
+        o->start.assign(std::size_t(volume->dims[axis]) + 1, 0);
+        for (std::uint16_t q : index) ++o->start[std::size_t(q) + 1];
+        for (std::size_t q = 1; q < o->start.size(); ++q) o->start[q] += o->start[q - 1];
+        if (axis != 2) {  // axis 2: the list is in (k, j, i) order already
+            std::vector<std::uint32_t> next(o->start.begin(), o->start.end() - 1);
+            o->order.resize(index.size());
+            for (std::size_t n = 0; n < index.size(); ++n)
+                o->order[next[index[n]]++] = std::uint32_t(n);
         }
-        sliceOrder_[axis] = std::move(order);
+        sliceOrder_[axis] = std::move(o);
     }
     return *sliceOrder_[axis];
+}
+
+const std::vector<std::uint32_t>& Scene::Impl::cellStarts() const {
+    std::lock_guard<std::mutex> lock(lazyMutex_);
+    if (!cellStarts_) {
+        const std::size_t cx = std::size_t(cellsX()),
+                          rows = std::size_t(volume->dims.y) * volume->dims.z;
+        auto start = std::make_unique<std::vector<std::uint32_t>>(rows * cx + 1, 0);
+        std::vector<std::uint32_t>& st = *start;
+        const std::size_t n = splats.size();
+        for (std::size_t q = 0; q < n; ++q) {
+            const std::size_t row = std::size_t(splats.k[q]) * volume->dims.y + splats.j[q];
+            ++st[row * cx + splats.i[q] / kCellWidth + 1];
+        }
+        for (std::size_t c = 1; c < st.size(); ++c) st[c] += st[c - 1];
+        cellStarts_ = std::move(start);
+    }
+    return *cellStarts_;
 }
 
 const footprint::SlabTable& Scene::Impl::slabTable() const {
@@ -184,8 +206,15 @@ const ReferenceField& Scene::Impl::referenceField() const {
     std::lock_guard<std::mutex> lock(lazyMutex_);
     if (!field_) {
         validateReferenceKernel(kernel);
-        field_ = std::make_shared<ReferenceField>(*volume, splats, kernel,
-                                                  fieldLayout(settings, splats));
+        if (splats.paletted()) {  // the field reads the emission arrays: a full copy
+            SplatList full = splats;
+            full.expandEmission();
+            field_ = std::make_shared<ReferenceField>(*volume, full, kernel,
+                                                      fieldLayout(settings, full));
+        } else {
+            field_ = std::make_shared<ReferenceField>(*volume, splats, kernel,
+                                                      fieldLayout(settings, splats));
+        }
     }
     return *field_;
 }

@@ -11,6 +11,7 @@
 #include "footprint/footprint_table.h"
 #include "footprint/kernel.h"
 #include "footprint/slab_table.h"
+#include "frame/chunk_binning.h"
 #include "frame/projection.h"
 #include "frame/tile_binning.h"
 #include "frame/transfer_table.h"
@@ -28,6 +29,8 @@ struct FrameWorkspace {
     std::vector<std::uint32_t> order;             ///< visiting order of the splats
     std::vector<std::uint32_t> key, first, last;  ///< per splat, splatter-specific
     std::vector<float> r, g, b;                   ///< shaded emission of this view
+    SheetChunks chunks;                           ///< streaming splatters: visiting order
+    ChunkBins chunkBins;                          ///< streaming splatters: one chunk's lists
 };
 
 struct Scene::Impl {
@@ -60,8 +63,28 @@ struct Scene::Impl {
                settings.classification == Classification::Post &&
                (settings.shading.enabled || settings.edges.enabled());
     }
-    /// Splat indices ordered (stably) by slice index along `axis`, made on first use.
-    const std::vector<std::uint32_t>& sliceOrder(int axis) const;
+    /// Splats ordered (stably) by slice index along `axis`, made on first use: `order`
+    /// lists the splat indices (empty for axis 2: the list is in (k, j, i) order already, so
+    /// the order is the identity and is not stored) and slice q holds positions
+    /// [start[q], start[q + 1]) of the order.
+    struct SliceOrder {
+        std::vector<std::uint32_t> order;
+        std::vector<std::uint32_t> start;
+        std::uint32_t at(std::size_t n) const {
+            return order.empty() ? std::uint32_t(n) : order[n];
+        }
+        const std::vector<std::uint32_t>* base() const { return order.empty() ? nullptr : &order; }
+    };
+    const SliceOrder& sliceOrder(int axis) const;
+    /// The list cut into cells of kCellWidth voxels along i within each row (k, j): cell
+    /// (k * dims.y + j) * cellsX + c holds the splats of row (k, j) with i in
+    /// [c kCellWidth, (c + 1) kCellWidth), at list positions [start[cell], start[cell + 1])
+    /// (the list is in (k, j, i) order, so cells are consecutive). Made on first use: the
+    /// axis-aligned splatter reads any slab of kCellWidth slices along any axis from it in
+    /// runs of consecutive splats, without a sorted copy of the list per axis.
+    static constexpr int kCellWidth = 8;
+    int cellsX() const { return (volume->dims.x + kCellWidth - 1) / kCellWidth; }
+    const std::vector<std::uint32_t>& cellStarts() const;
     /// The slab-section table of the image-aligned splatter, made on first use.
     const footprint::SlabTable& slabTable() const;
     /// The dense field of the reference ray caster (unshaded scenes), made on first use.
@@ -72,7 +95,8 @@ struct Scene::Impl {
 
   private:
     mutable std::mutex lazyMutex_, poolMutex_;
-    mutable std::unique_ptr<std::vector<std::uint32_t>> sliceOrder_[3];
+    mutable std::unique_ptr<SliceOrder> sliceOrder_[3];
+    mutable std::unique_ptr<std::vector<std::uint32_t>> cellStarts_;
     mutable std::unique_ptr<footprint::SlabTable> slabTable_;
     mutable std::shared_ptr<const ReferenceField> field_;
     mutable std::vector<std::unique_ptr<FrameWorkspace>> pool_;

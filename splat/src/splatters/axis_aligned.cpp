@@ -5,6 +5,7 @@
 // its slice, and the sheets are composited in visibility order. When the major axis
 // changes (at 45 degrees for isotropic voxels) the sheets change orientation: that is the
 // popping artifact the image-aligned splatter removes.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -127,24 +128,55 @@ class AxisAligned final : public Splatter {
         plan.pathLength = float(volume.spacing[m] / std::abs(camera.view[m]));
         plan.normal = glm::dvec3(0.0);
         plan.normal[m] = 1.0;
-        // Visiting order: by slice, in visibility order for the compositing direction.
-        const std::vector<std::uint32_t>& bySlice = scene.sliceOrder(m);
-        work.order.resize(bySlice.size());
-        const std::size_t n = bySlice.size();
-        for (std::size_t q = 0; q < n; ++q) work.order[q] = bySlice[plan.ascending ? q : n - 1 - q];
+        // Visiting order: slabs of kCellWidth slices in visibility order for the compositing
+        // direction, each read from the scene's cells in runs of consecutive splats (no sorted
+        // copy of the list); binning sorts each tile's records by slice.
+        const Scene::Impl& sc = scene;
+        const std::vector<std::uint32_t>& cells = scene.cellStarts();
+        constexpr int kWidth = Scene::Impl::kCellWidth;
+        const std::size_t slabs = (plan.sheets + kWidth - 1) / kWidth;
+        const bool ascending = plan.ascending;
+        work.chunks.count = slabs;
+        work.chunks.gather = [&sc, &cells, m, slabs, ascending](std::size_t c,
+                                                                std::vector<std::uint32_t>& ids,
+                                                                std::vector<std::uint32_t>& runs) {
+            const glm::ivec3 d = sc.volume->dims;
+            const std::size_t slab = ascending ? c : slabs - 1 - c, cx = std::size_t(sc.cellsX());
+            const std::size_t q0 = slab * kWidth, q1 = std::min<std::size_t>(q0 + kWidth, d[m]);
+            ids.clear();
+            runs.assign(1, 0);
+            // One run per non-empty cell: its splats lie on one row between its first and last.
+            auto add = [&](std::size_t cell) {
+                if (cells[cell] == cells[cell + 1]) return;
+                for (std::size_t q = cells[cell]; q < cells[cell + 1]; ++q)
+                    ids.push_back(std::uint32_t(q));
+                runs.push_back(std::uint32_t(ids.size()));
+            };
+            const std::size_t ny = std::size_t(d.y), rows = ny * std::size_t(d.z);
+            if (m == 2) {
+                for (std::size_t cell = q0 * ny * cx; cell < q1 * ny * cx; ++cell) add(cell);
+            } else if (m == 1) {
+                for (std::size_t k = 0; k < std::size_t(d.z); ++k)
+                    for (std::size_t cell = (k * ny + q0) * cx; cell < (k * ny + q1) * cx; ++cell)
+                        add(cell);
+            } else {
+                for (std::size_t r = 0; r < rows; ++r) add(r * cx + slab);
+            }
+        };
         stats.sheetAxis = m;
         stats.sheetSign = sa.sign;
         return plan;
     }
 
-    Image rasterize(const TileInputs& in, const FrameWorkspace&,
-                    RenderStats* stats) const override {
+    bool streams() const override { return true; }
+
+    Image rasterize(const TileInputs& in, FrameWorkspace& work, RenderStats* stats) const override {
         const SplatList& s = in.scene.splats;
         const int m = in.plan.axis;
         const WholeFootprints cutter{m == 0 ? s.i : (m == 1 ? s.j : s.k), in.plan.ascending,
                                      in.plan.sheets, in.scene.table,
                                      in.scene.poly ? &*in.scene.poly : nullptr};
-        return rasterizeWithPolicy(in, cutter, stats);
+        return rasterizeChunksWithPolicy(in, cutter, work.chunks, work.chunkBins, stats);
     }
 };
 

@@ -188,7 +188,7 @@ class ImageAligned final : public Splatter {
         // Within a slab, splats are visited in slice order along the major axis, which keeps
         // the accesses to the splat arrays coherent.
         const int m = sheetAxis(camera.view, scene.volume->spacing).axis;
-        orderByKey(work.key, slabs, &scene.sliceOrder(m), work.order);
+        orderByKey(work.key, slabs, scene.sliceOrder(m).base(), work.order);
         SheetPlan plan;
         plan.sheets = slabs;
         plan.ring = std::uint32_t(span);
@@ -200,8 +200,7 @@ class ImageAligned final : public Splatter {
         return plan;
     }
 
-    Image rasterize(const TileInputs& in, const FrameWorkspace& work,
-                    RenderStats* stats) const override {
+    Image rasterize(const TileInputs& in, FrameWorkspace& work, RenderStats* stats) const override {
         const SlabSections cutter{in,
                                   work.key,
                                   work.first,

@@ -14,14 +14,19 @@ namespace splat {
 class Splatter {
   public:
     virtual ~Splatter() = default;
-    /// Stage "order": writes the visiting order into work.order (and any per-splat keys
-    /// the splatter needs) and returns the view's sheet plan.
+    /// Stage "order": writes the visiting order into work.order, or work.chunks when it
+    /// streams (and any per-splat keys the splatter needs), and returns the view's sheet
+    /// plan. A splatter that does not stream finds work.proj projected.
     virtual SheetPlan order(const Scene::Impl& scene, const Camera& camera,
                             const RenderSettings& settings, FrameWorkspace& work,
                             RenderStats& stats) const = 0;
     /// Stage "tiles": the tile sweep with this splatter's Cutter, into a partial image.
-    virtual Image rasterize(const TileInputs& in, const FrameWorkspace& work,
+    virtual Image rasterize(const TileInputs& in, FrameWorkspace& work,
                             RenderStats* stats) const = 0;
+    /// True when the splatter projects and bins its splats itself, chunk by chunk front to
+    /// back inside `rasterize` (work.chunks), skipping splats hidden by then; the frame
+    /// then runs no whole-frame "project" and "bin" stages (their times are in binMs).
+    virtual bool streams() const { return false; }
 };
 
 const Splatter& axisAlignedSplatter();
