@@ -64,8 +64,7 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
     addOption(cmd, "--nan-policy", args.nanPolicy,
               "NaN/Inf samples: 'error' refuses the volume, 'zero' replaces them by 0", g);
     addFlag(cmd, "--allow-outside-data", args.allowOutsideData,
-            "NRRD/MetaImage: allow data files outside the header's folder (absolute paths, ..)",
-            g);
+            "NRRD/MetaImage: allow data files outside the header's folder (absolute paths, ..)", g);
     addOption(cmd, "--series", args.series,
               "DICOM: the SeriesInstanceUID to load when a folder holds several (`splat info "
               "FOLDER` lists them)",
