@@ -1,7 +1,8 @@
 // bench_accuracy: the splatters against the reference ray caster of the same model.
 //
 //   bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] [--classify pre|post]
-//                  [--azimuths 0,30,45] [--early-termination EPS]
+//                  [--azimuths 0,30,45] [--elevation E] [--early-termination EPS]
+//                  [--lod L]
 //
 // VOLUME defaults to synthetic:phantom:64, TF to ct-soft. For each azimuth renders the
 // reference, the axis-aligned splatter and the image-aligned splatter with slabs of 1, 0.5
@@ -9,6 +10,8 @@
 // max abs difference against the reference, with milliseconds per frame (the Renderer is
 // built once per configuration; the time is that of render() alone). The splatters use the
 // default front-to-back early termination (1/256) unless --early-termination says otherwise.
+// --lod L adds the axis-aligned and slab-1 image-aligned splatters at level of detail L
+// (Quality::lod) and their level; RMSE ratio = their RMSE over the full-resolution one's.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -30,6 +33,7 @@ struct Config {
     std::string label;
     RendererKind kind;
     double slab;
+    double lod = 0;
 };
 
 std::vector<double> parseList(const std::string& s) {
@@ -43,7 +47,8 @@ std::vector<double> parseList(const std::string& s) {
 void usage() {
     std::fprintf(stderr,
                  "usage: bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] "
-                 "[--classify pre|post] [--azimuths 0,30,45] [--early-termination EPS]\n");
+                 "[--classify pre|post] [--azimuths 0,30,45] [--elevation E] "
+                 "[--early-termination EPS] [--lod L]\n");
 }
 
 }  // namespace
@@ -53,7 +58,7 @@ int main(int argc, char** argv) {
         std::string volumeSpec = "synthetic:phantom:64", tf = "ct-soft", mode = "dvr",
                     classify = "pre";
         int size = 256;
-        double earlyTermination = -1;
+        double earlyTermination = -1, lod = 0, elevation = 0;
         std::vector<double> azimuths = {0, 30, 45};
         std::vector<std::string> positional;
         for (int a = 1; a < argc; ++a) {
@@ -72,6 +77,10 @@ int main(int argc, char** argv) {
                 azimuths = parseList(value());
             else if (arg == "--early-termination")
                 earlyTermination = std::stod(value());
+            else if (arg == "--lod")
+                lod = std::stod(value());
+            else if (arg == "--elevation")
+                elevation = std::stod(value());
             else if (arg == "-h" || arg == "--help") {
                 usage();
                 return 0;
@@ -98,12 +107,20 @@ int main(int argc, char** argv) {
         base.classification = classify == "post" ? Classification::Post : Classification::Pre;
         base.transfer = TransferFunction::load(tf).resolved(vs.minValue, vs.maxValue);
         base.camera.width = base.camera.height = size;
+        base.camera.elevationDeg = elevation;
         if (earlyTermination >= 0) base.quality.earlyTermination = earlyTermination;
 
-        const std::vector<Config> configs = {{"axis", RendererKind::Axis, 1.0},
-                                             {"sheet, slab 1", RendererKind::Sheet, 1.0},
-                                             {"sheet, slab 0.5", RendererKind::Sheet, 0.5},
-                                             {"sheet, slab 0.25", RendererKind::Sheet, 0.25}};
+        std::vector<Config> configs = {{"axis", RendererKind::Axis, 1.0},
+                                       {"sheet, slab 1", RendererKind::Sheet, 1.0},
+                                       {"sheet, slab 0.5", RendererKind::Sheet, 0.5},
+                                       {"sheet, slab 0.25", RendererKind::Sheet, 0.25}};
+        if (lod > 0) {
+            char label[64];
+            std::snprintf(label, sizeof label, "axis, lod %g", lod);
+            configs.insert(configs.begin() + 1, {label, RendererKind::Axis, 1.0, lod});
+            std::snprintf(label, sizeof label, "sheet, slab 1, lod %g", lod);
+            configs.insert(configs.begin() + 3, {label, RendererKind::Sheet, 1.0, lod});
+        }
         std::printf(
             "Accuracy against the reference ray caster: %s, %dx%d, %s %s, transfer "
             "function %s, default kernel and reference settings (step %g voxels, "
@@ -131,17 +148,24 @@ int main(int argc, char** argv) {
                 RenderSettings s = base;
                 s.renderer = c.kind;
                 s.quality.slab = c.slab;
+                s.quality.lod = c.lod;
                 s.camera.azimuthDeg = az;
                 const Renderer renderer(volume, s);
-                renderer.render();  // warm-up (first-touch allocations)
+                renderer.render();  // warm-up (first-touch allocations, the level of detail)
+                RenderStats st;
                 const auto a = std::chrono::steady_clock::now();
-                const Image im = renderer.render();
+                const Image im = renderer.render(&st);
                 const double ms =
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a)
                         .count();
                 const ImageMetrics m = compareImages(im, ref);
-                std::printf("| %g | %s | %.3g | %.1f | %.3g | %.1f |\n", az, c.label.c_str(),
-                            m.rmse, m.psnr, m.maxAbs, ms);
+                std::printf(
+                    "| %g | %s | %.3g | %.1f | %.3g | %.1f |\n", az,
+                    (c.label + (st.lodLevel ? " (level " + std::to_string(st.lodLevel) + ", " +
+                                                  std::to_string(st.lodSplats) + " splats)"
+                                            : ""))
+                        .c_str(),
+                    m.rmse, m.psnr, m.maxAbs, ms);
                 std::fflush(stdout);
             }
         }
