@@ -2,7 +2,7 @@
 //
 //   bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] [--classify pre|post]
 //                  [--azimuths 0,30,45] [--elevation E] [--early-termination EPS]
-//                  [--lod L]
+//                  [--lod L] [--supersample N]
 //
 // VOLUME defaults to synthetic:phantom:64, TF to ct-soft. For each azimuth renders the
 // reference, the axis-aligned splatter and the image-aligned splatter with slabs of 1, 0.5
@@ -11,7 +11,9 @@
 // built once per configuration; the time is that of render() alone). The splatters use the
 // default front-to-back early termination (1/256) unless --early-termination says otherwise.
 // --lod L adds the axis-aligned and slab-1 image-aligned splatters at level of detail L
-// (Quality::lod) and their level; RMSE ratio = their RMSE over the full-resolution one's.
+// (Quality::lod) and their level. --supersample N renders the reference with N x N rays per
+// pixel (at N times the size) and box-filters it: the pixel's area average rather than its
+// centre's value.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -48,7 +50,7 @@ void usage() {
     std::fprintf(stderr,
                  "usage: bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] "
                  "[--classify pre|post] [--azimuths 0,30,45] [--elevation E] "
-                 "[--early-termination EPS] [--lod L]\n");
+                 "[--early-termination EPS] [--lod L] [--supersample N]\n");
 }
 
 }  // namespace
@@ -57,7 +59,7 @@ int main(int argc, char** argv) {
     try {
         std::string volumeSpec = "synthetic:phantom:64", tf = "ct-soft", mode = "dvr",
                     classify = "pre";
-        int size = 256;
+        int size = 256, supersample = 1;
         double earlyTermination = -1, lod = 0, elevation = 0;
         std::vector<double> azimuths = {0, 30, 45};
         std::vector<std::string> positional;
@@ -77,6 +79,8 @@ int main(int argc, char** argv) {
                 azimuths = parseList(value());
             else if (arg == "--early-termination")
                 earlyTermination = std::stod(value());
+            else if (arg == "--supersample")
+                supersample = std::stoi(value());
             else if (arg == "--lod")
                 lod = std::stod(value());
             else if (arg == "--elevation")
@@ -97,6 +101,8 @@ int main(int argc, char** argv) {
         if (positional.size() > 0) volumeSpec = positional[0];
         if (positional.size() > 1) tf = positional[1];
         if (size < 1) throw std::runtime_error("--size must be >= 1");
+        if (supersample < 1 || supersample > 16)
+            throw std::runtime_error("--supersample must be between 1 and 16");
 
         const Volume volume = loadVolume(volumeSpec);
         const VolumeStats vs = volumeStats(volume);
@@ -124,9 +130,10 @@ int main(int argc, char** argv) {
         std::printf(
             "Accuracy against the reference ray caster: %s, %dx%d, %s %s, transfer "
             "function %s, default kernel and reference settings (step %g voxels, "
-            "tolerance %g), splatter early termination %g.\n\n",
+            "tolerance %g, %d x %d rays per pixel box-filtered), splatter early termination "
+            "%g.\n\n",
             volumeSpec.c_str(), size, size, mode.c_str(), classify.c_str(), tf.c_str(),
-            base.quality.referenceStep, base.quality.referenceTolerance,
+            base.quality.referenceStep, base.quality.referenceTolerance, supersample, supersample,
             base.quality.earlyTermination);
         std::printf("| azimuth | renderer | RMSE | PSNR (dB) | max abs | ms/frame |\n");
         std::printf("|---:|---|---:|---:|---:|---:|\n");
@@ -135,9 +142,22 @@ int main(int argc, char** argv) {
             rs.renderer = RendererKind::Reference;
             rs.camera.azimuthDeg = az;
             RenderStats refStats;
+            const int n = supersample;
+            if (n > 1) {  // N x N rays per pixel: the same view at N times the size
+                rs.camera.pixelSize = Camera(rs.camera, volume).pixelSize / n;
+                rs.camera.width = rs.camera.height = size * n;
+            }
             const Renderer reference(volume, rs);
             const auto t0 = std::chrono::steady_clock::now();
-            const Image ref = reference.render(&refStats);
+            const Image fine = reference.render(&refStats);
+            Image ref(size, size);
+            for (int y = 0; y < size; ++y)
+                for (int x = 0; x < size; ++x) {
+                    glm::vec4 sum(0.0f);
+                    for (int b = 0; b < n; ++b)
+                        for (int a = 0; a < n; ++a) sum += fine.at(x * n + a, y * n + b);
+                    ref.at(x, y) = sum / float(n * n);
+                }
             const double refMs =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count();
