@@ -37,6 +37,17 @@ TransferFunction timingTransfer() {
     return tf;
 }
 
+/// Pre-classified dvr with the timing transfer function on 2 threads, size^2 pixels.
+RenderSettings timingView(int size, double azimuth, double elevation) {
+    RenderSettings s;
+    s.transfer = timingTransfer();
+    s.threads = 2;
+    s.camera.width = s.camera.height = size;
+    s.camera.azimuthDeg = azimuth;
+    s.camera.elevationDeg = elevation;
+    return s;
+}
+
 /// Largest relative ripple of the footprint summed over a square lattice of `step` voxels,
 /// max over the lattice's offsets u of |sum_p fp(|u - p|^2) step^2 - 1|: an axis-aligned
 /// X-ray pixel inside a constant region sums the columns' footprints on the unit lattice
@@ -310,12 +321,7 @@ TEST_CASE("lod: X-ray and MIP at level 1 are the full splatter of the box-filter
 TEST_CASE("lod: a level is used only while a voxel covers fewer pixels than the threshold",
           "[lod]") {
     const Volume v = makeSynthetic("phantom", 32);
-    RenderSettings s;
-    s.transfer = timingTransfer();
-    s.threads = 2;
-    s.camera.width = s.camera.height = 48;
-    s.camera.azimuthDeg = 20;
-    s.camera.elevationDeg = 10;
+    const RenderSettings s = timingView(48, 20, 10);
     const Scene scene(v, s);
     for (RendererKind kind : {RendererKind::Axis, RendererKind::Sheet})
         for (double pixel : {0.3, 0.7, 1.2, 2.5, 9.0}) {
@@ -371,12 +377,7 @@ TEST_CASE("lod: dvr at level 1 against the reference (the measured cost of the k
     // silhouettes grow and thin shells blur, so its error is far above the full splatter's
     // (README "Level of detail" has the figures at full size).
     const Volume v = makeSynthetic("phantom", 64);
-    RenderSettings s;
-    s.transfer = timingTransfer();
-    s.threads = 2;
-    s.camera.width = s.camera.height = 64;
-    s.camera.azimuthDeg = 30;
-    s.camera.elevationDeg = 15;
+    const RenderSettings s = timingView(64, 30, 15);
     const Scene scene(v, s);
     RenderSettings r = s;
     r.renderer = RendererKind::Reference;
