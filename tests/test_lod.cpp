@@ -351,6 +351,30 @@ TEST_CASE("lod: a level is used only while a voxel covers fewer pixels than the 
                 }
             }
         }
+    // Perspective: the voxel's size at the bounding sphere's nearest depth decides. Fitted
+    // eye, 30 degrees: focal = R / sin 15 = 3.86 R, nearest depth 2.86 R, so a voxel covers
+    // 48 / (2 tan 15 3.86 R) 3.86 / 2.86 = 1.13 pixels there (0.84 at the volume centre).
+    RenderSettings p = s;
+    p.camera.projection = Projection::Perspective;
+    p.camera.fovDeg = 30;
+    const Camera pc(p.camera, v);
+    const double near =
+        48.0 / (2.0 * std::tan(M_PI / 12) * pc.focal) * pc.focal / (pc.focal - pc.boundingRadius);
+    REQUIRE(near == Approx(1.13).epsilon(0.01));
+    for (const auto& [lod, expected] : {std::pair{1.0, 0}, {1.2, 1}, {2.2, 1}, {2.3, 2}}) {
+        p.quality.lod = lod;
+        RenderStats st;
+        scene.render(p, &st);
+        INFO("perspective, lod " << lod);
+        CHECK(st.lodLevel == expected);
+    }
+    // The eye inside the volume: every voxel may be large; the full level (the exact path).
+    p.camera.distance = 5;
+    p.quality.lod = 64;
+    RenderStats inside;
+    scene.render(p, &inside);
+    CHECK(inside.lodLevel == 0);
+    CHECK(inside.exactPixels == 48u * 48u);
     // The reference ray caster ignores the knob.
     RenderSettings r = s;
     r.renderer = RendererKind::Reference;
