@@ -166,7 +166,11 @@ Scene::Impl::Impl(const Impl& fine, Coarser)
 const Scene::Impl* Scene::Impl::coarser() const {
     if (volume->dims == glm::ivec3(1)) return nullptr;
     std::lock_guard<std::mutex> lock(lazyMutex_);
-    if (!coarser_) coarser_ = std::make_unique<Impl>(*this, Coarser{});
+    // Isolated: while this thread waits inside the merge's parallel loop it must not pick up
+    // another frame's task that would ask for this lock again.
+    if (!coarser_)
+        tbb::this_task_arena::isolate(
+            [&] { coarser_ = std::make_unique<Impl>(*this, Coarser{}); });
     return coarser_.get();
 }
 
