@@ -137,31 +137,68 @@ class AxisAligned final : public Splatter {
         const std::size_t slabs = (plan.sheets + kWidth - 1) / kWidth;
         const bool ascending = plan.ascending;
         work.chunks.count = slabs;
-        work.chunks.gather = [&sc, &cells, m, slabs, ascending](std::size_t c,
-                                                                std::vector<std::uint32_t>& ids,
-                                                                std::vector<std::uint32_t>& runs) {
+        work.chunks.gather = [&sc, &cells, m, slabs, ascending,
+                              hidden = std::vector<std::uint8_t>()](
+                                 std::size_t c, std::vector<std::uint32_t>& ids,
+                                 std::vector<std::uint32_t>& runs,
+                                 const BrickTest& visible) mutable {
             const glm::ivec3 d = sc.volume->dims;
             const std::size_t slab = ascending ? c : slabs - 1 - c, cx = std::size_t(sc.cellsX());
             const std::size_t q0 = slab * kWidth, q1 = std::min<std::size_t>(q0 + kWidth, d[m]);
             ids.clear();
             runs.assign(1, 0);
+            // Bricks of kWidth^3 voxels: the slab's kWidth slices times kWidth x kWidth voxels
+            // of the other two axes (u, v), tested as one against the tiles' opacity; the
+            // cells of a hidden brick are left out (hidden[bu + bv * bricksU]). Cells are
+            // still read in the same order, so the image is the same with or without this.
+            const int u = m == 0 ? 1 : 0, v = m == 2 ? 1 : 2;
+            const int bricksU = (d[u] + kWidth - 1) / kWidth,
+                      bricksV = (d[v] + kWidth - 1) / kWidth;
+            hidden.assign(std::size_t(bricksU) * bricksV, 0);
+            if (visible.active())
+                for (int bv = 0; bv < bricksV; ++bv)
+                    for (int bu = 0; bu < bricksU; ++bu) {
+                        glm::ivec3 lo, hi;
+                        lo[m] = int(q0);
+                        hi[m] = int(q1) - 1;
+                        lo[u] = bu * kWidth;
+                        hi[u] = std::min(d[u], lo[u] + kWidth) - 1;
+                        lo[v] = bv * kWidth;
+                        hi[v] = std::min(d[v], lo[v] + kWidth) - 1;
+                        hidden[std::size_t(bv) * bricksU + bu] = !visible(lo, hi);
+                    }
+            auto brickHidden = [&](std::size_t iu, std::size_t iv) {
+                return hidden[iv / kWidth * std::size_t(bricksU) + iu / kWidth] != 0;
+            };
             // One run per non-empty cell: its splats lie on one row between its first and last.
+            std::size_t left = 0;
+            auto skip = [&](std::size_t cell) { left += cells[cell + 1] - cells[cell]; };
             auto add = [&](std::size_t cell) {
                 if (cells[cell] == cells[cell + 1]) return;
                 for (std::size_t q = cells[cell]; q < cells[cell + 1]; ++q)
                     ids.push_back(std::uint32_t(q));
                 runs.push_back(std::uint32_t(ids.size()));
             };
-            const std::size_t ny = std::size_t(d.y), rows = ny * std::size_t(d.z);
-            if (m == 2) {
-                for (std::size_t cell = q0 * ny * cx; cell < q1 * ny * cx; ++cell) add(cell);
-            } else if (m == 1) {
-                for (std::size_t k = 0; k < std::size_t(d.z); ++k)
-                    for (std::size_t cell = (k * ny + q0) * cx; cell < (k * ny + q1) * cx; ++cell)
-                        add(cell);
-            } else {
-                for (std::size_t r = 0; r < rows; ++r) add(r * cx + slab);
+            const std::size_t ny = std::size_t(d.y), nz = std::size_t(d.z);
+            if (m == 2) {  // u = i (cells), v = j
+                for (std::size_t k = q0; k < q1; ++k)
+                    for (std::size_t j = 0; j < ny; ++j)
+                        for (std::size_t ci = 0; ci < cx; ++ci)
+                            brickHidden(ci * kWidth, j) ? skip((k * ny + j) * cx + ci)
+                                                        : add((k * ny + j) * cx + ci);
+            } else if (m == 1) {  // u = i (cells), v = k
+                for (std::size_t k = 0; k < nz; ++k)
+                    for (std::size_t j = q0; j < q1; ++j)
+                        for (std::size_t ci = 0; ci < cx; ++ci)
+                            brickHidden(ci * kWidth, k) ? skip((k * ny + j) * cx + ci)
+                                                        : add((k * ny + j) * cx + ci);
+            } else {  // u = j, v = k; the slab is cell column `slab`
+                for (std::size_t k = 0; k < nz; ++k)
+                    for (std::size_t j = 0; j < ny; ++j)
+                        brickHidden(j, k) ? skip((k * ny + j) * cx + slab)
+                                          : add((k * ny + j) * cx + slab);
             }
+            return left;
         };
         stats.sheetAxis = m;
         stats.sheetSign = sa.sign;
