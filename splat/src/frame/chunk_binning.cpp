@@ -11,7 +11,6 @@ namespace splat {
 namespace {
 // A fixed number of parts (not one per thread) keeps the lists identical for any thread count.
 constexpr std::size_t kParts = 32;
-constexpr int kBlock = 4;  // TileAccumulator's early-termination blocks, pixels
 // A splat records whether it is visible in each of the first kMaskTiles tiles of its box;
 // boxes over more tiles (huge footprints) are binned to all of them unculled.
 constexpr int kMaskTiles = 16;
@@ -45,21 +44,6 @@ Occlusion::Occlusion(const TileGrid& grid, const std::vector<TileAccumulator>& t
                     m |= std::uint64_t(1) << (y * bx + x);
         mask_[std::size_t(t)] = m;
     });
-}
-
-bool Occlusion::visible(const PixelRect& r, int tx, int ty) const {
-    const int t = ty * g_.tilesX + tx;
-    const std::uint64_t m = mask_[std::size_t(t)];
-    if (m == 0) return true;
-    const int ox = tx * g_.tileSize, oy = ty * g_.tileSize;
-    const PixelRect c = clipToTile(r, g_, ox, oy);
-    const int bx0 = (c.x0 - ox) / kBlock, bx1 = (c.x1 - ox) / kBlock;
-    const int by0 = (c.y0 - oy) / kBlock, by1 = (c.y1 - oy) / kBlock;
-    const int bx = blocksX_[std::size_t(t)];
-    const std::uint64_t row = ((std::uint64_t(2) << (bx1 - bx0)) - 1) << bx0;
-    for (int y = by0; y <= by1; ++y)
-        if ((m >> (y * bx) & row) != row) return true;
-    return false;
 }
 
 bool Occlusion::visible(const PixelRect& r) const {

@@ -26,11 +26,25 @@ class Occlusion {
     bool enabled() const { return cull_; }
     /// True unless tile (tx, ty) is opaque over every block the box `r` (image pixels)
     /// touches.
-    bool visible(const PixelRect& r, int tx, int ty) const;
+    bool visible(const PixelRect& r, int tx, int ty) const {
+        const int t = ty * g_.tilesX + tx;
+        const std::uint64_t m = mask_[std::size_t(t)];
+        if (m == 0) return true;
+        const int ox = tx * g_.tileSize, oy = ty * g_.tileSize;
+        const PixelRect c = clipToTile(r, g_, ox, oy);
+        const int bx0 = (c.x0 - ox) / kBlock, bx1 = (c.x1 - ox) / kBlock;
+        const int by0 = (c.y0 - oy) / kBlock, by1 = (c.y1 - oy) / kBlock;
+        const int bx = blocksX_[std::size_t(t)];
+        const std::uint64_t row = ((std::uint64_t(2) << (bx1 - bx0)) - 1) << bx0;
+        for (int y = by0; y <= by1; ++y)
+            if ((m >> (y * bx) & row) != row) return true;
+        return false;
+    }
     /// True unless every tile the (non-empty) box touches is opaque over it.
     bool visible(const PixelRect& r) const;
 
   private:
+    static constexpr int kBlock = 4;  ///< TileAccumulator's early-termination blocks, pixels
     const TileGrid& g_;
     bool cull_;
     std::vector<std::uint64_t> mask_;

@@ -186,9 +186,9 @@ class AxisAligned final : public Splatter {
                         for (std::size_t ci = 0; ci < cx; ++ci)
                             brickHidden(ci * kWidth, j) ? skip((k * ny + j) * cx + ci)
                                                         : add((k * ny + j) * cx + ci);
-            } else if (m == 1) {  // u = i (cells), v = k
-                for (std::size_t k = 0; k < nz; ++k)
-                    for (std::size_t j = q0; j < q1; ++j)
+            } else if (m == 1) {  // u = i (cells), v = k; slice-major: already in sheet order
+                for (std::size_t j = q0; j < q1; ++j)
+                    for (std::size_t k = 0; k < nz; ++k)
                         for (std::size_t ci = 0; ci < cx; ++ci)
                             brickHidden(ci * kWidth, k) ? skip((k * ny + j) * cx + ci)
                                                         : add((k * ny + j) * cx + ci);
