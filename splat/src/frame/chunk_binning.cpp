@@ -72,7 +72,7 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
     if (projector.perspective()) out.each.resize(n);
     out.counts.assign(kParts * tileCount, 0);
     std::vector<std::size_t> hidden(kParts, 0);
-    const bool runBoxes = cull && !projector.perspective();
+    const bool ortho = !projector.perspective(), runBoxes = cull && ortho;
     // Pass 1: project, and count the tiles where each splat is visible. A run (splats of one
     // row, between its first and last) whose box is hidden everywhere is skipped whole.
     tbb::parallel_for(std::size_t(0), kParts, [&](std::size_t c) {
@@ -81,10 +81,13 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
         std::size_t h = 0;
         for (std::size_t run = std::min(runCount, c * runsPerPart); run < re; ++run) {
             const std::size_t a = runs[run], b = runs[run + 1];
+            // Orthographic: the run's positions are affine along its row.
+            const SplatProjector::Row row =
+                ortho ? projector.row(order[a]) : SplatProjector::Row{0, 0, 0, 0};
             if (runBoxes && b - a >= 2) {
                 float xa, ya, xb, yb;
-                projector.project(order[a], xa, ya, nullptr);
-                projector.project(order[b - 1], xb, yb, nullptr);
+                projector.project(row, order[a], xa, ya);
+                projector.project(row, order[b - 1], xb, yb);
                 // Every centre of the run lies between the two ends: one box (widened by a
                 // pixel against rounding) holds all their footprint boxes.
                 footprint::EllipticalFootprint e = projector.shared();
@@ -105,8 +108,8 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
             }
             for (std::size_t q = a; q < b; ++q) {
                 const PixelRect r =
-                    projector.project(order[q], out.sx[q], out.sy[q],
-                                      projector.perspective() ? &out.each[q] : nullptr);
+                    ortho ? projector.project(row, order[q], out.sx[q], out.sy[q])
+                          : projector.project(order[q], out.sx[q], out.sy[q], &out.each[q]);
                 out.rect[q] = r;
                 std::uint32_t bits = 0;
                 if (!r.empty())

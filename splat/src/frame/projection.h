@@ -79,6 +79,26 @@ class SplatProjector {
         return projectPerspective(w, sx, sy, *each);
     }
 
+    /// Orthographic views: the screen positions of the splats on one volume row (that of
+    /// splat `id`) are affine in their index i along the row, x = x0 + i dx, y = y0 + i dy
+    /// (the same positions as project(), to double rounding before the cast to float).
+    struct Row {
+        double x0, y0, dx, dy;
+    };
+    Row row(std::uint32_t id) const {
+        const glm::dvec3 d =
+            splats_.origin +
+            splats_.spacing * glm::dvec3(0.0, double(splats_.j[id]), double(splats_.k[id])) -
+            camera_.eye;
+        return {cx_ + glm::dot(d, rx_), cy_ - glm::dot(d, ry_), splats_.spacing.x * rx_.x,
+                -splats_.spacing.x * ry_.x};
+    }
+    PixelRect project(const Row& row, std::uint32_t id, float& sx, float& sy) const {
+        const double i = double(splats_.i[id]);
+        sx = float(row.x0 + i * row.dx);
+        sy = float(row.y0 + i * row.dy);
+        return footprintRect(sx, sy, shared_, width_, height_);
+    }
     /// Orthographic views: the pixel box holding the footprint boxes of every splat centred
     /// in the index-space box [lo, hi] (voxel positions, inclusive), widened by a pixel
     /// against rounding; empty when none of them reaches the image.
