@@ -104,12 +104,12 @@ inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Polic
         v[4] = 1.0f;  // every splat competes for the pixel's label, the background too
         v[5] = s.label[id];
     } else if constexpr (Policy::kSource == SheetSource::DensityGradient) {
-        v[0] = s.density[id];
+        v[0] = s.densityOf(id);
         v[1] = s.gx[id];
         v[2] = s.gy[id];
         v[3] = s.gz[id];
     } else if constexpr (Policy::kSource == SheetSource::Density) {
-        v[0] = s.density[id];
+        v[0] = s.densityOf(id);
     }
 }
 
