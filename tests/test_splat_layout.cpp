@@ -19,13 +19,19 @@ TEST_CASE("splat list: emission by value equals the per-splat arrays", "[splatte
     REQUIRE(!a.paletted());
     REQUIRE(b.paletted());
     CHECK(b.palette.size() <= 65536);
-    CHECK(b.bytes() < a.bytes());
+    // 6 bytes of index position and a 2-byte palette index per splat (plus the palette),
+    // against 6 + 4 (density) + 16 (emission).
+    CHECK(b.density.empty());
+    CHECK(b.bytes() == 8 * b.size() + 20 * b.palette.size());
+    CHECK(a.bytes() == 26 * a.size());
     for (std::size_t n = 0; n < a.size(); ++n) {
+        REQUIRE(b.densityOf(n) == a.density[n]);
         REQUIRE(b.emission(n) == a.emission(n));  // exactly: the same expression per value
         REQUIRE(b.world(n) == v.world(glm::dvec3(a.i[n], a.j[n], a.k[n])));
     }
     b.expandEmission();
     CHECK(!b.paletted());
+    CHECK(b.density == a.density);
     CHECK(b.extinction == a.extinction);
     CHECK(b.r == a.r);
 }

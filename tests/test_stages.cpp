@@ -94,6 +94,52 @@ TEST_CASE("compositing: over (back to front) equals under (front to back) on ran
     CHECK(c.pixels[0].a == Approx(1.0f).margin(1e-6));
 }
 
+TEST_CASE("compositing: a row of optical depths composites as sampleFromOpticalDepth does",
+          "[stages]") {
+    // The flush of pre-classified sheets composites whole rows (eight lanes with their own
+    // exp where AVX2 is present); against the double-precision closed form per pixel, for
+    // optical depths from 0 through the series/exp switch at 1/2 to 90 (exp underflows),
+    // slightly negative ones (kernels with negative lobes), and row lengths 1..13 (tails).
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const float taus[] = {0.0f, 1e-9f, 1e-4f, 1e-3f, 0.01f, 0.3f,   0.49999f, 0.5f, 0.50001f,
+                          0.9f, 2.0f,  7.5f,  30.0f, 90.0f, -1e-3f, -0.2f,    -0.6f};
+    for (CompositeOrder order : {CompositeOrder::FrontToBack, CompositeOrder::BackToFront})
+        for (int n = 1; n <= 13; ++n) {
+            TileAccumulator acc(16, 2, order, 0.0);
+            std::vector<float> tau(n), er(n), eg(n), eb(n);
+            std::vector<double> R(n, 0.0), A(n, 0.0);
+            for (int step = 0; step < 3; ++step) {
+                for (int i = 0; i < n; ++i) {
+                    tau[i] = taus[(i * 5 + step * 3 + n) % std::size(taus)];
+                    er[i] = u(rng) * std::max(tau[i], 0.0f);
+                    eg[i] = eb[i] = er[i];
+                    const double t = tau[i], alpha = -std::expm1(-t);
+                    const double c = t == 0 ? er[i] : er[i] * alpha / t;
+                    if (order == CompositeOrder::FrontToBack) {
+                        R[i] += (1 - A[i]) * c;
+                        A[i] += (1 - A[i]) * alpha;
+                    } else {
+                        R[i] = c + (1 - alpha) * R[i];
+                        A[i] = alpha + (1 - alpha) * A[i];
+                    }
+                }
+                acc.compositeOpticalDepths(16 + 1, n, tau.data(), er.data(), eg.data(), eb.data());
+            }
+            Image img(16, 2);
+            acc.resolve(img, 0, 0, RenderMode::Dvr);
+            for (int i = 0; i < n; ++i) {
+                INFO("n " << n << " pixel " << i);
+                CHECK(img.at(1 + i, 1).r == Approx(R[i]).epsilon(2e-6).margin(1e-7));
+                CHECK(img.at(1 + i, 1).a == Approx(A[i]).epsilon(2e-6).margin(1e-7));
+            }
+            // Pixels outside the row are untouched.
+            CHECK(img.at(0, 1).a == 0.0f);
+            if (1 + n < 16) CHECK(img.at(1 + n, 1).a == 0.0f);
+            CHECK(img.at(1, 0).a == 0.0f);
+        }
+}
+
 #if defined(FOOTPRINT_HAVE_LANES)
 namespace {
 struct LaneErrors {

@@ -19,21 +19,28 @@ struct SplatList {
     /// The volume's grid: a splat's world position is origin + spacing (i, j, k), computed
     /// when needed (world()) rather than stored beside the index position.
     glm::dvec3 origin{0.0}, spacing{1.0};
-    std::vector<float> density;     ///< d_i
+    std::vector<float> density;     ///< d_i (empty when paletted: read densityOf(n))
     std::vector<float> extinction;  ///< rho_i = f_rho(d_i), per world unit (pre)
     std::vector<float> r, g, b;     ///< premultiplied emission e_i = colour * rho_i (pre)
     /// Emission by value (ClassifyOptions::compactEmission): when rho_i and e_i depend on d_i
     /// alone and the splats take at most 65536 distinct values, `palette` holds
-    /// (rho, e_r, e_g, e_b) per distinct value, `emissionIndex` each splat's entry, and
-    /// extinction, r, g, b stay empty (2 bytes per splat instead of 16). Read emission(n).
+    /// (rho, e_r, e_g, e_b) per distinct value and `paletteDensity` the value itself,
+    /// `emissionIndex` each splat's entry, and density, extinction, r, g, b stay empty
+    /// (2 bytes per splat instead of 20). Read emission(n) and densityOf(n).
     std::vector<glm::vec4> palette;
+    std::vector<float> paletteDensity;
     std::vector<std::uint16_t> emissionIndex;
     bool paletted() const { return !palette.empty(); }
+    /// d_n, from the palette or the array.
+    float densityOf(std::size_t n) const {
+        return paletted() ? paletteDensity[emissionIndex[n]] : density[n];
+    }
     /// (rho_n, e_r, e_g, e_b) of splat n, from the palette or the arrays.
     glm::vec4 emission(std::size_t n) const {
         return paletted() ? palette[emissionIndex[n]] : glm::vec4(extinction[n], r[n], g[n], b[n]);
     }
-    /// Fills extinction, r, g, b from the palette and drops it (for code that needs arrays).
+    /// Fills density, extinction, r, g, b from the palette and drops it (for code that needs
+    /// arrays).
     void expandEmission();
     /// Unit normals -grad d / |grad d| (central differences in world units), only when
     /// classify() was asked for them (shading); empty otherwise.

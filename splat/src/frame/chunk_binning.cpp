@@ -11,51 +11,9 @@ namespace splat {
 namespace {
 // A fixed number of parts (not one per thread) keeps the lists identical for any thread count.
 constexpr std::size_t kParts = 32;
-constexpr int kBlock = 4;  // TileAccumulator's early-termination blocks, pixels
 // A splat records whether it is visible in each of the first kMaskTiles tiles of its box;
 // boxes over more tiles (huge footprints) are binned to all of them unculled.
 constexpr int kMaskTiles = 16;
-
-/// The tiles' opaque 4x4 blocks at the start of a chunk, one bit per block.
-struct Occlusion {
-    const TileGrid& g;
-    std::vector<std::uint64_t> mask;
-    std::vector<int> blocksX;
-
-    Occlusion(const TileGrid& grid, const std::vector<TileAccumulator>& tiles, bool cull)
-        : g(grid), mask(std::size_t(grid.count()), 0), blocksX(std::size_t(grid.count()), 0) {
-        if (!cull) return;
-        tbb::parallel_for(0, g.count(), [&](int t) {
-            const TileAccumulator& acc = tiles[std::size_t(t)];
-            const int bx = (acc.width() + kBlock - 1) / kBlock,
-                      by = (acc.height() + kBlock - 1) / kBlock;
-            blocksX[std::size_t(t)] = bx;
-            std::uint64_t m = 0;
-            for (int y = 0; y < by; ++y)
-                for (int x = 0; x < bx; ++x)
-                    if (acc.rectOpaque(x * kBlock, y * kBlock, x * kBlock, y * kBlock))
-                        m |= std::uint64_t(1) << (y * bx + x);
-            mask[std::size_t(t)] = m;
-        });
-    }
-
-    /// True unless tile (tx, ty) is opaque over every block the box `r` (image pixels)
-    /// touches.
-    bool visible(const PixelRect& r, int tx, int ty) const {
-        const int t = ty * g.tilesX + tx;
-        const std::uint64_t m = mask[std::size_t(t)];
-        if (m == 0) return true;
-        const int ox = tx * g.tileSize, oy = ty * g.tileSize;
-        const PixelRect c = clipToTile(r, g, ox, oy);
-        const int bx0 = (c.x0 - ox) / kBlock, bx1 = (c.x1 - ox) / kBlock;
-        const int by0 = (c.y0 - oy) / kBlock, by1 = (c.y1 - oy) / kBlock;
-        const int bx = blocksX[std::size_t(t)];
-        const std::uint64_t row = ((std::uint64_t(2) << (bx1 - bx0)) - 1) << bx0;
-        for (int y = by0; y <= by1; ++y)
-            if ((m >> (y * bx) & row) != row) return true;
-        return false;
-    }
-};
 
 /// Calls f(tx, ty, k) for the tiles the box touches, k counting them from 0 (row-major).
 template <class F>
@@ -68,9 +26,40 @@ void forTilesOf(const PixelRect& r, const TileGrid& g, F&& f) {
 }
 }  // namespace
 
+Occlusion::Occlusion(const TileGrid& grid, const std::vector<TileAccumulator>& tiles, bool cull)
+    : g_(grid),
+      cull_(cull),
+      mask_(std::size_t(grid.count()), 0),
+      blocksX_(std::size_t(grid.count()), 0) {
+    if (!cull) return;
+    tbb::parallel_for(0, g_.count(), [&](int t) {
+        const TileAccumulator& acc = tiles[std::size_t(t)];
+        const int bx = (acc.width() + kBlock - 1) / kBlock,
+                  by = (acc.height() + kBlock - 1) / kBlock;
+        blocksX_[std::size_t(t)] = bx;
+        std::uint64_t m = 0;
+        for (int y = 0; y < by; ++y)
+            for (int x = 0; x < bx; ++x)
+                if (acc.rectOpaque(x * kBlock, y * kBlock, x * kBlock, y * kBlock))
+                    m |= std::uint64_t(1) << (y * bx + x);
+        mask_[std::size_t(t)] = m;
+    });
+}
+
+bool Occlusion::visible(const PixelRect& r) const {
+    if (!cull_) return true;
+    const int tx0 = g_.tileOf(r.x0), tx1 = g_.tileOf(r.x1);
+    const int ty0 = g_.tileOf(r.y0), ty1 = g_.tileOf(r.y1);
+    for (int ty = ty0; ty <= ty1; ++ty)
+        for (int tx = tx0; tx <= tx1; ++tx)
+            if (visible(r, tx, ty)) return true;
+    return false;
+}
+
 std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
                      const std::vector<std::uint32_t>& runs, const TileGrid& grid,
-                     const std::vector<TileAccumulator>& tiles, bool cull, ChunkBins& out) {
+                     const Occlusion& occlusion, ChunkBins& out) {
+    const bool cull = occlusion.enabled();
     const std::size_t n = runs.empty() ? 0 : runs.back(), tileCount = std::size_t(grid.count());
     const std::size_t runCount = runs.empty() ? 0 : runs.size() - 1;
     const std::size_t runsPerPart = (runCount + kParts - 1) / kParts;
@@ -82,9 +71,8 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
     out.visible.resize(n);
     if (projector.perspective()) out.each.resize(n);
     out.counts.assign(kParts * tileCount, 0);
-    const Occlusion occlusion(grid, tiles, cull);
     std::vector<std::size_t> hidden(kParts, 0);
-    const bool runBoxes = cull && !projector.perspective();
+    const bool ortho = !projector.perspective(), runBoxes = cull && ortho;
     // Pass 1: project, and count the tiles where each splat is visible. A run (splats of one
     // row, between its first and last) whose box is hidden everywhere is skipped whole.
     tbb::parallel_for(std::size_t(0), kParts, [&](std::size_t c) {
@@ -93,10 +81,13 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
         std::size_t h = 0;
         for (std::size_t run = std::min(runCount, c * runsPerPart); run < re; ++run) {
             const std::size_t a = runs[run], b = runs[run + 1];
+            // Orthographic: the run's positions are affine along its row.
+            const SplatProjector::Row row =
+                ortho ? projector.row(order[a]) : SplatProjector::Row{0, 0, 0, 0};
             if (runBoxes && b - a >= 2) {
                 float xa, ya, xb, yb;
-                projector.project(order[a], xa, ya, nullptr);
-                projector.project(order[b - 1], xb, yb, nullptr);
+                projector.project(row, order[a], xa, ya);
+                projector.project(row, order[b - 1], xb, yb);
                 // Every centre of the run lies between the two ends: one box (widened by a
                 // pixel against rounding) holds all their footprint boxes.
                 footprint::EllipticalFootprint e = projector.shared();
@@ -117,8 +108,8 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
             }
             for (std::size_t q = a; q < b; ++q) {
                 const PixelRect r =
-                    projector.project(order[q], out.sx[q], out.sy[q],
-                                      projector.perspective() ? &out.each[q] : nullptr);
+                    ortho ? projector.project(row, order[q], out.sx[q], out.sy[q])
+                          : projector.project(order[q], out.sx[q], out.sy[q], &out.each[q]);
                 out.rect[q] = r;
                 std::uint32_t bits = 0;
                 if (!r.empty())

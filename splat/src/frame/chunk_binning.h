@@ -18,6 +18,58 @@
 
 namespace splat {
 
+/// The tiles' opaque 4x4 blocks at the start of a chunk, one bit per block (early splat
+/// elimination; all clear unless `cull`).
+class Occlusion {
+  public:
+    Occlusion(const TileGrid& grid, const std::vector<TileAccumulator>& tiles, bool cull);
+    bool enabled() const { return cull_; }
+    /// True unless tile (tx, ty) is opaque over every block the box `r` (image pixels)
+    /// touches.
+    bool visible(const PixelRect& r, int tx, int ty) const {
+        const int t = ty * g_.tilesX + tx;
+        const std::uint64_t m = mask_[std::size_t(t)];
+        if (m == 0) return true;
+        const int ox = tx * g_.tileSize, oy = ty * g_.tileSize;
+        const PixelRect c = clipToTile(r, g_, ox, oy);
+        const int bx0 = (c.x0 - ox) / kBlock, bx1 = (c.x1 - ox) / kBlock;
+        const int by0 = (c.y0 - oy) / kBlock, by1 = (c.y1 - oy) / kBlock;
+        const int bx = blocksX_[std::size_t(t)];
+        const std::uint64_t row = ((std::uint64_t(2) << (bx1 - bx0)) - 1) << bx0;
+        for (int y = by0; y <= by1; ++y)
+            if ((m >> (y * bx) & row) != row) return true;
+        return false;
+    }
+    /// True unless every tile the (non-empty) box touches is opaque over it.
+    bool visible(const PixelRect& r) const;
+
+  private:
+    static constexpr int kBlock = 4;  ///< TileAccumulator's early-termination blocks, pixels
+    const TileGrid& g_;
+    bool cull_;
+    std::vector<std::uint64_t> mask_;
+    std::vector<int> blocksX_;
+};
+
+/// Whether splats centred in an index-space box may still show in an orthographic view
+/// (a brick of the volume tested as one, before its splats are even listed); always true
+/// without culling or in perspective.
+class BrickTest {
+  public:
+    BrickTest(const SplatProjector& projector, const Occlusion& occlusion)
+        : projector_(projector), occlusion_(occlusion) {}
+    bool active() const { return occlusion_.enabled() && !projector_.perspective(); }
+    bool operator()(const glm::ivec3& lo, const glm::ivec3& hi) const {
+        if (!active()) return true;
+        const PixelRect r = projector_.boxOfIndexBox(lo, hi);
+        return !r.empty() && occlusion_.visible(r);
+    }
+
+  private:
+    const SplatProjector& projector_;
+    const Occlusion& occlusion_;
+};
+
 /// One entry of a tile's list: the splat, its position in the chunk and its screen centre
 /// (written by binning, so that the tile sweep streams through its records).
 struct SplatRecord {
@@ -39,11 +91,13 @@ struct VisitOrder {
 /// What a streaming splatter hands the chunked tile stage (tile_driver.h): `count` chunks
 /// of whole sheets in visiting order; gather(c, ids, runs) lists chunk c's splats in any
 /// order (binning sorts each tile's records by sheet, stably), cut into runs along volume
-/// rows (binChunk). Its cutter spans one sheet per
-/// splat (a ring of one), so no sheet is pending between chunks.
+/// rows (binChunk), and may leave out the splats of bricks `visible` says are hidden
+/// (returning how many it left out). Its cutter spans one sheet per splat (a ring of one),
+/// so no sheet is pending between chunks.
 struct SheetChunks {
     std::size_t count = 0;
-    std::function<void(std::size_t, std::vector<std::uint32_t>&, std::vector<std::uint32_t>&)>
+    std::function<std::size_t(std::size_t, std::vector<std::uint32_t>&, std::vector<std::uint32_t>&,
+                              const BrickTest& visible)>
         gather;
 };
 
@@ -62,13 +116,12 @@ struct ChunkBins {
 
 /// Projects the splats order[0, runs.back()) and bins the visible ones into `out`. `runs`
 /// cuts them into runs (run r: positions [runs[r], runs[r + 1])) of splats on one segment
-/// of a volume row, first and last at its ends: with `cull`, a run whose box is hidden in
-/// every tile it touches is skipped without projecting its inner splats. `tiles` holds
-/// each tile's compositing state (row-major over `grid`); with `cull`, a splat is left out
-/// of every tile that is opaque over its footprint box there. Returns the splats left out
-/// of every tile they touch.
+/// of a volume row, first and last at its ends: with culling, a run whose box is hidden in
+/// every tile it touches is skipped without projecting its inner splats, and a splat is
+/// left out of every tile that `occlusion` says is opaque over its footprint box there.
+/// Returns the splats left out of every tile they touch.
 std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
                      const std::vector<std::uint32_t>& runs, const TileGrid& grid,
-                     const std::vector<TileAccumulator>& tiles, bool cull, ChunkBins& out);
+                     const Occlusion& occlusion, ChunkBins& out);
 
 }  // namespace splat

@@ -3,12 +3,93 @@
 
 #include <algorithm>
 
+#include "footprint/lanes.h"
 #include "splat/error.h"
 
 namespace splat {
 
 namespace {
 constexpr int kBlock = 4;  // early-termination granularity, pixels (64 blocks per 32x32 tile)
+
+#if defined(FOOTPRINT_HAVE_LANES)
+FOOTPRINT_LANES_BEGIN
+/// alpha = 1 - exp(-tau) and k = alpha / tau for eight optical depths (the lanes of
+/// sampleFromOpticalDepth). |tau| < 1/2: k from its Taylor series to tau^8 (relative error
+/// < 3e-9, and no cancellation), alpha = k tau; otherwise exp(-tau) by range reduction to
+/// |r| <= ln2 / 2 and a degree-7 Taylor polynomial (relative error < 3e-9), k = alpha / tau.
+inline void opacityLanes(__m256 tau, __m256& alpha, __m256& k) {
+    const __m256 one = _mm256_set1_ps(1.0f);
+    // Series: k = sum_n (-tau)^n / (n + 1)!, Horner from the highest term.
+    const __m256 t = _mm256_sub_ps(_mm256_setzero_ps(), tau);
+    __m256 ks = _mm256_set1_ps(1.0f / 362880.0f);
+    for (float c : {1.0f / 40320.0f, 1.0f / 5040.0f, 1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f,
+                    1.0f / 6.0f, 0.5f, 1.0f})
+        ks = _mm256_fmadd_ps(ks, t, _mm256_set1_ps(c));
+    // exp(x), x = -tau clamped to where float exp is finite and normal.
+    const __m256 x = _mm256_min_ps(_mm256_max_ps(t, _mm256_set1_ps(-87.0f)), _mm256_set1_ps(87.0f));
+    const __m256 n = _mm256_round_ps(_mm256_mul_ps(x, _mm256_set1_ps(1.44269504088896341f)),
+                                     _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+    __m256 r = _mm256_fnmadd_ps(n, _mm256_set1_ps(0.693145751953125f), x);
+    r = _mm256_fnmadd_ps(n, _mm256_set1_ps(1.42860682030941723212e-6f), r);
+    __m256 p = _mm256_set1_ps(1.0f / 5040.0f);
+    for (float c : {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f, 1.0f})
+        p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(c));
+    const __m256i e =
+        _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
+    const __m256 ex = _mm256_mul_ps(p, _mm256_castsi256_ps(e));
+    const __m256 big = _mm256_cmp_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), tau),
+                                     _mm256_set1_ps(0.5f), _CMP_GE_OQ);
+    const __m256 alphaBig = _mm256_sub_ps(one, ex);
+    alpha = _mm256_blendv_ps(_mm256_mul_ps(ks, tau), alphaBig, big);
+    // Division only where it is taken (|tau| >= 1/2 there).
+    k = _mm256_blendv_ps(ks, _mm256_div_ps(alphaBig, _mm256_blendv_ps(one, tau, big)), big);
+}
+
+void compositeOpticalDepthsLanes(float* R, float* G, float* B, float* A, bool frontToBack, int n,
+                                 const float* tau, const float* er, const float* eg,
+                                 const float* eb) {
+    const __m256 one = _mm256_set1_ps(1.0f);
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    for (int i = 0; i < n; i += 8) {
+        const __m256i mask = _mm256_cmpgt_epi32(_mm256_set1_epi32(n - i), lane);
+        __m256 alpha, k;
+        opacityLanes(_mm256_maskload_ps(tau + i, mask), alpha, k);
+        const __m256 cr = _mm256_mul_ps(k, _mm256_maskload_ps(er + i, mask));
+        const __m256 cg = _mm256_mul_ps(k, _mm256_maskload_ps(eg + i, mask));
+        const __m256 cb = _mm256_mul_ps(k, _mm256_maskload_ps(eb + i, mask));
+        const __m256 a = _mm256_maskload_ps(A + i, mask);
+        const __m256 r = _mm256_maskload_ps(R + i, mask), g = _mm256_maskload_ps(G + i, mask),
+                     b = _mm256_maskload_ps(B + i, mask);
+        if (frontToBack) {
+            const __m256 t = _mm256_sub_ps(one, a);
+            _mm256_maskstore_ps(R + i, mask, _mm256_fmadd_ps(t, cr, r));
+            _mm256_maskstore_ps(G + i, mask, _mm256_fmadd_ps(t, cg, g));
+            _mm256_maskstore_ps(B + i, mask, _mm256_fmadd_ps(t, cb, b));
+            _mm256_maskstore_ps(A + i, mask, _mm256_fmadd_ps(t, alpha, a));
+        } else {
+            const __m256 t = _mm256_sub_ps(one, alpha);
+            _mm256_maskstore_ps(R + i, mask, _mm256_fmadd_ps(t, r, cr));
+            _mm256_maskstore_ps(G + i, mask, _mm256_fmadd_ps(t, g, cg));
+            _mm256_maskstore_ps(B + i, mask, _mm256_fmadd_ps(t, b, cb));
+            _mm256_maskstore_ps(A + i, mask, _mm256_fmadd_ps(t, a, alpha));
+        }
+    }
+}
+FOOTPRINT_LANES_END
+#endif
+}  // namespace
+
+void TileAccumulator::compositeOpticalDepths(int p, int n, const float* tau, const float* er,
+                                             const float* eg, const float* eb) {
+#if defined(FOOTPRINT_HAVE_LANES)
+    if (footprint::cpuHasLanes()) {
+        compositeOpticalDepthsLanes(&r_[p], &g_[p], &b_[p], &a_[p],
+                                    order_ == CompositeOrder::FrontToBack, n, tau, er, eg, eb);
+        return;
+    }
+#endif
+    for (int i = 0; i < n; ++i)
+        composite(p + i, sampleFromOpticalDepth(tau[i], er[i], eg[i], eb[i]));
 }
 
 TileAccumulator::TileAccumulator(int width, int height, CompositeOrder order,

@@ -66,6 +66,12 @@ class TileAccumulator {
             a_[p] = s.alpha + t * a_[p];
         }
     }
+    /// Pre-classified dvr: composites the n pixels p, p + 1, ... (one tile row) from their
+    /// optical depths and emissions as composite(p + i, sampleFromOpticalDepth(tau[i], ...)),
+    /// eight pixels at a time where the CPU has AVX2 (to float rounding: the lanes use their
+    /// own exp).
+    void compositeOpticalDepths(int p, int n, const float* tau, const float* er, const float* eg,
+                                const float* eb);
     void maximum(int p, float v) { r_[p] = std::max(r_[p], v); }
     void add(int p, float v) { r_[p] += v; }
 

@@ -79,6 +79,46 @@ class SplatProjector {
         return projectPerspective(w, sx, sy, *each);
     }
 
+    /// Orthographic views: the screen positions of the splats on one volume row (that of
+    /// splat `id`) are affine in their index i along the row, x = x0 + i dx, y = y0 + i dy
+    /// (the same positions as project(), to double rounding before the cast to float).
+    struct Row {
+        double x0, y0, dx, dy;
+    };
+    Row row(std::uint32_t id) const {
+        const glm::dvec3 d =
+            splats_.origin +
+            splats_.spacing * glm::dvec3(0.0, double(splats_.j[id]), double(splats_.k[id])) -
+            camera_.eye;
+        return {cx_ + glm::dot(d, rx_), cy_ - glm::dot(d, ry_), splats_.spacing.x * rx_.x,
+                -splats_.spacing.x * ry_.x};
+    }
+    PixelRect project(const Row& row, std::uint32_t id, float& sx, float& sy) const {
+        const double i = double(splats_.i[id]);
+        sx = float(row.x0 + i * row.dx);
+        sy = float(row.y0 + i * row.dy);
+        return footprintRect(sx, sy, shared_, width_, height_);
+    }
+    /// Orthographic views: the pixel box holding the footprint boxes of every splat centred
+    /// in the index-space box [lo, hi] (voxel positions, inclusive), widened by a pixel
+    /// against rounding; empty when none of them reaches the image.
+    PixelRect boxOfIndexBox(const glm::ivec3& lo, const glm::ivec3& hi) const {
+        double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+        for (int c = 0; c < 8; ++c) {
+            const glm::dvec3 idx(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+            const glm::dvec3 d = splats_.origin + splats_.spacing * idx - camera_.eye;
+            const double x = cx_ + glm::dot(d, rx_), y = cy_ - glm::dot(d, ry_);
+            x0 = std::min(x0, x);
+            x1 = std::max(x1, x);
+            y0 = std::min(y0, y);
+            y1 = std::max(y1, y);
+        }
+        footprint::EllipticalFootprint e = shared_;
+        e.halfWidth += float(0.5 * (x1 - x0)) + 1.0f;
+        e.halfHeight += float(0.5 * (y1 - y0)) + 1.0f;
+        return footprintRect(float(0.5 * (x0 + x1)), float(0.5 * (y0 + y1)), e, width_, height_);
+    }
+
   private:
     PixelRect projectPerspective(const glm::dvec3& w, float& sx, float& sy,
                                  footprint::EllipticalFootprint& e) const;

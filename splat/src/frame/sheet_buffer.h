@@ -7,6 +7,7 @@
 // sheet it falls into (splat/src/splatters/).
 #include <algorithm>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 #include "footprint/ellipse.h"
@@ -101,10 +102,16 @@ class SheetBuffer {
         if (!dirty()) return;
         const int xe = std::min(dx1_, w_ - 1);
         for (int y = dy0_; y <= dy1_; ++y) {
-            for (int x = dx0_; x <= xe; ++x) {
-                const int p = y * w_ + x;
-                const float len = pathScale ? pathLength * pathScale[p] : pathLength;
-                policy(acc, p, &v_[std::size_t(y) * stride_ + x], plane_, len);
+            if constexpr (std::is_same_v<Policy, DvrPrePolicy>) {
+                const float* v = &v_[std::size_t(y) * stride_ + dx0_];
+                acc.compositeOpticalDepths(y * w_ + dx0_, xe - dx0_ + 1, v, v + plane_,
+                                           v + 2 * plane_, v + 3 * plane_);
+            } else {
+                for (int x = dx0_; x <= xe; ++x) {
+                    const int p = y * w_ + x;
+                    const float len = pathScale ? pathLength * pathScale[p] : pathLength;
+                    policy(acc, p, &v_[std::size_t(y) * stride_ + x], plane_, len);
+                }
             }
             for (int c = 0; c < NCh; ++c) {
                 float* row = &v_[c * plane_ + std::size_t(y) * stride_];

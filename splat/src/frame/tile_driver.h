@@ -104,12 +104,12 @@ inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Polic
         v[4] = 1.0f;  // every splat competes for the pixel's label, the background too
         v[5] = s.label[id];
     } else if constexpr (Policy::kSource == SheetSource::DensityGradient) {
-        v[0] = s.density[id];
+        v[0] = s.densityOf(id);
         v[1] = s.gx[id];
         v[2] = s.gy[id];
         v[3] = s.gz[id];
     } else if constexpr (Policy::kSource == SheetSource::Density) {
-        v[0] = s.density[id];
+        v[0] = s.densityOf(id);
     }
 }
 
@@ -325,9 +325,10 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
     tbb::enumerable_thread_specific<std::vector<SplatRecord>> sortScratch;
     for (std::size_t c = 0; c < sc.count; ++c) {
         const auto t0 = Clock::now();
-        sc.gather(c, bins.ids, bins.runs);
+        const Occlusion occlusion(g, tiles, cull);
+        hidden += sc.gather(c, bins.ids, bins.runs, BrickTest(projector, occlusion));
         hidden += binChunk(projector, VisitOrder{&bins.ids, bins.ids.size(), false}, bins.runs, g,
-                           tiles, cull, bins);
+                           occlusion, bins);
         const auto t1 = Clock::now();
         tbb::parallel_for(0, g.count(), 1, [&](int t) {
             if (bins.begin[t] == bins.begin[t + 1]) return;

@@ -155,8 +155,9 @@ float maxGradientMagnitude(const Volume& v) {
 void SplatList::expandEmission() {
     if (!paletted()) return;
     const std::size_t n = size();
-    for (auto* a : {&extinction, &r, &g, &b}) a->resize(n);
+    for (auto* a : {&density, &extinction, &r, &g, &b}) a->resize(n);
     for (std::size_t q = 0; q < n; ++q) {
+        density[q] = paletteDensity[emissionIndex[q]];
         const glm::vec4 e = palette[emissionIndex[q]];
         extinction[q] = e.x;
         r[q] = e.y;
@@ -164,13 +165,14 @@ void SplatList::expandEmission() {
         b[q] = e.w;
     }
     palette.clear();
+    paletteDensity.clear();
     std::vector<std::uint16_t>().swap(emissionIndex);
 }
 
 std::size_t SplatList::bytes() const {
     std::size_t total = 0;
     for (const auto* a : {&i, &j, &k, &emissionIndex}) total += a->size() * sizeof(std::uint16_t);
-    total += palette.size() * sizeof(glm::vec4);
+    total += palette.size() * sizeof(glm::vec4) + paletteDensity.size() * sizeof(float);
     for (const auto* a : {&density, &extinction, &r, &g, &b, &nx, &ny, &nz, &gx, &gy, &gz, &label})
         total += a->size() * sizeof(float);
     return total;
@@ -285,13 +287,13 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
     s.voxels = volume.voxelCount();
     s.origin = volume.origin;
     s.spacing = volume.spacing;
-    s.density.resize(n);
     if (paletted) {
         s.palette.resize(distinct.size());
         for (std::size_t q = 0; q < distinct.size(); ++q) s.palette[q] = emissionOf(distinct[q]);
+        s.paletteDensity = distinct;
         s.emissionIndex.resize(n);
     } else {
-        for (auto* a : {&s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
+        for (auto* a : {&s.density, &s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
     }
     for (auto* a : {&s.i, &s.j, &s.k}) a->resize(n);
     if (normals)
@@ -308,7 +310,7 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                 s.i[o] = std::uint16_t(i);
                 s.j[o] = std::uint16_t(j);
                 s.k[o] = std::uint16_t(k);
-                s.density[o] = value;
+                if (!paletted) s.density[o] = value;
                 if (labelled) s.label[o] = float(shown[volume.index(i, j, k)]);
                 if (paletted) {
                     s.emissionIndex[o] =

@@ -80,13 +80,6 @@ SplatList coarserSplats(const SplatList& fine, const glm::ivec3& fd) {
     for (std::size_t K = 1; K < start.size(); ++K) start[K] += start[K - 1];
 
     const bool hasEmission = fine.paletted() || !fine.extinction.empty();
-    bool zeroEmission = true;  // xray, mip and post: one zero palette entry, as 2 bytes
-    if (fine.paletted())
-        for (const glm::vec4& e : fine.palette) zeroEmission = zeroEmission && e == glm::vec4(0.0f);
-    else
-        for (const std::vector<float>* a : {&fine.extinction, &fine.r, &fine.g, &fine.b})
-            zeroEmission = zeroEmission &&
-                           std::all_of(a->begin(), a->end(), [](float v) { return v == 0.0f; });
     const bool normals = !fine.nx.empty(), gradients = !fine.gx.empty(),
                labels = !fine.label.empty();
 
@@ -98,12 +91,8 @@ SplatList coarserSplats(const SplatList& fine, const glm::ivec3& fd) {
     s.voxels = std::size_t(cd.x) * std::size_t(cd.y) * std::size_t(cd.z);
     for (auto* a : {&s.i, &s.j, &s.k}) a->resize(m);
     s.density.resize(m);
-    if (hasEmission && zeroEmission) {
-        s.palette.assign(1, glm::vec4(0.0f));
-        s.emissionIndex.assign(m, 0);
-    } else if (hasEmission) {
+    if (hasEmission)
         for (auto* a : {&s.extinction, &s.r, &s.g, &s.b}) a->resize(m);
-    }
     if (normals)
         for (auto* a : {&s.nx, &s.ny, &s.nz}) a->resize(m);
     if (gradients)
@@ -118,7 +107,7 @@ SplatList coarserSplats(const SplatList& fine, const glm::ivec3& fd) {
         for (int J = 0; J < cd.y; ++J) {
             forCell(K, J, [&](std::size_t q) {
                 CellSums& c = cells[fine.i[q] / 2];
-                c.density += fine.density[q];
+                c.density += fine.densityOf(q);
                 const glm::vec4 e = hasEmission ? fine.emission(q) : glm::vec4(0.0f);
                 c.emission += e;
                 if (normals) {

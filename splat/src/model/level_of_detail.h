@@ -21,8 +21,8 @@ Volume coarserGrid(const Volume& fine);
 
 /// The next level's splat list of `fine` (a list in (k, j, i) order on a grid of `fineDims`),
 /// in (k, j, i) order on coarserGrid's grid: one splat per cell holding at least one splat.
-/// Averages every per-splat value (emission by value is expanded into arrays: averages are no
-/// longer a few distinct values); unit normals become the extinction-weighted mean normal,
+/// Averages every per-splat value (values by palette become arrays: averages are no longer a
+/// few distinct values); unit normals become the extinction-weighted mean normal,
 /// normalised (zero where the members' normals cancel); a label becomes the most frequent
 /// label of the cell's splats (the lowest on a tie).
 SplatList coarserSplats(const SplatList& fine, const glm::ivec3& fineDims);

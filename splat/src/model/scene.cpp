@@ -207,10 +207,23 @@ const std::vector<std::uint32_t>& Scene::Impl::cellStarts() const {
             const std::size_t row = std::size_t(splats.k[q]) * volume->dims.y + splats.j[q];
             ++st[row * cx + splats.i[q] / kCellWidth + 1];
         }
+        const glm::ivec3 b = bricks();
+        auto counts = std::make_unique<std::vector<std::uint32_t>>(std::size_t(b.x) * b.y * b.z, 0);
+        for (std::size_t row = 0; row < rows; ++row) {
+            const std::size_t j = row % std::size_t(volume->dims.y), k = row / volume->dims.y;
+            const std::size_t brickRow = (k / kCellWidth * b.y + j / kCellWidth) * b.x;
+            for (std::size_t c = 0; c < cx; ++c) (*counts)[brickRow + c] += st[row * cx + c + 1];
+        }
         for (std::size_t c = 1; c < st.size(); ++c) st[c] += st[c - 1];
         cellStarts_ = std::move(start);
+        brickCounts_ = std::move(counts);
     }
     return *cellStarts_;
+}
+
+const std::vector<std::uint32_t>& Scene::Impl::brickCounts() const {
+    cellStarts();
+    return *brickCounts_;
 }
 
 const footprint::SlabTable& Scene::Impl::slabTable() const {

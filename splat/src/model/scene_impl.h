@@ -96,6 +96,11 @@ struct Scene::Impl {
     static constexpr int kCellWidth = 8;
     int cellsX() const { return (volume->dims.x + kCellWidth - 1) / kCellWidth; }
     const std::vector<std::uint32_t>& cellStarts() const;
+    /// Splats per brick of kCellWidth^3 voxels, brick (bi, bj, bk) at
+    /// (bk * bricks.y + bj) * bricks.x + bi: a slab of the axis-aligned splatter along any axis
+    /// is one layer of these bricks (made with cellStarts()).
+    const std::vector<std::uint32_t>& brickCounts() const;
+    glm::ivec3 bricks() const { return (volume->dims + (kCellWidth - 1)) / kCellWidth; }
     /// The slab-section table of the image-aligned splatter, made on first use.
     const footprint::SlabTable& slabTable() const;
     /// The dense field of the reference ray caster (unshaded scenes), made on first use.
@@ -107,7 +112,7 @@ struct Scene::Impl {
   private:
     mutable std::mutex lazyMutex_, poolMutex_;
     mutable std::unique_ptr<SliceOrder> sliceOrder_[3];
-    mutable std::unique_ptr<std::vector<std::uint32_t>> cellStarts_;
+    mutable std::unique_ptr<std::vector<std::uint32_t>> cellStarts_, brickCounts_;
     mutable std::unique_ptr<footprint::SlabTable> slabTable_;
     mutable std::shared_ptr<const ReferenceField> field_;
     mutable std::vector<std::unique_ptr<FrameWorkspace>> pool_;

@@ -5,6 +5,8 @@
 // its slice, and the sheets are composited in visibility order. When the major axis
 // changes (at 45 degrees for isotropic voxels) the sheets change orientation: that is the
 // popping artifact the image-aligned splatter removes.
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -92,6 +94,11 @@ int splatFootprint(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx
     return splatFootprintScalar(sheet, values, sx, sy, e, rect, table, poly);
 }
 
+/// The splats and runs one part of a slab lists (AxisAligned's gather).
+struct GatherPart {
+    std::vector<std::uint32_t> ids, runs;
+};
+
 /// Each splat lies in the one sheet of its slice along the major axis.
 struct WholeFootprints {
     const std::vector<std::uint16_t>& index;  ///< slice index of each splat along the axis
@@ -137,31 +144,96 @@ class AxisAligned final : public Splatter {
         const std::size_t slabs = (plan.sheets + kWidth - 1) / kWidth;
         const bool ascending = plan.ascending;
         work.chunks.count = slabs;
-        work.chunks.gather = [&sc, &cells, m, slabs, ascending](std::size_t c,
-                                                                std::vector<std::uint32_t>& ids,
-                                                                std::vector<std::uint32_t>& runs) {
-            const glm::ivec3 d = sc.volume->dims;
+        const std::vector<std::uint32_t>& brickCounts = scene.brickCounts();
+        work.chunks.gather = [&sc, &cells, &brickCounts, m, slabs, ascending,
+                              state = std::vector<std::uint8_t>(),
+                              parts = std::vector<GatherPart>()](std::size_t c,
+                                                                 std::vector<std::uint32_t>& ids,
+                                                                 std::vector<std::uint32_t>& runs,
+                                                                 const BrickTest& visible) mutable {
+            const glm::ivec3 d = sc.volume->dims, nb = sc.bricks();
             const std::size_t slab = ascending ? c : slabs - 1 - c, cx = std::size_t(sc.cellsX());
             const std::size_t q0 = slab * kWidth, q1 = std::min<std::size_t>(q0 + kWidth, d[m]);
-            ids.clear();
-            runs.assign(1, 0);
-            // One run per non-empty cell: its splats lie on one row between its first and last.
-            auto add = [&](std::size_t cell) {
-                if (cells[cell] == cells[cell + 1]) return;
-                for (std::size_t q = cells[cell]; q < cells[cell + 1]; ++q)
-                    ids.push_back(std::uint32_t(q));
-                runs.push_back(std::uint32_t(ids.size()));
+            // The slab is one layer of bricks of kWidth^3 voxels (u, v: the other two axes).
+            // Each is tested as one against the tiles' opacity: the cells of an empty or hidden
+            // brick are not read at all (state[bu + bv * nb[u]] = 0), the splats of a hidden
+            // one counted from brickCounts. Cells of the others are read in the same order
+            // as without bricks, so the image is the same.
+            const int u = m == 0 ? 1 : 0, v = m == 2 ? 1 : 2;
+            const std::size_t bricksU = std::size_t(nb[u]), bricksV = std::size_t(nb[v]);
+            state.assign(bricksU * bricksV, 0);
+            std::vector<std::size_t> left(bricksV, 0);
+            tbb::parallel_for(std::size_t(0), bricksV, [&](std::size_t bv) {
+                for (std::size_t bu = 0; bu < bricksU; ++bu) {
+                    glm::ivec3 bi;
+                    bi[m] = int(slab);
+                    bi[u] = int(bu);
+                    bi[v] = int(bv);
+                    const std::uint32_t n =
+                        brickCounts[(std::size_t(bi.z) * nb.y + std::size_t(bi.y)) * nb.x + bi.x];
+                    if (n == 0) continue;
+                    glm::ivec3 lo = bi * kWidth, hi = glm::min(d, lo + kWidth) - 1;
+                    lo[m] = int(q0);
+                    hi[m] = int(q1) - 1;
+                    if (visible(lo, hi))
+                        state[bv * bricksU + bu] = 1;
+                    else
+                        left[bv] += n;
+                }
+            });
+            auto shown = [&](std::size_t iu, std::size_t iv) {
+                return state[iv / kWidth * bricksU + iu / kWidth] != 0;
             };
-            const std::size_t ny = std::size_t(d.y), rows = ny * std::size_t(d.z);
-            if (m == 2) {
-                for (std::size_t cell = q0 * ny * cx; cell < q1 * ny * cx; ++cell) add(cell);
-            } else if (m == 1) {
-                for (std::size_t k = 0; k < std::size_t(d.z); ++k)
-                    for (std::size_t cell = (k * ny + q0) * cx; cell < (k * ny + q1) * cx; ++cell)
-                        add(cell);
-            } else {
-                for (std::size_t r = 0; r < rows; ++r) add(r * cx + slab);
+            // The cells are listed in parts (in parallel, then joined in order): part p holds
+            // slice q0 + p / bricksV (m = 0: all of them) and the v-brick p % bricksV. One
+            // run per non-empty cell: its splats lie on one row between its first and last.
+            const std::size_t ny = std::size_t(d.y);
+            const std::size_t nParts = m == 0 ? bricksV : (q1 - q0) * bricksV;
+            if (parts.size() < nParts) parts.resize(nParts);
+            tbb::parallel_for(std::size_t(0), nParts, [&](std::size_t p) {
+                GatherPart& part = parts[p];
+                part.ids.clear();
+                part.runs.clear();
+                auto add = [&](std::size_t cell) {
+                    if (cells[cell] == cells[cell + 1]) return;
+                    for (std::size_t q = cells[cell]; q < cells[cell + 1]; ++q)
+                        part.ids.push_back(std::uint32_t(q));
+                    part.runs.push_back(std::uint32_t(part.ids.size()));
+                };
+                const std::size_t bv = p % bricksV, slice = q0 + p / bricksV;
+                const std::size_t v0 = bv * kWidth, v1 = std::min<std::size_t>(v0 + kWidth, d[v]);
+                if (m == 2) {  // u = i (one cell per brick), v = j
+                    for (std::size_t j = v0; j < v1; ++j)
+                        for (std::size_t ci = 0; ci < cx; ++ci)
+                            if (shown(ci * kWidth, j)) add((slice * ny + j) * cx + ci);
+                } else if (m == 1) {  // u = i, v = k: slice-major, already in sheet order
+                    for (std::size_t k = v0; k < v1; ++k)
+                        for (std::size_t ci = 0; ci < cx; ++ci)
+                            if (shown(ci * kWidth, k)) add((k * ny + slice) * cx + ci);
+                } else {  // u = j, v = k; the slab is cell column `slab`
+                    for (std::size_t k = v0; k < v1; ++k)
+                        for (std::size_t j = 0; j < ny; ++j)
+                            if (shown(j, k)) add((k * ny + j) * cx + slab);
+                }
+            });
+            std::size_t total = 0, runCount = 0;
+            for (std::size_t p = 0; p < nParts; ++p) {
+                total += parts[p].ids.size();
+                runCount += parts[p].runs.size();
             }
+            ids.resize(total);
+            runs.resize(runCount + 1);
+            runs[0] = 0;
+            std::size_t at = 0, r = 1;
+            for (std::size_t p = 0; p < nParts; ++p) {
+                std::copy(parts[p].ids.begin(), parts[p].ids.end(),
+                          ids.begin() + std::ptrdiff_t(at));
+                for (std::uint32_t e : parts[p].runs) runs[r++] = std::uint32_t(at + e);
+                at += parts[p].ids.size();
+            }
+            std::size_t hidden = 0;
+            for (std::size_t h : left) hidden += h;
+            return hidden;
         };
         stats.sheetAxis = m;
         stats.sheetSign = sa.sign;
