@@ -1,7 +1,8 @@
 // bench_accuracy: the splatters against the reference ray caster of the same model.
 //
 //   bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] [--classify pre|post]
-//                  [--azimuths 0,30,45] [--early-termination EPS]
+//                  [--azimuths 0,30,45] [--elevation E] [--early-termination EPS]
+//                  [--lod L] [--supersample N]
 //
 // VOLUME defaults to synthetic:phantom:64, TF to ct-soft. For each azimuth renders the
 // reference, the axis-aligned splatter and the image-aligned splatter with slabs of 1, 0.5
@@ -9,6 +10,10 @@
 // max abs difference against the reference, with milliseconds per frame (the Renderer is
 // built once per configuration; the time is that of render() alone). The splatters use the
 // default front-to-back early termination (1/256) unless --early-termination says otherwise.
+// --lod L adds the axis-aligned and slab-1 image-aligned splatters at level of detail L
+// (Quality::lod) and their level. --supersample N renders the reference with N x N rays per
+// pixel (at N times the size) and box-filters it: the pixel's area average rather than its
+// centre's value.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -30,6 +35,7 @@ struct Config {
     std::string label;
     RendererKind kind;
     double slab;
+    double lod = 0;
 };
 
 std::vector<double> parseList(const std::string& s) {
@@ -43,7 +49,8 @@ std::vector<double> parseList(const std::string& s) {
 void usage() {
     std::fprintf(stderr,
                  "usage: bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] "
-                 "[--classify pre|post] [--azimuths 0,30,45] [--early-termination EPS]\n");
+                 "[--classify pre|post] [--azimuths 0,30,45] [--elevation E] "
+                 "[--early-termination EPS] [--lod L] [--supersample N]\n");
 }
 
 }  // namespace
@@ -52,8 +59,8 @@ int main(int argc, char** argv) {
     try {
         std::string volumeSpec = "synthetic:phantom:64", tf = "ct-soft", mode = "dvr",
                     classify = "pre";
-        int size = 256;
-        double earlyTermination = -1;
+        int size = 256, supersample = 1;
+        double earlyTermination = -1, lod = 0, elevation = 0;
         std::vector<double> azimuths = {0, 30, 45};
         std::vector<std::string> positional;
         for (int a = 1; a < argc; ++a) {
@@ -72,6 +79,12 @@ int main(int argc, char** argv) {
                 azimuths = parseList(value());
             else if (arg == "--early-termination")
                 earlyTermination = std::stod(value());
+            else if (arg == "--supersample")
+                supersample = std::stoi(value());
+            else if (arg == "--lod")
+                lod = std::stod(value());
+            else if (arg == "--elevation")
+                elevation = std::stod(value());
             else if (arg == "-h" || arg == "--help") {
                 usage();
                 return 0;
@@ -88,6 +101,8 @@ int main(int argc, char** argv) {
         if (positional.size() > 0) volumeSpec = positional[0];
         if (positional.size() > 1) tf = positional[1];
         if (size < 1) throw std::runtime_error("--size must be >= 1");
+        if (supersample < 1 || supersample > 16)
+            throw std::runtime_error("--supersample must be between 1 and 16");
 
         const Volume volume = loadVolume(volumeSpec);
         const VolumeStats vs = volumeStats(volume);
@@ -98,18 +113,27 @@ int main(int argc, char** argv) {
         base.classification = classify == "post" ? Classification::Post : Classification::Pre;
         base.transfer = TransferFunction::load(tf).resolved(vs.minValue, vs.maxValue);
         base.camera.width = base.camera.height = size;
+        base.camera.elevationDeg = elevation;
         if (earlyTermination >= 0) base.quality.earlyTermination = earlyTermination;
 
-        const std::vector<Config> configs = {{"axis", RendererKind::Axis, 1.0},
-                                             {"sheet, slab 1", RendererKind::Sheet, 1.0},
-                                             {"sheet, slab 0.5", RendererKind::Sheet, 0.5},
-                                             {"sheet, slab 0.25", RendererKind::Sheet, 0.25}};
+        std::vector<Config> configs = {{"axis", RendererKind::Axis, 1.0},
+                                       {"sheet, slab 1", RendererKind::Sheet, 1.0},
+                                       {"sheet, slab 0.5", RendererKind::Sheet, 0.5},
+                                       {"sheet, slab 0.25", RendererKind::Sheet, 0.25}};
+        if (lod > 0) {
+            char label[64];
+            std::snprintf(label, sizeof label, "axis, lod %g", lod);
+            configs.insert(configs.begin() + 1, {label, RendererKind::Axis, 1.0, lod});
+            std::snprintf(label, sizeof label, "sheet, slab 1, lod %g", lod);
+            configs.insert(configs.begin() + 3, {label, RendererKind::Sheet, 1.0, lod});
+        }
         std::printf(
             "Accuracy against the reference ray caster: %s, %dx%d, %s %s, transfer "
             "function %s, default kernel and reference settings (step %g voxels, "
-            "tolerance %g), splatter early termination %g.\n\n",
+            "tolerance %g, %d x %d rays per pixel box-filtered), splatter early termination "
+            "%g.\n\n",
             volumeSpec.c_str(), size, size, mode.c_str(), classify.c_str(), tf.c_str(),
-            base.quality.referenceStep, base.quality.referenceTolerance,
+            base.quality.referenceStep, base.quality.referenceTolerance, supersample, supersample,
             base.quality.earlyTermination);
         std::printf("| azimuth | renderer | RMSE | PSNR (dB) | max abs | ms/frame |\n");
         std::printf("|---:|---|---:|---:|---:|---:|\n");
@@ -118,9 +142,22 @@ int main(int argc, char** argv) {
             rs.renderer = RendererKind::Reference;
             rs.camera.azimuthDeg = az;
             RenderStats refStats;
+            const int n = supersample;
+            if (n > 1) {  // N x N rays per pixel: the same view at N times the size
+                rs.camera.pixelSize = Camera(rs.camera, volume).pixelSize / n;
+                rs.camera.width = rs.camera.height = size * n;
+            }
             const Renderer reference(volume, rs);
             const auto t0 = std::chrono::steady_clock::now();
-            const Image ref = reference.render(&refStats);
+            const Image fine = reference.render(&refStats);
+            Image ref(size, size);
+            for (int y = 0; y < size; ++y)
+                for (int x = 0; x < size; ++x) {
+                    glm::vec4 sum(0.0f);
+                    for (int b = 0; b < n; ++b)
+                        for (int a = 0; a < n; ++a) sum += fine.at(x * n + a, y * n + b);
+                    ref.at(x, y) = sum / float(n * n);
+                }
             const double refMs =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count();
@@ -131,17 +168,24 @@ int main(int argc, char** argv) {
                 RenderSettings s = base;
                 s.renderer = c.kind;
                 s.quality.slab = c.slab;
+                s.quality.lod = c.lod;
                 s.camera.azimuthDeg = az;
                 const Renderer renderer(volume, s);
-                renderer.render();  // warm-up (first-touch allocations)
+                renderer.render();  // warm-up (first-touch allocations, the level of detail)
+                RenderStats st;
                 const auto a = std::chrono::steady_clock::now();
-                const Image im = renderer.render();
+                const Image im = renderer.render(&st);
                 const double ms =
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a)
                         .count();
                 const ImageMetrics m = compareImages(im, ref);
-                std::printf("| %g | %s | %.3g | %.1f | %.3g | %.1f |\n", az, c.label.c_str(),
-                            m.rmse, m.psnr, m.maxAbs, ms);
+                std::printf(
+                    "| %g | %s | %.3g | %.1f | %.3g | %.1f |\n", az,
+                    (c.label + (st.lodLevel ? " (level " + std::to_string(st.lodLevel) + ", " +
+                                                  std::to_string(st.lodSplats) + " splats)"
+                                            : ""))
+                        .c_str(),
+                    m.rmse, m.psnr, m.maxAbs, ms);
                 std::fflush(stdout);
             }
         }

@@ -5,11 +5,12 @@
 //       writes the volume as a float MetaImage with splat's world grid (origin, spacing),
 //       so that another renderer sees the same samples at the same world positions.
 //   bench_frames render VOLUME TF.json [--renderer axis|sheet|reference] [--slab S]
-//       [--size N] [--threads T] [--frames F] [--elevation E] [--warmup 0|1]
+//       [--lod L] [--size N] [--threads T] [--frames F] [--elevation E] [--warmup 0|1]
 //       [--save 0,4,..] [--out DIR]
 //       renders a rotation of F frames (azimuth 360 k / F) and prints JSON: per frame its
-//       wall time and stage counters and the camera (target, right, up, view, pixel size),
-//       and the scene's build time, splat count and bytes per splat. Frames listed in
+//       wall time, stage counters, level of detail used (Quality::lod) and the camera (target,
+//       right, up, view, pixel size), and the scene's build time, splat count and bytes per splat.
+//       Frames listed in
 //       --save are written to DIR/frame_K.f32 (float RGBA, row 0 at the top).
 //   bench_frames compare A B W H
 //       RMSE and max abs difference of the RGB of two W x H images over black, each a .f32
@@ -89,6 +90,7 @@ int renderRotation(const std::string& spec, const std::string& tfPath, const Opt
     s.renderer = splat::parseRenderer(o.get("--renderer", "axis"));
     s.transfer = splat::TransferFunction::load(tfPath);
     s.quality.slab = std::stod(o.get("--slab", "1"));
+    s.quality.lod = std::stod(o.get("--lod", "0"));
     s.threads = std::stoi(o.get("--threads", "2"));
     const int size = std::stoi(o.get("--size", "512"));
     const int frames = std::max(1, std::stoi(o.get("--frames", "12")));
@@ -127,9 +129,9 @@ int renderRotation(const std::string& spec, const std::string& tfPath, const Opt
     const splat::SplatList& sp = scene.splats();
     json << "{\"renderer\": \"" << splat::toString(s.renderer) << "\", \"size\": " << size
          << ", \"threads\": " << s.threads << ", \"slab\": " << s.quality.slab
-         << ", \"scene_ms\": " << sceneMs << ", \"splats\": " << sp.size()
-         << ", \"splat_bytes\": " << sp.bytes() << ", \"voxels\": " << volume->voxelCount()
-         << ", \"frames\": [";
+         << ", \"lod\": " << s.quality.lod << ", \"scene_ms\": " << sceneMs
+         << ", \"splats\": " << sp.size() << ", \"splat_bytes\": " << sp.bytes()
+         << ", \"voxels\": " << volume->voxelCount() << ", \"frames\": [";
     bool first = true;
     for (int f = 0; f < frames; ++f) {
         if (!wanted(f)) continue;
@@ -149,6 +151,7 @@ int renderRotation(const std::string& spec, const std::string& tfPath, const Opt
              << ", \"bin_ms\": " << st.binMs << ", \"tiles_ms\": " << st.tilesMs
              << ", \"footprint_pixels\": " << st.footprintPixels
              << ", \"culled_splats\": " << st.culledSplats << ", \"sheets\": " << st.sheets
+             << ", \"lod_level\": " << st.lodLevel << ", \"lod_splats\": " << st.lodSplats
              << ", \"target\": " << vec(cam.target) << ", \"right\": " << vec(cam.right)
              << ", \"up\": " << vec(cam.up) << ", \"view\": " << vec(cam.view)
              << ", \"pixel_size\": " << cam.pixelSize << ", \"radius\": " << cam.boundingRadius
@@ -205,7 +208,7 @@ int compare(const std::string& a, const std::string& b, int w, int h) {
 int usage() {
     std::cerr << "usage: bench_frames export VOLUME OUT.mha\n"
                  "       bench_frames render VOLUME TF.json [--renderer R] [--slab S] "
-                 "[--size N] [--threads T] [--frames F] [--elevation E] [--warmup 0|1] "
+                 "[--lod L] [--size N] [--threads T] [--frames F] [--elevation E] [--warmup 0|1] "
                  "[--save LIST] [--out DIR]\n"
                  "       bench_frames compare A B W H\n";
     return 2;

@@ -104,6 +104,8 @@ void registerBench(CLI::App& app) {
                                    {"footprint_pixels_per_s", rate},
                                    {"sheets", stats.sheets},
                                    {"culled", stats.culledSplats},
+                                   {"lod_level", stats.lodLevel},
+                                   {"lod_splats", stats.lodSplats},
                                    {"project_ms", stats.projectMs},
                                    {"bin_ms", stats.binMs},
                                    {"tiles_ms", stats.tilesMs}});

@@ -44,6 +44,9 @@ void dropIgnoredOptions(RenderArgs& a, const RenderSettings& s, const RenderUse&
             drop("early-termination", a.earlyTermination != d.earlyTermination,
                  "--early-termination applies to the splatters, not to the reference renderer",
                  [&] { a.earlyTermination = d.earlyTermination; });
+            drop("lod", a.lod != d.lod,
+                 "--lod applies to the splatters, not to the reference renderer",
+                 [&] { a.lod = d.lod; });
         }
     }
     if (s.mode != RenderMode::Dvr)

@@ -59,6 +59,10 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool imageOutput) {
               "reference renderer: step refinement tolerance", q);
     addOption(cmd, "--threads", a.threads, "worker threads (0 = all cores)", q);
     addOption(cmd, "--tile-size", a.tileSize, "splatters: screen tile edge in pixels (8..64)", q);
+    addOption(cmd, "--lod", a.lod,
+              "splatters: level of detail, pixels per voxel below which 2x2x2 voxels are "
+              "merged into one splat of twice the size, repeatedly (0..64; 0 = off)",
+              q);
     addTechniqueOptions(cmd, a.technique, imageOutput);
     if (imageOutput)
         addOption(cmd, "--window", a.window,
@@ -162,6 +166,8 @@ RenderSettings parseSettings(const RenderArgs& a) {
     if (a.tileSize < 8 || a.tileSize > 64) throw Error("--tile-size must be between 8 and 64");
     s.threads = a.threads;
     s.quality.tileSize = a.tileSize;
+    requireIn(a.lod, 0, 64, "--lod (pixels per voxel; 0 = off)");
+    s.quality.lod = a.lod;
     requireIn(a.refStep, 1e-3, 64, "--ref-step (voxels)");
     if (!std::isfinite(a.refTolerance) || !(a.refTolerance > 0) || a.refTolerance > 1)
         throw Error("--ref-tolerance must be a finite number in (0, 1]");

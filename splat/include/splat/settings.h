@@ -95,6 +95,12 @@ struct Quality {
     double referenceStep = 0.25, referenceTolerance = 1e-4;
     /// Screen tile edge, pixels (8..64): each tile owns its sheets and compositing.
     int tileSize = 32;
+    /// Level of detail (splatters): while a voxel of the level in use covers fewer than
+    /// `lod` pixels (its largest spacing over the pixel size; perspective: at the volume's
+    /// nearest depth), the splatters use the next level, 2x2x2 voxels merged into one splat
+    /// of twice the size (Laur & Hanrahan). 0 = off: always the full-resolution list.
+    /// 0..64.
+    double lod = 0;
 };
 
 struct RenderSettings {
@@ -143,6 +149,11 @@ struct RenderStats {
     /// a kernel straddles or lies behind the perspective near plane (eye inside or within
     /// two kernel radii of the volume's kernels), where a local-affine footprint is invalid.
     std::size_t exactPixels = 0;
+    /// Level of detail the splatters used (Quality::lod): 0 the full-resolution list, L the
+    /// list of 2^L x 2^L x 2^L voxels merged per splat, holding lodSplats splats (= splats at
+    /// level 0; 0 for frames of the reference ray caster).
+    int lodLevel = 0;
+    std::size_t lodSplats = 0;
 };
 
 /// The one enum <-> string table: names as used by the command line and scene files.

@@ -10,7 +10,7 @@
 //
 // Knobs (names as on the command line, `--sweep NAME=V1,V2,...`):
 //   per frame (one Scene serves them):  renderer, slab, early-termination, size (WxH or N),
-//                                       order
+//                                       order, lod
 //   per Scene (a new Scene per value):  classify, kernel, sigma, radius, footprint-res,
 //                                       slab-radial-res, slab-depth-res, poly-tol
 #include <cmath>

@@ -140,7 +140,8 @@ std::vector<std::string> studyKnobNames() {
             "footprint-res",
             "slab-radial-res",
             "slab-depth-res",
-            "poly-tol"};
+            "poly-tol",
+            "lod"};
 }
 
 bool isSceneKnob(const std::string& n) {
@@ -186,6 +187,8 @@ void applyKnob(RenderSettings& s, const std::string& n, const std::string& v) {
         q.slabDepthResolution = parseInt(n, v);
     else if (n == "poly-tol")
         q.polynomialTolerance = parseNumber(n, v);
+    else if (n == "lod")
+        q.lod = parseNumber(n, v);
     else {
         std::string all;
         for (const auto& k : studyKnobNames()) all += (all.empty() ? "" : ", ") + k;
@@ -394,6 +397,7 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         frame.quality.referenceStep = s.quality.referenceStep;
         frame.quality.referenceTolerance = s.quality.referenceTolerance;
         frame.quality.tileSize = s.quality.tileSize;
+        frame.quality.lod = s.quality.lod;
         point.settings = frame;
         std::vector<double> ms;
         double sumSq = 0, sumMax = 0, sumFlip = 0;

@@ -15,6 +15,7 @@
 #include "frame/frame.h"
 #include "frame/projection.h"
 #include "frame/tile_binning.h"
+#include "model/level_of_detail.h"
 #include "reference/reference_frame.h"
 #include "splat/error.h"
 #include "splatters/splatter.h"
@@ -199,6 +200,19 @@ bool needsExactPath(const Scene::Impl& scene, const Camera& camera) {
         [](bool a, bool b) { return a || b; });
 }
 
+/// The level of detail the splatters use for this view (Quality::lod): coarser while a voxel
+/// of the level covers fewer than `lod` pixels.
+const Scene::Impl& levelOfDetail(const Scene::Impl& scene, const Camera& camera, double lod) {
+    const Scene::Impl* level = &scene;
+    if (lod > 0)
+        while (voxelPixels(camera, *level->volume) < lod) {
+            const Scene::Impl* next = level->coarser();
+            if (!next) break;
+            level = next;
+        }
+    return *level;
+}
+
 }  // namespace
 
 void validateFrame(const RenderSettings& s) {
@@ -211,6 +225,8 @@ void validateFrame(const RenderSettings& s) {
     if (!(q.earlyTermination >= 0 && q.earlyTermination < 1))
         throw Error("early termination threshold must be in [0, 1)");
     if (q.tileSize < 8 || q.tileSize > 64) throw Error("tile size must be between 8 and 64 pixels");
+    if (!(q.lod >= 0 && q.lod <= 64))
+        throw Error("level of detail threshold must be between 0 (off) and 64 pixels per voxel");
     if (s.threads < 0 || s.threads > 1024)
         throw Error("thread count must be between 0 (all) and 1024");
     if (!(q.referenceStep > 0) || !(q.referenceTolerance > 0))
@@ -235,13 +251,20 @@ Image renderFrame(const Scene::Impl& scene, const RenderSettings& given, RenderS
     runOnThreads(s.threads, [&] {
         const Camera camera(s.camera, *scene.volume);
         local.perspective = camera.perspective();
+        // The camera is the full-resolution scene's: a level's grid is centred differently
+        // when a dimension is odd.
+        const Scene::Impl& level = s.renderer == RendererKind::Reference
+                                       ? scene
+                                       : levelOfDetail(scene, camera, s.quality.lod);
         if (s.renderer == RendererKind::Reference) {
             image = referenceFrame(scene, camera, s, local, depth);
-        } else if (needsExactPath(scene, camera)) {
+        } else if (needsExactPath(level, camera)) {
             image = referenceFrame(scene, camera, s, local, depth);
             local.exactPixels = std::size_t(camera.width()) * std::size_t(camera.height());
         } else {
-            image = splatFrame(scene, camera, s, local, depth);
+            local.lodLevel = level.level;
+            local.lodSplats = level.splats.size();
+            image = splatFrame(level, camera, s, local, depth);
         }
     });
     local.milliseconds = msSince(start);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "frame/frame.h"
+#include "model/level_of_detail.h"
 #include "model/scene_impl.h"
 #include "reference/field.h"
 #include "reference/reference_frame.h"
@@ -147,6 +148,30 @@ Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
         poly.emplace(table);
         if (poly->maxError() > s.quality.polynomialTolerance) poly.reset();
     }
+}
+
+Scene::Impl::Impl(const Impl& fine, Coarser)
+    : volume(std::make_shared<const Volume>(coarserGrid(*fine.volume))),
+      settings(fine.settings),
+      kernel(fine.kernel),
+      splats(coarserSplats(fine.splats, fine.volume->dims)),
+      transfer(fine.transfer),
+      table(fine.table),
+      poly(fine.poly),
+      level(fine.level + 1),
+      minValue(fine.minValue),
+      maxValue(fine.maxValue),
+      labelTable(fine.labelTable) {}
+
+const Scene::Impl* Scene::Impl::coarser() const {
+    if (volume->dims == glm::ivec3(1)) return nullptr;
+    std::lock_guard<std::mutex> lock(lazyMutex_);
+    // Isolated: while this thread waits inside the merge's parallel loop it must not pick up
+    // another frame's task that would ask for this lock again.
+    if (!coarser_)
+        tbb::this_task_arena::isolate(
+            [&] { coarser_ = std::make_unique<Impl>(*this, Coarser{}); });
+    return coarser_.get();
 }
 
 const Scene::Impl::SliceOrder& Scene::Impl::sliceOrder(int axis) const {

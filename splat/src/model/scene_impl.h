@@ -43,6 +43,17 @@ struct Scene::Impl {
     std::optional<footprint::FootprintPoly> poly;  ///< when within polynomialTolerance
 
     Impl(std::shared_ptr<const Volume> v, const RenderSettings& s);
+    /// The next level of detail of `fine` (model/level_of_detail.h): its grid (no samples)
+    /// and merged splats, with fine's settings, kernel and tables.
+    struct Coarser {};
+    Impl(const Impl& fine, Coarser);
+
+    /// Level of detail of this list: 0 for the scene's own, L for 2^L x 2^L x 2^L voxels
+    /// merged per splat.
+    int level = 0;
+    /// The next level (2x the spacing), made on first use and kept; null when this level's
+    /// grid is one voxel along every axis. The splatters render a level like any scene.
+    const Impl* coarser() const;
 
     float minValue = 0, maxValue = 0;  ///< of the volume (normalized iso levels)
     /// Labels: colour and extinction (a) per label as shown, and the shown label of every
@@ -105,6 +116,7 @@ struct Scene::Impl {
     mutable std::unique_ptr<footprint::SlabTable> slabTable_;
     mutable std::shared_ptr<const ReferenceField> field_;
     mutable std::vector<std::unique_ptr<FrameWorkspace>> pool_;
+    mutable std::unique_ptr<Impl> coarser_;
 };
 
 /// A workspace taken from a Scene's pool for the duration of one frame.
