@@ -179,29 +179,31 @@ class Bench:
             self.volumes[name] = (spec, mha, info)
         return self.volumes[name]
 
-    def splat(self, spec, renderer, size, threads, frames, save, out, slab=1.0):
+    def splat(self, spec, renderer, size, threads, frames, save, out, slab=1.0, lod=0.0):
         os.makedirs(out, exist_ok=True)
         return run_json([f"{self.bin}/bench_frames", "render", spec, self.tf, "--renderer",
                          renderer, "--slab", str(slab), "--size", str(size), "--threads",
                          str(threads), "--frames", str(frames), "--elevation", str(ELEVATION),
                          "--save", ",".join(map(str, save)), "--out", out,
-                         "--warmup", "0" if renderer == "reference" else "1"])
+                         "--warmup", "0" if renderer == "reference" else "1"]
+                        + (["--lod", str(lod)] if lod > 0 else []))
 
     def compare(self, a, b, size):
         return run_json([f"{self.bin}/bench_frames", "compare", a, b, str(size), str(size)])
 
-    def config(self, name, size, threads, renderer="axis", slab=1.0, vtk_step=1.0):
-        """One row: splat (renderer, slab) and VTK (vtk_step voxels) on `name` at size^2."""
+    def config(self, name, size, threads, renderer="axis", slab=1.0, vtk_step=1.0, lod=0.0):
+        """One row: splat (renderer, slab, level of detail) and VTK (vtk_step voxels) on
+        `name` at size^2."""
         a = self.args
         spec, mha, info = self.volume(name, VOLUMES[name])
         frames, save = a.frames, a.error_frames
-        tag = f"{name}_{size}_{threads}_{renderer}_{slab}_{vtk_step}".replace(":", "_")
+        tag = f"{name}_{size}_{threads}_{renderer}_{slab}_{vtk_step}_{lod}".replace(":", "_")
         splat_ms, vtk_ms, splat_runs = [], [], []
         vtk = Vtk(mha, info, size, threads)
         cameras = None
         for rnd in range(a.rounds):
             run = self.splat(spec, renderer, size, threads, frames, save if rnd == 0 else [],
-                             self.path(tag, "splat"), slab)
+                             self.path(tag, "splat"), slab, lod)
             splat_runs.append(run)
             splat_ms += [f["ms"] for f in run["frames"]]
             cameras = run["frames"]
@@ -242,7 +244,7 @@ class Bench:
                  for s in ("project_ms", "order_ms", "bin_ms", "tiles_ms")}
         row = {
             "volume": name, "size": size, "threads": threads, "renderer": renderer,
-            "slab": slab, "vtk_step": vtk_step, "frames": frames, "rounds": a.rounds,
+            "slab": slab, "lod": lod, "vtk_step": vtk_step, "frames": frames, "rounds": a.rounds,
             "splat_ms": statistics.median(splat_ms), "vtk_ms": statistics.median(vtk_ms),
             "splat_rmse": statistics.mean(e["rmse"] for e in err_splat) if err_splat else None,
             "vtk_rmse": statistics.mean(e["rmse"] for e in err_vtk),
@@ -255,8 +257,7 @@ class Bench:
             "stages_ms": stage,
         }
         row["ratio"] = row["splat_ms"] / row["vtk_ms"]
-        print(f"  {name} {size}^2 {threads}T {renderer}"
-              f"{'' if renderer == 'axis' else f' slab {slab}'} vs VTK step {vtk_step}: "
+        print(f"  {name} {size}^2 {threads}T {label(row)} vs VTK step {vtk_step}: "
               f"splat {row['splat_ms']:.0f} ms, VTK {row['vtk_ms']:.0f} ms, "
               f"ratio {row['ratio']:.2f}", file=sys.stderr)
         return row
@@ -286,6 +287,10 @@ class Bench:
         return out
 
 
+# Level of detail (Quality::lod) for the rows where voxels are smaller than pixels.
+LOD = 1.0
+LOD_ROWS = [("ch2", 256), ("phantom:256", 256), ("phantom:512", 512)]
+
 VOLUMES = {
     "ch2": CH2,
     "phantom:256": "synthetic:phantom:256",
@@ -293,16 +298,24 @@ VOLUMES = {
 }
 
 
+def label(r):
+    """A row's splat renderer as the tables name it."""
+    rend = r["renderer"] if r["renderer"] == "axis" else f"{r['renderer']} slab {r['slab']:g}"
+    return rend + (f" lod {r['lod']:g}" if r.get("lod", 0) > 0 else "")
+
+
 def plan(quick):
-    """(volume, size, threads, renderer, slab, VTK step) per row."""
+    """(volume, size, threads, renderer, slab, VTK step, level of detail) per row."""
     if quick:
-        return [("ch2", 256, 2, "axis", 1.0, 1.0)]
+        return [("ch2", 256, 2, "axis", 1.0, 1.0, 0.0)]
     rows = [("ch2", s, 2, "axis", 1.0, 1.0) for s in (256, 512, 1024)]
     rows += [("ch2", 512, 2, "axis", 1.0, 0.5), ("ch2", 512, 2, "axis", 1.0, 0.25),
              ("ch2", 512, 2, "sheet", 1.0, 0.25),
              ("ch2", 512, 1, "axis", 1.0, 1.0), ("ch2", 512, 1, "sheet", 1.0, 0.25)]
     rows += [("phantom:256", s, 2, "axis", 1.0, 1.0) for s in (256, 512, 1024)]
     rows += [("phantom:512", 512, 2, "axis", 1.0, 1.0)]
+    rows = [r + (0.0,) for r in rows]
+    rows += [(v, s, 2, "axis", 1.0, 1.0, LOD) for v, s in LOD_ROWS]
     return rows
 
 
@@ -318,7 +331,7 @@ def markdown(result):
            "| fill limit |",
            "|---|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        rend = r["renderer"] if r["renderer"] == "axis" else f"{r['renderer']} slab {r['slab']:g}"
+        rend = label(r)
         out.append(
             f"| {r['volume']} | {r['size']}² | {r['threads']} | {rend} | {r['vtk_step']:g} "
             f"| {r['splat_ms']:.0f} | {r['vtk_ms']:.0f} | **{r['ratio']:.2f}×** "
@@ -335,7 +348,7 @@ def markdown(result):
                "| project ms | bin ms | tiles ms | fill time at the limit ms |")
     out.append("|---|---|---|---|---:|---:|---:|---:|---:|---:|")
     for r in rows:
-        rend = r["renderer"] if r["renderer"] == "axis" else f"{r['renderer']} slab {r['slab']:g}"
+        rend = label(r)
         st = r["stages_ms"]
         lim = limit.get(r["threads"], 0)
         out.append(
@@ -378,7 +391,7 @@ def main():
     bench = Bench(args)
     start = time.perf_counter()
     try:
-        rows = [bench.config(v, s, t, rend, slab, step) for v, s, t, rend, slab, step in plan(args.quick)]
+        rows = [bench.config(*row) for row in plan(args.quick)]
         result = {"transfer_function": TF, "elevation": ELEVATION, "frames": args.frames,
                   "rounds": args.rounds, "error_frames": args.error_frames,
                   "vtk_fine_step": VTK_FINE_STEP, "rows": rows, "fill": bench.fill(),
