@@ -4,7 +4,8 @@
 // interpolation:
 //   FootprintLanes: fp(r^2) of FootprintTable::lookup, from the table (two gathers) or from
 //                   a FootprintPoly (permutes and fused multiply-adds, no gathers);
-//   FractionLanes:  F(r^2, z) of SlabTable::fraction, bilinear (four gathers).
+//   FractionLanes:  F(r^2, z) of SlabTable::fraction, bilinear (four 4-lane 64-bit gathers
+//                   of the interleaved table rows).
 // Both reproduce the scalar lookups' clamping. On x86-64 (FOOTPRINT_HAVE_LANES defined)
 // they are compiled for AVX2 + FMA whatever the translation unit targets: code between
 // FOOTPRINT_LANES_BEGIN and FOOTPRINT_LANES_END is, so a portable build carries the vector
@@ -88,7 +89,7 @@ class FootprintLanes {
 class FractionLanes {
   public:
     explicit FractionLanes(const SlabTable& t)
-        : values_(t.values_.data()),
+        : pairs_(reinterpret_cast<const double*>(t.values_.data())),
           invR_(_mm256_set1_ps(t.invR2Step_)),
           invZ_(_mm256_set1_ps(t.invZStep_)),
           zMin_(_mm256_set1_ps(t.zMin_)),
@@ -98,7 +99,7 @@ class FractionLanes {
 
     /// The radial part of a lookup, shared by every depth at the same r^2 (r2 >= 0).
     struct Radial {
-        __m256i row;  ///< index of the grid row below r^2
+        __m256i row;  ///< index of the grid row below r^2 (times the row stride)
         __m256 fr;    ///< fraction towards the next row
     };
     Radial radial(__m256 r2) const {
@@ -113,20 +114,30 @@ class FractionLanes {
         zz = _mm256_min_ps(_mm256_max_ps(zz, zero), nz_);  // NaN -> 0 as fraction()
         const __m256i j = _mm256_cvttps_epi32(zz);
         const __m256 fz = _mm256_sub_ps(zz, _mm256_cvtepi32_ps(j));
-        const __m256i one = _mm256_set1_epi32(1);
-        const __m256i idx = _mm256_add_epi32(r.row, j);
-        const __m256i idx2 = _mm256_add_epi32(idx, stride_);
-        const __m256 p0 = _mm256_i32gather_ps(values_, idx, 4);
-        const __m256 p1 = _mm256_i32gather_ps(values_, _mm256_add_epi32(idx, one), 4);
-        const __m256 p2 = _mm256_i32gather_ps(values_, idx2, 4);
-        const __m256 p3 = _mm256_i32gather_ps(values_, _mm256_add_epi32(idx2, one), 4);
+        // Pair (F(i, j), F(i + 1, j)) of every lane as one 64-bit element, lanes 0 1 4 5
+        // in one gather and 2 3 6 7 in another, so that even / odd floats of the two
+        // gathers interleave back into lane order (vshufps works within 128-bit halves).
+        const __m256i idx = _mm256_permutevar8x32_epi32(_mm256_add_epi32(r.row, j),
+                                                        _mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7));
+        const __m128i lo = _mm256_castsi256_si128(idx), hi = _mm256_extracti128_si256(idx, 1);
+        // (the masked form: GCC 12 warns about the unmasked one's undefined source)
+        const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), none = _mm256_setzero_pd();
+        auto gather = [&](const double* base, __m128i i) {
+            return _mm256_castpd_ps(_mm256_mask_i32gather_pd(none, base, i, all, 8));
+        };
+        const __m256 a0 = gather(pairs_, lo), b0 = gather(pairs_, hi);
+        const __m256 a1 = gather(pairs_ + 1, lo), b1 = gather(pairs_ + 1, hi);
+        const __m256 p0 = _mm256_shuffle_ps(a0, b0, _MM_SHUFFLE(2, 0, 2, 0));  // F(i, j)
+        const __m256 p2 = _mm256_shuffle_ps(a0, b0, _MM_SHUFFLE(3, 1, 3, 1));  // F(i + 1, j)
+        const __m256 p1 = _mm256_shuffle_ps(a1, b1, _MM_SHUFFLE(2, 0, 2, 0));  // F(i, j + 1)
+        const __m256 p3 = _mm256_shuffle_ps(a1, b1, _MM_SHUFFLE(3, 1, 3, 1));
         const __m256 a = _mm256_fmadd_ps(fz, _mm256_sub_ps(p1, p0), p0);
         const __m256 b = _mm256_fmadd_ps(fz, _mm256_sub_ps(p3, p2), p2);
         return _mm256_fmadd_ps(r.fr, _mm256_sub_ps(b, a), a);
     }
 
   private:
-    const float* values_;
+    const double* pairs_;  // SlabTable::values_, a pair of floats per element
     __m256 invR_, invZ_, zMin_, nr_, nz_;
     __m256i stride_;
 };

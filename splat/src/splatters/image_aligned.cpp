@@ -24,6 +24,9 @@ namespace {
 /// thickness (e.g. an extreme spacing ratio), and the buckets would not fit in memory.
 constexpr double kMaxSlabs = double(1 << 24);
 
+/// Most slabs one kernel may span (the slab thickness is at least 1e-3 voxels).
+constexpr int kMaxSpan = 8192;
+
 /// The sections of one kernel in n consecutive slabs at once, slab j between the depths
 /// tb[j] and tb[j + 1] (world units along the ray, relative to the splat centre), each added
 /// to sheets[j]. Sharing r^2, fp(r^2) and the fraction F(r^2, z) at every inner slab
@@ -40,6 +43,7 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
     const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
     for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
     const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), zero = _mm256_setzero_ps();
+    const __m256 one = _mm256_set1_ps(1.0f);
     const __m256 signBit = _mm256_set1_ps(-0.0f);
     const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
     const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
@@ -48,9 +52,30 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
     const __m256 vds = _mm256_set1_ps(e.depthScale), vtx = _mm256_set1_ps(e.tx);
     __m256 vv[NCh];
     for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+    // Per boundary b, per row: F is the constant 0 or 1 (kind 0, 1) or must be looked up
+    // (kind 2). The section of slab j is zero where both its boundaries are the same
+    // constant, so a row visits only slabs [jBegin, jEnd).
+    signed char kind[kMaxSpan + 1];
     for (int y = y0; y <= y1; ++y) {
         const float dy = float(y + oy) + 0.5f - sy;
-        const __m256 vgyy = _mm256_set1_ps(e.gamma * dy * dy), vshift = _mm256_set1_ps(e.beta * dy);
+        const float gyy = e.gamma * dy * dy;     // the row's smallest r^2 (every lane's r^2 >= it)
+        if (!(gyy < fpTable.r2Max())) continue;  // the whole row is outside the ellipse
+        const footprint::SlabTable::Saturation sat = table.saturation(gyy);
+        // Depth of the rays' closest approach along the row: tc = tx dx + ty dy, linear in dx.
+        const float dxA = float(x0 + ox) + 0.5f - sx, dxB = float(x1 + ox) + 0.5f - sx;
+        const float tcA = e.tx * dxA + e.ty * dy, tcB = e.tx * dxB + e.ty * dy;
+        const float tcLo = std::min(tcA, tcB), tcHi = std::max(tcA, tcB);
+        int jBegin = n, jEnd = 0;
+        for (int b = 0; b <= n; ++b) {
+            const float zLo = e.depthScale * (tb[b] - tcHi), zHi = e.depthScale * (tb[b] - tcLo);
+            kind[b] = zHi <= sat.zeroBelow ? 0 : (zLo >= sat.oneAbove ? 1 : 2);
+            if (b > 0 && (kind[b] == 2 || kind[b] != kind[b - 1])) {
+                jBegin = std::min(jBegin, b - 1);
+                jEnd = b;
+            }
+        }
+        if (jBegin >= jEnd) continue;
+        const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(e.beta * dy);
         const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
         for (int x = x0; x <= x1; x += 8) {
@@ -63,13 +88,16 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
             const __m256 weight = _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vScale));
             const footprint::FractionLanes::Radial radial = fraction.radial(r2);
             const __m256 tc = _mm256_fmadd_ps(vtx, dx, vtyy);
-            // Kernel-space depth of boundary b along these rays: z = depthScale (t - tc).
-            auto depth = [&](int b) {
-                return _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc));
+            // F at boundary b: z = depthScale (t - tc) in kernel units, looked up only where
+            // the row is not saturated there.
+            auto fractionAt = [&](int b) {
+                if (kind[b] != 2) return kind[b] ? one : zero;
+                return fraction(radial,
+                                _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
             };
-            __m256 below = fraction(radial, depth(0));
-            for (int j = 0; j < n; ++j) {
-                const __m256 above = fraction(radial, depth(j + 1));
+            __m256 below = fractionAt(jBegin);
+            for (int j = jBegin; j < jEnd; ++j) {
+                const __m256 above = fractionAt(j + 1);
                 // |F(above) - F(below)|: the boundaries run back to front when compositing is.
                 const __m256 w =
                     _mm256_mul_ps(weight, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
@@ -143,8 +171,6 @@ struct SlabSections {
         return splatSections(sheets, n, v, sx, sy, e, r, table,
                              in.scene.poly ? &*in.scene.poly : nullptr, tb);
     }
-    /// Most slabs one kernel may span (the slab thickness is at least 1e-3 voxels).
-    static constexpr int kMaxSpan = 8192;
 };
 
 class ImageAligned final : public Splatter {
@@ -169,7 +195,7 @@ class ImageAligned final : public Splatter {
         zmax += ext;
         const double slabCount = double(std::floor((zmax - zmin) / thickness)) + 1;
         const double span = double(std::ceil(2.0f * ext / thickness)) + 2;
-        if (!(slabCount <= kMaxSlabs) || !(span <= SlabSections::kMaxSpan))
+        if (!(slabCount <= kMaxSlabs) || !(span <= kMaxSpan))
             throw Error("image-aligned splatter: the volume's depth range (" +
                         std::to_string(zmax - zmin) + ") at slab thickness " +
                         std::to_string(thickness) +
