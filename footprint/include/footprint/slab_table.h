@@ -93,8 +93,8 @@ class SlabTable {
     float r2Max_ = 0, invR2Step_ = 0, invZStep_ = 0, zMin_ = 0, nrf_ = 0, nzf_ = 0;
     // F on the (nr + 2) x (nz + 2) grid (z fastest, guards for + 1) with rows i and i + 1
     // interleaved: (F(i, j), F(i + 1, j)) at 2 (i stride + j), i in [0, nr]. The four
-    // values of one bilinear lookup are 16 contiguous bytes, two 64-bit reads
-    // (FractionLanes gathers 64-bit pairs: half the element reads of four float gathers).
+    // values of one bilinear lookup are 16 contiguous bytes (FractionLanes: one load per
+    // lane instead of four gathered floats).
     std::vector<float> values_;
     std::vector<Saturation> saturation_;  // per grid row 0..nr (the row below r^2)
 };

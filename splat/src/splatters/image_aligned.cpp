@@ -56,6 +56,8 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
     // (kind 2). The section of slab j is zero where both its boundaries are the same
     // constant, so a row visits only slabs [jBegin, jEnd).
     signed char kind[kMaxSpan + 1];
+    float* rows[kMaxSpan];
+    std::ptrdiff_t planes[kMaxSpan];  // distance between channel planes, per sheet
     for (int y = y0; y <= y1; ++y) {
         const float dy = float(y + oy) + 0.5f - sy;
         const float gyy = e.gamma * dy * dy;     // the row's smallest r^2 (every lane's r^2 >= it)
@@ -75,6 +77,15 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
             }
         }
         if (jBegin >= jEnd) continue;
+        // This row of every slab's sheet (the stores may alias the sheets' members: without
+        // these the compiler reloads them for every store).
+        for (int j = jBegin; j < jEnd; ++j) {
+            rows[j] = sheets[j]->row(0, y);
+            if constexpr (NCh > 1)
+                planes[j] = sheets[j]->row(1, y) - rows[j];
+            else
+                planes[j] = 0;
+        }
         const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(e.beta * dy);
         const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
@@ -102,8 +113,8 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
                 const __m256 w =
                     _mm256_mul_ps(weight, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
                 below = above;
-                for (int c = 0; c < NCh; ++c) {
-                    float* p = sheets[j]->row(c, y) + x;
+                float* p = rows[j] + x;
+                for (int c = 0; c < NCh; ++c, p += planes[j]) {
                     _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
                 }
             }
