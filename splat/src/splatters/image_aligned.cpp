@@ -42,8 +42,8 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
     const int ox = sheets[0]->originX(), oy = sheets[0]->originY();
     const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
     for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
-    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), zero = _mm256_setzero_ps();
-    const __m256 one = _mm256_set1_ps(1.0f);
+    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), vZero = _mm256_setzero_ps();
+    const __m256 vOne = _mm256_set1_ps(1.0f);
     const __m256 signBit = _mm256_set1_ps(-0.0f);
     const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
     const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
@@ -52,10 +52,14 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
     const __m256 vds = _mm256_set1_ps(e.depthScale), vtx = _mm256_set1_ps(e.tx);
     __m256 vv[NCh];
     for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
-    // Per boundary b, per row: F is the constant 0 or 1 (kind 0, 1) or must be looked up
-    // (kind 2). The section of slab j is zero where both its boundaries are the same
-    // constant, so a row visits only slabs [jBegin, jEnd).
-    signed char kind[kMaxSpan + 1];
+    // Per row, F at boundary b is the constant 0 or 1 where the boundary's depth over the
+    // row lies beyond the table's saturation bounds at the row's smallest r^2, and must be
+    // looked up elsewhere. The boundaries' depths are monotone in b (ascending front to
+    // back, descending back to front), so the constant ones are a prefix [0, pre) and a
+    // suffix [suf, n] (front to back F = 0 before the kernel and 1 behind it; back to front
+    // the reverse): a row visits only slabs [pre - 1, suf), the others' sections are zero.
+    const bool ascending = tb[n] > tb[0];
+    const __m256 vPre = ascending ? vZero : vOne, vSuf = ascending ? vOne : vZero;
     float* rows[kMaxSpan];
     std::ptrdiff_t planes[kMaxSpan];  // distance between channel planes, per sheet
     for (int y = y0; y <= y1; ++y) {
@@ -67,15 +71,18 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
         const float dxA = float(x0 + ox) + 0.5f - sx, dxB = float(x1 + ox) + 0.5f - sx;
         const float tcA = e.tx * dxA + e.ty * dy, tcB = e.tx * dxB + e.ty * dy;
         const float tcLo = std::min(tcA, tcB), tcHi = std::max(tcA, tcB);
-        int jBegin = n, jEnd = 0;
-        for (int b = 0; b <= n; ++b) {
-            const float zLo = e.depthScale * (tb[b] - tcHi), zHi = e.depthScale * (tb[b] - tcLo);
-            kind[b] = zHi <= sat.zeroBelow ? 0 : (zLo >= sat.oneAbove ? 1 : 2);
-            if (b > 0 && (kind[b] == 2 || kind[b] != kind[b - 1])) {
-                jBegin = std::min(jBegin, b - 1);
-                jEnd = b;
-            }
+        // z(b) over the row's pixels lies in [zLo(b), zHi(b)].
+        auto zero = [&](int b) { return e.depthScale * (tb[b] - tcLo) <= sat.zeroBelow; };
+        auto one = [&](int b) { return e.depthScale * (tb[b] - tcHi) >= sat.oneAbove; };
+        int pre = 0, suf = n + 1;
+        if (ascending) {
+            while (pre <= n && zero(pre)) ++pre;
+            while (suf > pre && one(suf - 1)) --suf;
+        } else {
+            while (pre <= n && one(pre)) ++pre;
+            while (suf > pre && zero(suf - 1)) --suf;
         }
+        const int jBegin = std::max(pre - 1, 0), jEnd = std::min(suf, n);
         if (jBegin >= jEnd) continue;
         // This row of every slab's sheet (the stores may alias the sheets' members: without
         // these the compiler reloads them for every store).
@@ -93,7 +100,7 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
             const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
             const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
             const __m256 q = _mm256_add_ps(dx, vshift);
-            const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), zero);
+            const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), vZero);
             const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
                                                 _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
             const __m256 weight = _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vScale));
@@ -102,7 +109,8 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
             // F at boundary b: z = depthScale (t - tc) in kernel units, looked up only where
             // the row is not saturated there.
             auto fractionAt = [&](int b) {
-                if (kind[b] != 2) return kind[b] ? one : zero;
+                if (b < pre) return vPre;
+                if (b >= suf) return vSuf;
                 return fraction(radial,
                                 _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
             };
