@@ -241,7 +241,50 @@ TEST_CASE("slab table: edges and bad input", "[footprint][slab]") {
     CHECK(s.exact(2.5, 0) == 0);
     CHECK(s.exact(0, -3) == 0);
     CHECK(s.exact(0, 3) == Approx(s.footprint().exact(0)).epsilon(1e-13));
-    CHECK(s.bytes() == (130 * 1026 + 4098) * sizeof(float));
+    CHECK(s.bytes() == (2 * 129 * 1026 + 4098) * sizeof(float));  // rows interleaved in pairs
     CHECK_THROWS_AS(SlabTable(Kernel::defaultKernel(), 1, 512), std::invalid_argument);
     CHECK_THROWS_AS(SlabTable(Kernel::defaultKernel(), 512, 0), std::invalid_argument);
+}
+
+TEST_CASE("slab table: saturation bounds are exact and follow the chord", "[footprint][slab]") {
+    // Outside (zeroBelow, oneAbove) of r^2 the interpolated F must be exactly 0 or 1 for
+    // every r^2' >= r^2 (the image-aligned splatter then skips the lookups there); and the
+    // bounds must hug the kernel's chord +-sqrt(R^2 - r^2) (3 grid steps), or they save
+    // nothing. (They may lie inside the chord: F rounds to 1.0f before z reaches it.)
+    for (const Kernel& k : {Kernel::defaultKernel(), Kernel::cubicBSpline()})
+        for (int nz : {8, 1024}) {
+            const SlabTable s(k, 128, nz);
+            const double R = k.radius(), zStep = 2 * R / nz;
+            std::mt19937 rng(5);
+            std::uniform_real_distribution<double> U(0, 1);
+            int zeros = 0, ones = 0;
+            for (int trial = 0; trial < 20000; ++trial) {
+                const float r2 = float(R * R * U(rng));
+                const SlabTable::Saturation sat = s.saturation(r2);
+                REQUIRE(sat.zeroBelow < sat.oneAbove);
+                const float r2b = r2 + float((R * R - r2) * U(rng) * (trial % 2));
+                const float z = float(-1.2 * R + 2.4 * R * U(rng));
+                if (z <= sat.zeroBelow) {
+                    ++zeros;
+                    CHECK(s.fraction(r2b, z) == 0.0f);
+                    CHECK(s.fraction(r2b, std::nextafter(sat.zeroBelow, -1e30f)) == 0.0f);
+                }
+                if (z >= sat.oneAbove) {
+                    ++ones;
+                    CHECK(s.fraction(r2b, z) == 1.0f);
+                    CHECK(s.fraction(r2b, std::nextafter(sat.oneAbove, 1e30f)) == 1.0f);
+                }
+            }
+            CHECK(zeros > 1000);
+            CHECK(ones > 1000);
+            for (int i = 0; i <= 128; ++i) {
+                const double r2 = R * R * i / 128;
+                const SlabTable::Saturation sat = s.saturation(float(r2));
+                const double L = std::sqrt(R * R - r2);
+                INFO(k.name() << " nz=" << nz << " r2=" << r2 << ": " << sat.zeroBelow << " .. "
+                              << sat.oneAbove << ", chord " << L);
+                if (L > 3 * zStep) CHECK(sat.zeroBelow >= -L - 3 * zStep);
+                if (L > 3 * zStep) CHECK(sat.oneAbove <= L + 3 * zStep);
+            }
+        }
 }

@@ -4,7 +4,8 @@
 // interpolation:
 //   FootprintLanes: fp(r^2) of FootprintTable::lookup, from the table (two gathers) or from
 //                   a FootprintPoly (permutes and fused multiply-adds, no gathers);
-//   FractionLanes:  F(r^2, z) of SlabTable::fraction, bilinear (four gathers).
+//   FractionLanes:  F(r^2, z) of SlabTable::fraction, bilinear (one 16-byte load per lane
+//                   from the interleaved table rows, transposed).
 // Both reproduce the scalar lookups' clamping. On x86-64 (FOOTPRINT_HAVE_LANES defined)
 // they are compiled for AVX2 + FMA whatever the translation unit targets: code between
 // FOOTPRINT_LANES_BEGIN and FOOTPRINT_LANES_END is, so a portable build carries the vector
@@ -98,7 +99,7 @@ class FractionLanes {
 
     /// The radial part of a lookup, shared by every depth at the same r^2 (r2 >= 0).
     struct Radial {
-        __m256i row;  ///< index of the grid row below r^2
+        __m256i row;  ///< index of the grid row below r^2 (times the row stride)
         __m256 fr;    ///< fraction towards the next row
     };
     Radial radial(__m256 r2) const {
@@ -113,20 +114,30 @@ class FractionLanes {
         zz = _mm256_min_ps(_mm256_max_ps(zz, zero), nz_);  // NaN -> 0 as fraction()
         const __m256i j = _mm256_cvttps_epi32(zz);
         const __m256 fz = _mm256_sub_ps(zz, _mm256_cvtepi32_ps(j));
-        const __m256i one = _mm256_set1_epi32(1);
-        const __m256i idx = _mm256_add_epi32(r.row, j);
-        const __m256i idx2 = _mm256_add_epi32(idx, stride_);
-        const __m256 p0 = _mm256_i32gather_ps(values_, idx, 4);
-        const __m256 p1 = _mm256_i32gather_ps(values_, _mm256_add_epi32(idx, one), 4);
-        const __m256 p2 = _mm256_i32gather_ps(values_, idx2, 4);
-        const __m256 p3 = _mm256_i32gather_ps(values_, _mm256_add_epi32(idx2, one), 4);
+        // The table interleaves rows i and i + 1, so a lane's four values are one 16-byte
+        // load: [F(i, j) F(i + 1, j) F(i, j + 1) F(i + 1, j + 1)]. Eight loads and a 4 x 8
+        // transpose beat four 8-lane float gathers (32 element reads) and four 4-lane
+        // 64-bit gathers (16).
+        alignas(32) int at[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(at), _mm256_add_epi32(r.row, j));
+        auto cell = [&](int l, int h) {  // lanes l and h, in the low and high half
+            return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(values_ + 2 * at[l])),
+                                        _mm_loadu_ps(values_ + 2 * at[h]), 1);
+        };
+        const __m256 c0 = cell(0, 4), c1 = cell(1, 5), c2 = cell(2, 6), c3 = cell(3, 7);
+        const __m256 u0 = _mm256_unpacklo_ps(c0, c1), u1 = _mm256_unpackhi_ps(c0, c1);
+        const __m256 u2 = _mm256_unpacklo_ps(c2, c3), u3 = _mm256_unpackhi_ps(c2, c3);
+        const __m256 p0 = _mm256_shuffle_ps(u0, u2, _MM_SHUFFLE(1, 0, 1, 0));
+        const __m256 p2 = _mm256_shuffle_ps(u0, u2, _MM_SHUFFLE(3, 2, 3, 2));
+        const __m256 p1 = _mm256_shuffle_ps(u1, u3, _MM_SHUFFLE(1, 0, 1, 0));
+        const __m256 p3 = _mm256_shuffle_ps(u1, u3, _MM_SHUFFLE(3, 2, 3, 2));
         const __m256 a = _mm256_fmadd_ps(fz, _mm256_sub_ps(p1, p0), p0);
         const __m256 b = _mm256_fmadd_ps(fz, _mm256_sub_ps(p3, p2), p2);
         return _mm256_fmadd_ps(r.fr, _mm256_sub_ps(b, a), a);
     }
 
   private:
-    const float* values_;
+    const float* values_;  // SlabTable::values_ (rows interleaved in pairs)
     __m256 invR_, invZ_, zMin_, nr_, nz_;
     __m256i stride_;
 };

@@ -17,9 +17,10 @@
 //   * sections of any partition of [-R, R] telescope to the full footprint (to float
 //     rounding, ~1e-7 of the peak).
 // A single section's error is the bilinear error of F times fp: at the defaults
-// (128 x 1024, 0.5 MiB + 16 KiB) it is 1.7e-6 of the peak for the default Gaussian (the
-// tests assert 5e-6) and 4.2e-5 for the cubic B-spline (asserted 1e-4: its u^3 term is not
-// smooth in r^2 at the centre); see tools/bench/bench_footprint for other resolutions.
+// (128 x 1024, 1 MiB with rows interleaved in pairs, + 16 KiB) it is 1.7e-6 of the
+// peak for the default Gaussian (the tests assert 5e-6) and 4.2e-5 for the cubic B-spline (asserted
+// 1e-4: its u^3 term is not smooth in r^2 at the centre); see tools/bench/bench_footprint for other
+// resolutions.
 #include <cstddef>
 #include <vector>
 
@@ -54,10 +55,24 @@ class SlabTable {
         zz = zz < nzf_ ? zz : nzf_;
         const int i = int(rr), j = int(zz);
         const float fr = rr - float(i), fz = zz - float(j);
-        const float* p = values_.data() + std::size_t(i) * stride_ + j;
-        const float a = p[0] + fz * (p[1] - p[0]);
-        const float b = p[stride_] + fz * (p[stride_ + 1] - p[stride_]);
+        const float* p = values_.data() + 2 * (std::size_t(i) * stride_ + j);
+        const float a = p[0] + fz * (p[2] - p[0]);
+        const float b = p[1] + fz * (p[3] - p[1]);
         return a + fr * (b - a);
+    }
+    /// Depths where fraction() is exactly 0 or 1 (what the interpolation reads there is all
+    /// 0 or all 1, with one grid step of margin): for every r2' >= r2 (as fraction() and
+    /// FractionLanes clamp and index it), F(r2', z) == 0 for z <= zeroBelow and
+    /// F(r2', z) == 1 for z >= oneAbove. The kernel's chord shrinks as r grows, so a row of
+    /// pixels whose smallest r^2 is r2 needs no lookup at the depths outside (zeroBelow,
+    /// oneAbove): the image-aligned splatter cuts each kernel only where F varies.
+    struct Saturation {
+        float zeroBelow, oneAbove;
+    };
+    Saturation saturation(float r2) const {
+        float rr = (r2 > 0.0f ? r2 : 0.0f) * invR2Step_;
+        rr = rr < nrf_ ? rr : nrf_;
+        return saturation_[std::size_t(int(rr))];
     }
     /// C(r, z) by direct adaptive quadrature (slow; for tests).
     double exact(double r, double z) const;
@@ -76,7 +91,12 @@ class SlabTable {
     FootprintTable footprint_;
     int nr_ = 0, nz_ = 0, stride_ = 0;
     float r2Max_ = 0, invR2Step_ = 0, invZStep_ = 0, zMin_ = 0, nrf_ = 0, nzf_ = 0;
-    std::vector<float> values_;  // F on (nr + 2) x (nz + 2), z fastest (guards for +1)
+    // F on the (nr + 2) x (nz + 2) grid (z fastest, guards for + 1) with rows i and i + 1
+    // interleaved: (F(i, j), F(i + 1, j)) at 2 (i stride + j), i in [0, nr]. The four
+    // values of one bilinear lookup are 16 contiguous bytes (FractionLanes: one load per
+    // lane instead of four gathered floats).
+    std::vector<float> values_;
+    std::vector<Saturation> saturation_;  // per grid row 0..nr (the row below r^2)
 };
 
 }  // namespace footprint

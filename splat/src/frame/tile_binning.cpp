@@ -12,6 +12,9 @@ namespace {
 // A fixed number of chunks (not one per thread) keeps the result identical for any
 // thread count.
 constexpr std::size_t kChunks = 64;
+/// The rectangles are read in visiting order, scattered in memory: each is requested this
+/// many splats ahead of its use.
+constexpr std::size_t kAhead = 16;
 
 template <class F>
 void forTilesOf(const PixelRect& r, const TileGrid& g, F&& f) {
@@ -35,6 +38,7 @@ void binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& orde
         std::uint32_t* cnt = &counts[c * tiles];
         const std::size_t e = std::min(n, (c + 1) * chunk);
         for (std::size_t o = c * chunk; o < e; ++o) {
+            if (o + kAhead < e) __builtin_prefetch(&p.rect[order[o + kAhead]]);
             const PixelRect& r = p.rect[order[o]];
             if (!r.empty()) forTilesOf(r, grid, [&](int t) { ++cnt[t]; });
         }
@@ -56,6 +60,7 @@ void binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& orde
         std::uint32_t* next = &counts[c * tiles];
         const std::size_t e = std::min(n, (c + 1) * chunk);
         for (std::size_t o = c * chunk; o < e; ++o) {
+            if (o + kAhead < e) __builtin_prefetch(&p.rect[order[o + kAhead]]);
             const PixelRect& r = p.rect[order[o]];
             if (!r.empty()) forTilesOf(r, grid, [&](int t) { bins.splats[next[t]++] = order[o]; });
         }

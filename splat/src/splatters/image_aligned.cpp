@@ -24,6 +24,9 @@ namespace {
 /// thickness (e.g. an extreme spacing ratio), and the buckets would not fit in memory.
 constexpr double kMaxSlabs = double(1 << 24);
 
+/// Most slabs one kernel may span (the slab thickness is at least 1e-3 voxels).
+constexpr int kMaxSpan = 8192;
+
 /// The sections of one kernel in n consecutive slabs at once, slab j between the depths
 /// tb[j] and tb[j + 1] (world units along the ray, relative to the splat centre), each added
 /// to sheets[j]. Sharing r^2, fp(r^2) and the fraction F(r^2, z) at every inner slab
@@ -39,7 +42,8 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
     const int ox = sheets[0]->originX(), oy = sheets[0]->originY();
     const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
     for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
-    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), zero = _mm256_setzero_ps();
+    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), vZero = _mm256_setzero_ps();
+    const __m256 vOne = _mm256_set1_ps(1.0f);
     const __m256 signBit = _mm256_set1_ps(-0.0f);
     const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
     const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
@@ -48,34 +52,77 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
     const __m256 vds = _mm256_set1_ps(e.depthScale), vtx = _mm256_set1_ps(e.tx);
     __m256 vv[NCh];
     for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+    // Per row, F at boundary b is the constant 0 or 1 where the boundary's depth over the
+    // row lies beyond the table's saturation bounds at the row's smallest r^2, and must be
+    // looked up elsewhere. The boundaries' depths are monotone in b (ascending front to
+    // back, descending back to front), so the constant ones are a prefix [0, pre) and a
+    // suffix [suf, n] (front to back F = 0 before the kernel and 1 behind it; back to front
+    // the reverse): a row visits only slabs [pre - 1, suf), the others' sections are zero.
+    const bool ascending = tb[n] > tb[0];
+    const __m256 vPre = ascending ? vZero : vOne, vSuf = ascending ? vOne : vZero;
+    float* rows[kMaxSpan];
+    std::ptrdiff_t planes[kMaxSpan];  // distance between channel planes, per sheet
     for (int y = y0; y <= y1; ++y) {
         const float dy = float(y + oy) + 0.5f - sy;
-        const __m256 vgyy = _mm256_set1_ps(e.gamma * dy * dy), vshift = _mm256_set1_ps(e.beta * dy);
+        const float gyy = e.gamma * dy * dy;     // the row's smallest r^2 (every lane's r^2 >= it)
+        if (!(gyy < fpTable.r2Max())) continue;  // the whole row is outside the ellipse
+        const footprint::SlabTable::Saturation sat = table.saturation(gyy);
+        // Depth of the rays' closest approach along the row: tc = tx dx + ty dy, linear in dx.
+        const float dxA = float(x0 + ox) + 0.5f - sx, dxB = float(x1 + ox) + 0.5f - sx;
+        const float tcA = e.tx * dxA + e.ty * dy, tcB = e.tx * dxB + e.ty * dy;
+        const float tcLo = std::min(tcA, tcB), tcHi = std::max(tcA, tcB);
+        // z(b) over the row's pixels lies in [zLo(b), zHi(b)].
+        auto zero = [&](int b) { return e.depthScale * (tb[b] - tcLo) <= sat.zeroBelow; };
+        auto one = [&](int b) { return e.depthScale * (tb[b] - tcHi) >= sat.oneAbove; };
+        int pre = 0, suf = n + 1;
+        if (ascending) {
+            while (pre <= n && zero(pre)) ++pre;
+            while (suf > pre && one(suf - 1)) --suf;
+        } else {
+            while (pre <= n && one(pre)) ++pre;
+            while (suf > pre && zero(suf - 1)) --suf;
+        }
+        const int jBegin = std::max(pre - 1, 0), jEnd = std::min(suf, n);
+        if (jBegin >= jEnd) continue;
+        // This row of every slab's sheet (the stores may alias the sheets' members: without
+        // these the compiler reloads them for every store).
+        for (int j = jBegin; j < jEnd; ++j) {
+            rows[j] = sheets[j]->row(0, y);
+            if constexpr (NCh > 1)
+                planes[j] = sheets[j]->row(1, y) - rows[j];
+            else
+                planes[j] = 0;
+        }
+        const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(e.beta * dy);
         const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
         for (int x = x0; x <= x1; x += 8) {
             const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
             const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
             const __m256 q = _mm256_add_ps(dx, vshift);
-            const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), zero);
+            const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), vZero);
             const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
                                                 _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
             const __m256 weight = _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vScale));
             const footprint::FractionLanes::Radial radial = fraction.radial(r2);
             const __m256 tc = _mm256_fmadd_ps(vtx, dx, vtyy);
-            // Kernel-space depth of boundary b along these rays: z = depthScale (t - tc).
-            auto depth = [&](int b) {
-                return _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc));
+            // F at boundary b: z = depthScale (t - tc) in kernel units, looked up only where
+            // the row is not saturated there.
+            auto fractionAt = [&](int b) {
+                if (b < pre) return vPre;
+                if (b >= suf) return vSuf;
+                return fraction(radial,
+                                _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
             };
-            __m256 below = fraction(radial, depth(0));
-            for (int j = 0; j < n; ++j) {
-                const __m256 above = fraction(radial, depth(j + 1));
+            __m256 below = fractionAt(jBegin);
+            for (int j = jBegin; j < jEnd; ++j) {
+                const __m256 above = fractionAt(j + 1);
                 // |F(above) - F(below)|: the boundaries run back to front when compositing is.
                 const __m256 w =
                     _mm256_mul_ps(weight, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
                 below = above;
-                for (int c = 0; c < NCh; ++c) {
-                    float* p = sheets[j]->row(c, y) + x;
+                float* p = rows[j] + x;
+                for (int c = 0; c < NCh; ++c, p += planes[j]) {
                     _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
                 }
             }
@@ -143,8 +190,6 @@ struct SlabSections {
         return splatSections(sheets, n, v, sx, sy, e, r, table,
                              in.scene.poly ? &*in.scene.poly : nullptr, tb);
     }
-    /// Most slabs one kernel may span (the slab thickness is at least 1e-3 voxels).
-    static constexpr int kMaxSpan = 8192;
 };
 
 class ImageAligned final : public Splatter {
@@ -169,7 +214,7 @@ class ImageAligned final : public Splatter {
         zmax += ext;
         const double slabCount = double(std::floor((zmax - zmin) / thickness)) + 1;
         const double span = double(std::ceil(2.0f * ext / thickness)) + 2;
-        if (!(slabCount <= kMaxSlabs) || !(span <= SlabSections::kMaxSpan))
+        if (!(slabCount <= kMaxSlabs) || !(span <= kMaxSpan))
             throw Error("image-aligned splatter: the volume's depth range (" +
                         std::to_string(zmax - zmin) + ") at slab thickness " +
                         std::to_string(thickness) +
