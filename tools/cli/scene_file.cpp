@@ -224,9 +224,10 @@ void applyScene(const CLI::App& cmd, CommandTable& t, const std::string& file) {
         }
         if (key == "volume" && value.is_object()) {
             for (auto& [k, v] : value.items()) {
+                const std::string& name = k;  // (clang 14 cannot capture a structured binding)
                 const bool known =
                     k == "path" || std::any_of(std::begin(kVolumeKeys), std::end(kVolumeKeys),
-                                               [&](const char* n) { return k == n; });
+                                               [&](const char* n) { return name == n; });
                 if (!known)
                     throw UsageError(file + ": unknown scene key 'volume." + k +
                                      "' (path, dims, type, spacing, big-endian, header-bytes, "
