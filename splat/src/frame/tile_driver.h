@@ -240,22 +240,30 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
     const std::vector<float> pathScale = perspectivePathScale(in.camera, in.plan.normal);
     Image image(g.width, g.height);
     std::vector<TileCounters> counters(std::size_t(g.count()));
+    // One ring of clean sheets per worker thread, moved to each tile it sweeps (a sweep
+    // leaves its ring clean), instead of a fresh ring allocated and cleared per tile.
+    const std::uint32_t ring = in.plan.ring;
+    struct Ring {
+        std::vector<std::unique_ptr<SheetBuffer<NCh>>> sheets;
+        std::vector<SheetBuffer<NCh>*> ptr;
+    };
+    tbb::enumerable_thread_specific<Ring> rings;
     tbb::parallel_for(0, g.count(), 1, [&](int t) {
         const DenormalsAreZero ftz;  // footprint tails must not hit slow denormal paths
         const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
         constexpr bool surface = kSurfacePolicy<Policy>;  // issue 13: also when clipped
         TileAccumulator acc = makeTileAccumulator(in, g, t, Policy::kTerminates, surface);
         if (in.bins.begin[t] != in.bins.begin[t + 1]) {
-            const std::uint32_t ring = in.plan.ring;
-            std::vector<SheetBuffer<NCh>> sheets;
-            sheets.reserve(ring);
-            std::vector<SheetBuffer<NCh>*> ptr(ring);
-            for (std::uint32_t k = 0; k < ring; ++k) {
-                sheets.emplace_back(ox, oy, acc.width(), acc.height());
-                ptr[k] = &sheets.back();
+            Ring& r = rings.local();
+            while (r.sheets.size() < ring) {
+                r.sheets.push_back(
+                    std::make_unique<SheetBuffer<NCh>>(ox, oy, g.tileSize, g.tileSize));
+                r.ptr.push_back(r.sheets.back().get());
             }
+            for (std::uint32_t k = 0; k < ring; ++k)
+                r.sheets[k]->moveTo(ox, oy, acc.width(), acc.height());
             const std::vector<float> tileScale = tilePathScale(pathScale, g, t);
-            sweepTile(in, policy, cutter, BinnedSplats{in, t}, g, t, acc, ptr.data(), ring,
+            sweepTile(in, policy, cutter, BinnedSplats{in, t}, g, t, acc, r.ptr.data(), ring,
                       tileScale.empty() ? nullptr : tileScale.data(), counters[t]);
         }
         acc.resolve(image, ox, oy, in.settings.mode);
