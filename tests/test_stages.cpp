@@ -33,11 +33,20 @@ TEST_CASE("binning: every tile lists exactly the splats whose rectangle touches 
              std::min(y + size(rng), 69)};
     }
     p.rect[5] = {1, 1, 0, 0};  // empty
+    // Distinct per-splat values, so that a record copied from the wrong splat shows.
+    std::vector<std::uint32_t> key(n), span(n);
+    for (std::size_t q = 0; q < n; ++q) {
+        p.sx.push_back(0.5f * float(q));
+        p.sy.push_back(-0.25f * float(q));
+        p.depth.push_back(3.0f + float(q));
+        key[q] = std::uint32_t(q % 97);
+        span[q] = std::uint32_t(1 + q % 5);
+    }
     std::vector<std::uint32_t> order(n);
     for (std::size_t q = 0; q < n; ++q) order[q] = std::uint32_t((q * 7919) % n);
     const TileGrid grid(100, 70, 16);
     TileBins bins;
-    binToTiles(p, order, grid, bins);
+    binToTiles(p, order, key, span, grid, bins);
     REQUIRE(bins.begin.size() == std::size_t(grid.count()) + 1);
     for (int t = 0; t < grid.count(); ++t) {
         const int ox = (t % grid.tilesX) * 16, oy = (t / grid.tilesX) * 16;
@@ -47,8 +56,16 @@ TEST_CASE("binning: every tile lists exactly the splats whose rectangle touches 
             if (!r.empty() && r.x0 <= ox + 15 && r.x1 >= ox && r.y0 <= oy + 15 && r.y1 >= oy)
                 expected.push_back(id);
         }
-        const std::vector<std::uint32_t> got(bins.splats.begin() + bins.begin[t],
-                                             bins.splats.begin() + bins.begin[t + 1]);
+        std::vector<std::uint32_t> got;
+        for (std::uint32_t q = bins.begin[t]; q < bins.begin[t + 1]; ++q) {
+            const SheetRecord& rec = bins.records[q];
+            got.push_back(rec.id);
+            REQUIRE(rec.key == key[rec.id]);
+            REQUIRE(rec.span == span[rec.id]);
+            REQUIRE(rec.sx == p.sx[rec.id]);
+            REQUIRE(rec.sy == p.sy[rec.id]);
+            REQUIRE(rec.depth == p.depth[rec.id]);
+        }
         REQUIRE(got == expected);
     }
 }

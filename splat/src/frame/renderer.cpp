@@ -67,8 +67,8 @@ SheetPlan order(const Splatter& splatter, const Scene::Impl& scene, const Camera
 /// Stage "bin": every splat listed in the screen tiles its footprint touches.
 void bin(const Camera& camera, const RenderSettings& s, FrameWorkspace& work, RenderStats& stats) {
     const auto start = Clock::now();
-    binToTiles(work.proj, work.order, TileGrid(camera.width(), camera.height(), s.quality.tileSize),
-               work.bins);
+    binToTiles(work.proj, work.order, work.key, work.span,
+               TileGrid(camera.width(), camera.height(), s.quality.tileSize), work.bins);
     stats.binMs = msSince(start);
 }
 

@@ -26,6 +26,7 @@ void forTilesOf(const PixelRect& r, const TileGrid& g, F&& f) {
 }  // namespace
 
 void binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& order,
+                const std::vector<std::uint32_t>& key, const std::vector<std::uint32_t>& span,
                 const TileGrid& grid, TileBins& bins) {
     bins.grid = grid;
     const std::size_t tiles = std::size_t(grid.count());
@@ -55,14 +56,25 @@ void binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& orde
         }
     }
     bins.begin[tiles] = std::uint32_t(total);
-    bins.splats.resize(total);
+    bins.records.resize(total);
     tbb::parallel_for(std::size_t(0), kChunks, [&](std::size_t c) {
         std::uint32_t* next = &counts[c * tiles];
         const std::size_t e = std::min(n, (c + 1) * chunk);
         for (std::size_t o = c * chunk; o < e; ++o) {
-            if (o + kAhead < e) __builtin_prefetch(&p.rect[order[o + kAhead]]);
-            const PixelRect& r = p.rect[order[o]];
-            if (!r.empty()) forTilesOf(r, grid, [&](int t) { bins.splats[next[t]++] = order[o]; });
+            if (o + kAhead < e) {
+                const std::uint32_t a = order[o + kAhead];
+                __builtin_prefetch(&p.rect[a]);
+                __builtin_prefetch(&p.sx[a]);
+                __builtin_prefetch(&p.sy[a]);
+                __builtin_prefetch(&p.depth[a]);
+                __builtin_prefetch(&key[a]);
+                __builtin_prefetch(&span[a]);
+            }
+            const std::uint32_t id = order[o];
+            const PixelRect& r = p.rect[id];
+            if (r.empty()) continue;
+            const SheetRecord rec{id, key[id], span[id], p.sx[id], p.sy[id], p.depth[id]};
+            forTilesOf(r, grid, [&](int t) { bins.records[next[t]++] = rec; });
         }
     });
 }

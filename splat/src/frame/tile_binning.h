@@ -44,16 +44,28 @@ inline PixelRect clipToTile(PixelRect r, const TileGrid& g, int t) {
     return clipToTile(r, g, (t % g.tilesX) * g.tileSize, (t / g.tilesX) * g.tileSize);
 }
 
+/// One entry of a tile's list: what the tile sweep reads of a splat, written by binning
+/// in visiting order so that the sweep streams through its records instead of reading the
+/// per-splat arrays at random by splat index (24 bytes).
+struct SheetRecord {
+    std::uint32_t id;    ///< splat index
+    std::uint32_t key;   ///< first sheet the splat touches, in visiting order
+    std::uint32_t span;  ///< sheets it spans from there
+    float sx, sy;        ///< screen position of the centre (ProjectedSplats::sx, sy)
+    float depth;         ///< depth of the centre (ProjectedSplats::depth)
+};
+
 struct TileBins {
     TileGrid grid;
     std::vector<std::uint32_t> begin;   ///< grid.count() + 1 offsets
-    std::vector<std::uint32_t> splats;  ///< splat indices, per tile in `order`
+    std::vector<SheetRecord> records;   ///< per tile, in `order`
     std::vector<std::uint32_t> counts;  ///< scratch: per chunk and tile
 };
 
 /// Bins the splats listed in `order` (visiting order) to tiles, into `bins` (its arrays
-/// are reused across frames).
+/// are reused across frames); key[id] and span[id] are splat id's sheets (SheetRecord).
 void binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& order,
+                const std::vector<std::uint32_t>& key, const std::vector<std::uint32_t>& span,
                 const TileGrid& grid, TileBins& bins);
 
 }  // namespace splat

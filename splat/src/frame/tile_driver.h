@@ -10,7 +10,8 @@
 //   then: resolve the tile into the image.
 //
 // A Cutter says which sheet a splat starts in (key, in visiting order), how many sheets it
-// spans, and how its kernel is cut into them; that is all that differs between the
+// spans, and how its kernel is cut into them, each from the splat's record in the tile's
+// list (the Source's: SplatRecord or SheetRecord); that is all that differs between the
 // axis-aligned (one sheet: the whole footprint) and the image-aligned splatter (every slab
 // it crosses: slab sections).
 #include <tbb/enumerable_thread_specific.h>
@@ -113,18 +114,19 @@ inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Polic
     }
 }
 
-/// A tile's list of splats as the whole-frame stages made it (projectSplats, binToTiles).
+/// A tile's records as the whole-frame stages made them (projectSplats, binToTiles).
 struct BinnedSplats {
     const TileInputs& in;
     int t;
     std::uint32_t begin() const { return in.bins.begin[t]; }
     std::uint32_t end() const { return in.bins.begin[t + 1]; }
-    std::uint32_t id(std::uint32_t q) const { return in.bins.splats[q]; }
-    float sx(std::uint32_t q) const { return in.proj.sx[id(q)]; }
-    float sy(std::uint32_t q) const { return in.proj.sy[id(q)]; }
-    PixelRect rect(std::uint32_t q) const { return in.proj.rect[id(q)]; }
-    const footprint::EllipticalFootprint& ellipse(std::uint32_t q) const {
-        return in.proj.ellipse(id(q));
+    const SheetRecord& record(std::uint32_t q) const { return in.bins.records[q]; }
+    const footprint::EllipticalFootprint& ellipse(const SheetRecord& r) const {
+        return in.proj.ellipse(r.id);
+    }
+    /// ProjectedSplats::rect of the (binned, so not behind the eye) splat, from its record.
+    PixelRect rect(const SheetRecord& r) const {
+        return footprintRect(r.sx, r.sy, ellipse(r), in.bins.grid.width, in.bins.grid.height);
     }
 };
 
@@ -136,14 +138,12 @@ struct ChunkRecords {
     int t;
     std::uint32_t begin() const { return bins.begin[t]; }
     std::uint32_t end() const { return bins.begin[t + 1]; }
-    std::uint32_t id(std::uint32_t q) const { return bins.records[q].id; }
-    float sx(std::uint32_t q) const { return bins.records[q].sx; }
-    float sy(std::uint32_t q) const { return bins.records[q].sy; }
-    const footprint::EllipticalFootprint& ellipse(std::uint32_t q) const {
-        return projector.perspective() ? bins.each[bins.records[q].local] : projector.shared();
+    const SplatRecord& record(std::uint32_t q) const { return bins.records[q]; }
+    const footprint::EllipticalFootprint& ellipse(const SplatRecord& r) const {
+        return projector.perspective() ? bins.each[r.local] : projector.shared();
     }
-    PixelRect rect(std::uint32_t q) const {
-        return footprintRect(sx(q), sy(q), ellipse(q), grid.width, grid.height);
+    PixelRect rect(const SplatRecord& r) const {
+        return footprintRect(r.sx, r.sy, ellipse(r), grid.width, grid.height);
     }
 };
 
@@ -161,23 +161,22 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
     if (next == end) return;
     // Sweep position (sheet index in visiting order) and the last position that has
     // contributions pending in the ring.
-    std::uint32_t step = cutter.key(src.id(next)), pendingEnd = step;
+    std::uint32_t step = cutter.key(src.record(next)), pendingEnd = step;
     bool pending = false;
     while (next < end || pending) {
-        if (!pending) step = std::max(step, cutter.key(src.id(next)));  // skip empty sheets
-        for (; next < end && cutter.key(src.id(next)) == step; ++next) {
-            const std::uint32_t id = src.id(next);
-            const PixelRect r = clipToTile(src.rect(next), grid, ox, oy);
+        if (!pending) step = std::max(step, cutter.key(src.record(next)));  // skip empty sheets
+        for (; next < end && cutter.key(src.record(next)) == step; ++next) {
+            const auto& rec = src.record(next);
+            const PixelRect r = clipToTile(src.rect(rec), grid, ox, oy);
             if (acc.rectOpaque(r.x0 - ox, r.y0 - oy, r.x1 - ox, r.y1 - oy)) {
                 ++cnt.culled;
                 continue;
             }
-            const std::uint32_t n = cutter.span(id);
+            const std::uint32_t n = cutter.span(rec);
             for (std::uint32_t j = 0; j < n; ++j) target[j] = sheets[(step + j) % ring];
             float v[NCh];
-            splatValues<Policy>(in, id, v);
-            cnt.footprintPixels +=
-                cutter.cut(target, id, v, src.sx(next), src.sy(next), src.ellipse(next), r);
+            splatValues<Policy>(in, rec.id, v);
+            cnt.footprintPixels += cutter.cut(target, rec, v, src.ellipse(rec), r);
             pendingEnd = std::max(pendingEnd, step + n - 1);
             pending = true;
         }
@@ -241,22 +240,30 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
     const std::vector<float> pathScale = perspectivePathScale(in.camera, in.plan.normal);
     Image image(g.width, g.height);
     std::vector<TileCounters> counters(std::size_t(g.count()));
+    // One ring of clean sheets per worker thread, moved to each tile it sweeps (a sweep
+    // leaves its ring clean), instead of a fresh ring allocated and cleared per tile.
+    const std::uint32_t ring = in.plan.ring;
+    struct Ring {
+        std::vector<std::unique_ptr<SheetBuffer<NCh>>> sheets;
+        std::vector<SheetBuffer<NCh>*> ptr;
+    };
+    tbb::enumerable_thread_specific<Ring> rings;
     tbb::parallel_for(0, g.count(), 1, [&](int t) {
         const DenormalsAreZero ftz;  // footprint tails must not hit slow denormal paths
         const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
         constexpr bool surface = kSurfacePolicy<Policy>;  // issue 13: also when clipped
         TileAccumulator acc = makeTileAccumulator(in, g, t, Policy::kTerminates, surface);
         if (in.bins.begin[t] != in.bins.begin[t + 1]) {
-            const std::uint32_t ring = in.plan.ring;
-            std::vector<SheetBuffer<NCh>> sheets;
-            sheets.reserve(ring);
-            std::vector<SheetBuffer<NCh>*> ptr(ring);
-            for (std::uint32_t k = 0; k < ring; ++k) {
-                sheets.emplace_back(ox, oy, acc.width(), acc.height());
-                ptr[k] = &sheets.back();
+            Ring& r = rings.local();
+            while (r.sheets.size() < ring) {
+                r.sheets.push_back(
+                    std::make_unique<SheetBuffer<NCh>>(ox, oy, g.tileSize, g.tileSize));
+                r.ptr.push_back(r.sheets.back().get());
             }
+            for (std::uint32_t k = 0; k < ring; ++k)
+                r.sheets[k]->moveTo(ox, oy, acc.width(), acc.height());
             const std::vector<float> tileScale = tilePathScale(pathScale, g, t);
-            sweepTile(in, policy, cutter, BinnedSplats{in, t}, g, t, acc, ptr.data(), ring,
+            sweepTile(in, policy, cutter, BinnedSplats{in, t}, g, t, acc, r.ptr.data(), ring,
                       tileScale.empty() ? nullptr : tileScale.data(), counters[t]);
         }
         acc.resolve(image, ox, oy, in.settings.mode);
@@ -278,20 +285,20 @@ template <class Cutter>
 void sortBySheet(const Cutter& cutter, SplatRecord* first, SplatRecord* last,
                  std::vector<SplatRecord>& scratch) {
     if (last - first < 2) return;
-    std::uint32_t lo = cutter.key(first->id), hi = lo;
+    std::uint32_t lo = cutter.key(*first), hi = lo;
     bool sorted = true;
     for (SplatRecord* r = first + 1; r != last; ++r) {
-        const std::uint32_t k = cutter.key(r->id);
-        sorted &= k >= cutter.key((r - 1)->id);
+        const std::uint32_t k = cutter.key(*r);
+        sorted &= k >= cutter.key(*(r - 1));
         lo = std::min(lo, k);
         hi = std::max(hi, k);
     }
     if (sorted) return;
     std::vector<std::uint32_t> start(std::size_t(hi - lo) + 2, 0);
-    for (SplatRecord* r = first; r != last; ++r) ++start[cutter.key(r->id) - lo + 1];
+    for (SplatRecord* r = first; r != last; ++r) ++start[cutter.key(*r) - lo + 1];
     for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
     scratch.resize(std::size_t(last - first));
-    for (SplatRecord* r = first; r != last; ++r) scratch[start[cutter.key(r->id) - lo]++] = *r;
+    for (SplatRecord* r = first; r != last; ++r) scratch[start[cutter.key(*r) - lo]++] = *r;
     std::copy(scratch.begin(), scratch.end(), first);
 }
 

@@ -26,11 +26,11 @@ class ReferenceField;
 struct FrameWorkspace {
     ProjectedSplats proj;
     TileBins bins;
-    std::vector<std::uint32_t> order;             ///< visiting order of the splats
-    std::vector<std::uint32_t> key, first, last;  ///< per splat, splatter-specific
-    std::vector<float> r, g, b;                   ///< shaded emission of this view
-    SheetChunks chunks;                           ///< streaming splatters: visiting order
-    ChunkBins chunkBins;                          ///< streaming splatters: one chunk's lists
+    std::vector<std::uint32_t> order;      ///< visiting order of the splats
+    std::vector<std::uint32_t> key, span;  ///< per splat: sheets (SheetRecord), when binned
+    std::vector<float> r, g, b;            ///< shaded emission of this view
+    SheetChunks chunks;                    ///< streaming splatters: visiting order
+    ChunkBins chunkBins;                   ///< streaming splatters: one chunk's lists
 };
 
 struct Scene::Impl {

@@ -107,14 +107,14 @@ struct WholeFootprints {
     const footprint::FootprintTable& table;
     const footprint::FootprintPoly* poly;
 
-    std::uint32_t key(std::uint32_t id) const {
-        return ascending ? index[id] : slices - 1 - index[id];
+    std::uint32_t key(const SplatRecord& s) const {
+        return ascending ? index[s.id] : slices - 1 - index[s.id];
     }
-    std::uint32_t span(std::uint32_t) const { return 1; }
+    std::uint32_t span(const SplatRecord&) const { return 1; }
     template <int NCh>
-    int cut(SheetBuffer<NCh>* const* sheets, std::uint32_t, const float (&v)[NCh], float sx,
-            float sy, const footprint::EllipticalFootprint& e, const PixelRect& r) const {
-        return splatFootprint(*sheets[0], v, sx, sy, e, r, table, poly);
+    int cut(SheetBuffer<NCh>* const* sheets, const SplatRecord& s, const float (&v)[NCh],
+            const footprint::EllipticalFootprint& e, const PixelRect& r) const {
+        return splatFootprint(*sheets[0], v, s.sx, s.sy, e, r, table, poly);
     }
 };
 

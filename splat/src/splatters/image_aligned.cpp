@@ -163,31 +163,30 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
     return splatSectionsScalar(sheets, n, values, sx, sy, e, rect, table, poly, tb);
 }
 
-/// Each splat is cut into the slabs first..last it crosses.
+/// Each splat is cut into the slabs it crosses: `span` slabs from `key` in visiting order.
 struct SlabSections {
     const TileInputs& in;
-    const std::vector<std::uint32_t>&keys, &first, &last;
     const footprint::SlabTable& table;
     bool ftb;
 
-    std::uint32_t key(std::uint32_t id) const { return keys[id]; }
-    std::uint32_t span(std::uint32_t id) const { return last[id] - first[id] + 1; }
+    std::uint32_t key(const SheetRecord& s) const { return s.key; }
+    std::uint32_t span(const SheetRecord& s) const { return s.span; }
     template <int NCh>
-    int cut(SheetBuffer<NCh>* const* sheets, std::uint32_t id, const float (&v)[NCh], float sx,
-            float sy, const footprint::EllipticalFootprint& e, const PixelRect& r) const {
+    int cut(SheetBuffer<NCh>* const* sheets, const SheetRecord& s, const float (&v)[NCh],
+            const footprint::EllipticalFootprint& e, const PixelRect& r) const {
         // Slab boundaries in visiting order, as depths along this splat's rays relative to
-        // its centre: t = (plane depth - centre) / cos.
+        // its centre: t = (plane depth - centre) / cos. Boundary b is plane first + b front
+        // to back, last + 1 - b back to front (key = slabs - 1 - last).
         const ProjectedSplats& proj = in.proj;
-        const int n = int(span(id));
+        const int n = int(s.span);
         float tb[kMaxSpan + 1];
-        const float perRay = proj.perspective ? proj.depthPerRay[id] : 1.0f;
+        const float perRay = proj.perspective ? proj.depthPerRay[s.id] : 1.0f;
+        const std::uint32_t base = ftb ? s.key : in.plan.sheets - s.key;
         for (int b = 0; b <= n; ++b) {
-            const std::uint32_t plane =
-                ftb ? first[id] + std::uint32_t(b) : last[id] + 1 - std::uint32_t(b);
-            tb[b] =
-                (in.plan.depthOrigin + float(plane) * in.plan.thickness - proj.depth[id]) * perRay;
+            const std::uint32_t plane = ftb ? base + std::uint32_t(b) : base - std::uint32_t(b);
+            tb[b] = (in.plan.depthOrigin + float(plane) * in.plan.thickness - s.depth) * perRay;
         }
-        return splatSections(sheets, n, v, sx, sy, e, r, table,
+        return splatSections(sheets, n, v, s.sx, s.sy, e, r, table,
                              in.scene.poly ? &*in.scene.poly : nullptr, tb);
     }
 };
@@ -220,15 +219,15 @@ class ImageAligned final : public Splatter {
                         std::to_string(thickness) +
                         " would need too many slabs; use a thicker --slab or check the spacing");
         const std::uint32_t slabs = std::uint32_t(slabCount);
-        work.first.resize(count);
-        work.last.resize(count);
         work.key.resize(count);
+        work.span.resize(count);
         for (std::size_t n = 0; n < count; ++n) {
-            work.first[n] =
+            const std::uint32_t first =
                 std::min(slabs - 1, std::uint32_t((proj.depth[n] - ext - zmin) / thickness));
-            work.last[n] =
+            const std::uint32_t last =
                 std::min(slabs - 1, std::uint32_t((proj.depth[n] + ext - zmin) / thickness));
-            work.key[n] = ftb ? work.first[n] : slabs - 1 - work.last[n];
+            work.key[n] = ftb ? first : slabs - 1 - last;
+            work.span[n] = last - first + 1;
         }
         // Within a slab, splats are visited in slice order along the major axis, which keeps
         // the accesses to the splat arrays coherent.
@@ -245,12 +244,8 @@ class ImageAligned final : public Splatter {
         return plan;
     }
 
-    Image rasterize(const TileInputs& in, FrameWorkspace& work, RenderStats* stats) const override {
-        const SlabSections cutter{in,
-                                  work.key,
-                                  work.first,
-                                  work.last,
-                                  in.scene.slabTable(),
+    Image rasterize(const TileInputs& in, FrameWorkspace&, RenderStats* stats) const override {
+        const SlabSections cutter{in, in.scene.slabTable(),
                                   in.settings.order == CompositeOrder::FrontToBack};
         return rasterizeWithPolicy(in, cutter, stats);
     }
