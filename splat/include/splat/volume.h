@@ -24,6 +24,14 @@ struct Volume {
     /// tilt, NaNs replaced, ...). Every command prints it (README "Input files and bad
     /// input" lists the cases).
     std::string note;
+    /// Background value b (issue 21, splat/DESIGN.md "Reconstructed fields"): what the data
+    /// hold where nothing is (air at -1000 HU in CT, 0 in MR magnitude and signed fields).
+    /// The reconstructed field is f(x) = b + sum_i (d_i - b) h(x - x_i): it tends to b
+    /// outside the volume and across clipped regions, and "empty" means "equal to b".
+    float background = 0.0f;
+    /// Where `background` came from, printed by `splat info`: e.g. "DICOM Pixel Padding
+    /// Value", "median of the outer faces", "--background", "scene file".
+    std::string backgroundSource = "default (0)";
 
     std::size_t voxelCount() const {
         return std::size_t(dims.x) * std::size_t(dims.y) * std::size_t(dims.z);
