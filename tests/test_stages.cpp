@@ -106,7 +106,7 @@ TEST_CASE("compositing: over (back to front) equals under (front to back) on ran
     }
     // Background after resolve: I + (1 - a) bg.
     Image c = a;
-    applyBackground(c, RenderMode::Dvr, glm::vec4(0.2f, 0.3f, 0.4f, 1.0f));
+    applyBackground(c, RenderMode::Dvr, glm::vec4(0.2f, 0.3f, 0.4f, 1.0f), 0.0f);
     CHECK(c.pixels[0].g == Approx(a.pixels[0].g + (1 - a.pixels[0].a) * 0.3f).margin(1e-7));
     CHECK(c.pixels[0].a == Approx(1.0f).margin(1e-6));
 }

@@ -1,6 +1,8 @@
 // Shared rendering options (see render_options.h).
 #include "render_options.h"
 
+#include <tuple>
+
 #include <unistd.h>
 
 #include <cmath>
@@ -66,7 +68,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool imageOutput) {
     addTechniqueOptions(cmd, a.technique, imageOutput);
     if (imageOutput)
         addOption(cmd, "--window", a.window,
-                  "mip/xray 8-bit output: display window LOW,HIGH (default 0,max)", "Output");
+                  "mip/xray 8-bit output: display window LOW,HIGH (default: the data range, 0 included)", "Output");
     addSceneOptions(cmd);
 }
 
@@ -248,11 +250,7 @@ WriteOptions displayOptions(const RenderArgs& a, const RenderSettings& s, const 
         o.windowLow = float(w[0]);
         o.windowHigh = float(w[1]);
     } else {
-        float mx = 0.0f;
-        for (const auto& p : image.pixels)
-            if (std::isfinite(p.r)) mx = std::max(mx, p.r);
-        o.windowLow = 0.0f;
-        o.windowHigh = mx > 0.0f ? mx : 1.0f;
+        std::tie(o.windowLow, o.windowHigh) = defaultWindow({&image});
     }
     return o;
 }

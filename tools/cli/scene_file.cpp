@@ -45,11 +45,6 @@ std::map<const CLI::App*, CommandTable>& tables() {
     return t;
 }
 
-std::vector<std::pair<std::string, std::string>>& runMetadata() {
-    static std::vector<std::pair<std::string, std::string>> m;
-    return m;
-}
-
 CommandTable& tableOf(const CLI::App& cmd) { return tables()[&cmd]; }
 
 Entry* find(CommandTable& t, const std::string& key) {
@@ -446,6 +441,11 @@ void beginRun(const CLI::App& cmd) {
                      // No time stamp (OpenEXR writes one by default): a scene reproduces
                      // its images byte for byte.
                      {"DateTime", ""}};
+}
+
+std::vector<std::pair<std::string, std::string>>& runMetadata() {
+    static std::vector<std::pair<std::string, std::string>> m;
+    return m;
 }
 
 WriteOptions withMetadata(WriteOptions o) {

@@ -93,6 +93,8 @@ void beginRun(const CLI::App& cmd);
 std::string canonicalCommand(const CLI::App& cmd);
 /// `o` plus this run's metadata: Software, splat:command (canonicalCommand), splat:scene.
 WriteOptions withMetadata(WriteOptions o);
+/// The key/value pairs every image of this run records (set when the command line is read).
+std::vector<std::pair<std::string, std::string>>& runMetadata();
 /// Writes --write-scene FILE (if given) with the scene fixed by beginRun.
 void finishRun(const CLI::App& cmd);
 

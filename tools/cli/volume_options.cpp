@@ -2,9 +2,12 @@
 #include "volume_options.h"
 
 #include <cmath>
+#include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include "diagnostics.h"
+#include "technique_options.h"
 #include "scene_file.h"
 #include "splat/error.h"
 
@@ -69,6 +72,10 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
               "DICOM: the SeriesInstanceUID to load when a folder holds several (`splat info "
               "FOLDER` lists them)",
               g);
+    addOption(cmd, "--background-value", args.backgroundValue,
+              "the field's value where nothing is (b; e.g. -1000 for CT in HU): a number, or "
+              "'auto' for the median of the outer faces (default: from the file, else auto)",
+              g);
 }
 
 LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
@@ -92,7 +99,29 @@ LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
 }
 
 Volume loadVolumeFromArgs(const VolumeArgs& args) {
-    Volume v = loadVolume(args.spec, loadOptionsFromArgs(args));
+    const LoadOptions options = loadOptionsFromArgs(args);
+    std::optional<float> background;
+    if (!args.backgroundValue.empty() && args.backgroundValue != "auto") {
+        background = asUsage([&] {
+            const std::vector<double> b = parseNumbers(args.backgroundValue, "--background-value");
+            if (b.size() != 1 || !(std::abs(b[0]) <= 3.0e38))
+                throw Error("--background-value '" + args.backgroundValue +
+                            "': expected one finite number or 'auto'");
+            return float(b[0]);
+        });
+    }
+    Volume v = loadVolume(args.spec, options);
+    if (background) {
+        v.background = *background;
+        v.backgroundSource = "--background-value";
+    } else if (args.backgroundValue == "auto") {
+        v.background = backgroundFromFaces(v);
+        v.backgroundSource = "median of the outer faces (--background-value auto)";
+    }
+    // Recorded in every image the run writes, so that a scene reproduces.
+    char b[64];
+    std::snprintf(b, sizeof b, "%.9g", double(v.background));
+    runMetadata().push_back({"splat:background_value", std::string(b) + " (" + v.backgroundSource + ")"});
     // Every command that loads a volume says what the loader had to assume or change.
     std::string note = v.note;
     for (std::size_t at; (at = note.find("; ")) != std::string::npos;) note.replace(at, 2, "\n");

@@ -15,10 +15,11 @@ struct VolumeArgs {
     std::string nanPolicy = "error";  // error | zero
     bool allowOutsideData = false;    // NRRD/MetaImage data files outside the header's folder
     std::string series;               // DICOM SeriesInstanceUID
+    std::string backgroundValue;      // b: a number, "auto" (the faces rule) or "" (the loader's)
 };
 
 /// Adds VOLUME and --dims/--type/--spacing/--big-endian/--header-bytes/--nan-policy/
-/// --allow-outside-data/--series.
+/// --allow-outside-data/--series/--background-value.
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args);
 
 /// Parses the options (UsageError on malformed ones).

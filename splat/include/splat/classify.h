@@ -19,7 +19,11 @@ struct SplatList {
     /// The volume's grid: a splat's world position is origin + spacing (i, j, k), computed
     /// when needed (world()) rather than stored beside the index position.
     glm::dvec3 origin{0.0}, spacing{1.0};
-    std::vector<float> density;     ///< d_i (empty when paletted: read densityOf(n))
+    /// The volume's background value b (splat/DESIGN.md "Reconstructed fields"): density
+    /// holds d_i - b, so that sum (d_i - b) h is the field minus b and a voxel equal to b
+    /// needs no splat; whoever reads the field adds b back (x-ray integrates f - b).
+    float background = 0.0f;
+    std::vector<float> density;     ///< d_i - b (empty when paletted: read densityOf(n))
     std::vector<float> extinction;  ///< rho_i = f_rho(d_i), per world unit (pre)
     std::vector<float> r, g, b;     ///< premultiplied emission e_i = colour * rho_i (pre)
     /// Emission by value (ClassifyOptions::compactEmission): when rho_i and e_i depend on d_i

@@ -30,6 +30,12 @@ struct WriteOptions {
     std::vector<std::pair<std::string, std::string>> metadata;
 };
 
+/// The default display window of mip and x-ray images: [min(0, lowest), highest] of the red
+/// channel over `images` (finite values; high = low + 1 when flat). Data below 0 (CT in HU,
+/// where a mip ray that misses the bone sees air at -1000) keep their range; data at or
+/// above 0 keep the window [0, max].
+std::pair<float, float> defaultWindow(const std::vector<const Image*>& images);
+
 /// Writes `.png`, `.gif`, `.jpg` (8-bit display values, RGB) or `.exr`, `.tif`/`.tiff`
 /// (32-bit float RGBA, values as computed). Throws splat::Error naming the file on failure.
 void writeImage(const std::string& path, const Image& image, const WriteOptions& options = {});

@@ -61,6 +61,13 @@ std::uint64_t checkedVoxelCount(const glm::ivec3& dims, const std::string& what)
 /// Throws splat::Error naming `what` (a file name or description) otherwise.
 Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::string& what);
 
+/// The default background value rule (splat/DESIGN.md, Decisions): the median of the
+/// finite samples on the volume's six outer faces. Right for CT in HU (air, about -1000, or
+/// the scanner's padding fills the faces), MR magnitude (0) and signed fields such as phase
+/// or velocity (0 around the object, not the minimum). Files that state a value (DICOM Pixel
+/// Padding Value) and CT series use that instead; `splat info` prints which.
+float backgroundFromFaces(const Volume& v);
+
 /// Statistics of a volume's samples.
 struct VolumeStats {
     float minValue = 0, maxValue = 0;

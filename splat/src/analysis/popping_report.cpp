@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <tuple>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -355,17 +356,12 @@ std::string metricsCsv(const PoppingResult& r) {
 bool windowed(RenderMode m) { return m == RenderMode::Mip || m == RenderMode::Xray; }
 
 // How images of the run are shown: dvr and iso as sRGB of the linear values, mip and xray
-// windowed to [0, max of the red channel over `images`].
+// windowed to defaultWindow(images) (the data's range, 0 included).
 WriteOptions displayFor(const RenderSettings& s, const std::vector<const Image*>& images) {
     WriteOptions o;
     if (!windowed(s.mode)) return o;
-    float hi = 0;
-    for (const Image* im : images)
-        for (const glm::vec4& p : im->pixels)
-            if (std::isfinite(p.r)) hi = std::max(hi, p.r);
     o.mapping = DisplayMapping::Window;
-    o.windowLow = 0;
-    o.windowHigh = hi > 0 ? hi : 1;
+    std::tie(o.windowLow, o.windowHigh) = defaultWindow(images);
     return o;
 }
 
@@ -739,7 +735,7 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
         }
         h << "</div>\n<figcaption>Frames at both ends of the interval, "
           << (windowed(r.settings.mode)
-                  ? "windowed to [0, " + formatNumber(display.windowHigh, 4) + "]"
+                  ? "windowed to [" + formatNumber(display.windowLow, 4) + ", " + formatNumber(display.windowHigh, 4) + "]"
                   : std::string("sRGB"))
           << "; heat maps (inferno) of the largest RGB difference, |after − before| scaled to [0, "
           << formatNumber(changeScale, 4) << "]"

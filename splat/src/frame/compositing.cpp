@@ -161,7 +161,11 @@ void TileAccumulator::resolve(Image& image, int ox, int oy, RenderMode mode) con
         }
 }
 
-void applyBackground(Image& image, RenderMode mode, const glm::vec4& bg) {
+void applyBackground(Image& image, RenderMode mode, const glm::vec4& bg, float fieldBackground) {
+    if (mode == RenderMode::Mip) {
+        for (glm::vec4& out : image.pixels) out = glm::vec4(glm::vec3(out) + fieldBackground, 1.0f);
+        return;
+    }
     if (mode != RenderMode::Dvr && mode != RenderMode::Iso) return;
     for (glm::vec4& out : image.pixels) out = out + (1.0f - out.a) * bg;
 }

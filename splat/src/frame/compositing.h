@@ -122,8 +122,11 @@ class TileAccumulator {
 };
 
 /// The last step of a frame: dvr and iso pixels are composited over the background,
-/// I = C + (1 - a) I_bg; other modes have none.
-void applyBackground(Image& image, RenderMode mode, const glm::vec4& background);
+/// I = C + (1 - a) I_bg; mip pixels, the maximum of f - b along the ray (at least 0: every
+/// ray sees b outside the volume), get the field's background value b added back; x-ray,
+/// the integral of f - b, is left as it is.
+void applyBackground(Image& image, RenderMode mode, const glm::vec4& background,
+                     float fieldBackground);
 
 // ---- compositing policies: one home per render mode -------------------------------
 // A policy says how many channels a sheet pixel holds and where they come from (kSource),
@@ -268,7 +271,8 @@ struct LabelPolicy {
     }
 };
 
-/// MIP: the maximum over sheets of the mean of f over the ray's path through each.
+/// MIP: the maximum over sheets of the mean of f - b over the ray's path through each (b is
+/// added to the image by applyBackground).
 struct MipPolicy {
     static constexpr int kChannels = 1;
     static constexpr bool kTerminates = false;
@@ -278,7 +282,7 @@ struct MipPolicy {
     }
 };
 
-/// X-ray: the line integral of f, the sum over sheets.
+/// X-ray: the line integral of f - b, the sum over sheets.
 struct XrayPolicy {
     static constexpr int kChannels = 1;
     static constexpr bool kTerminates = false;

@@ -87,7 +87,8 @@ PolicyContext policyContext(const Scene::Impl& scene, const Camera& camera,
     if (postDvr) ctx.edges = s.edges;
     const float g = scene.splats.gradientScale;
     ctx.invGradientScale = g > 0.0f ? 1.0f / g : 0.0f;
-    ctx.isoLevel = float(s.isoLevel);
+    // The sheets hold f - b (SplatList::background): the level is compared as level - b.
+    ctx.isoLevel = float(s.isoLevel - double(scene.splats.background));
     ctx.isoColour = glm::vec3(s.transfer.sample(float(s.isoLevel)));
     if (s.mode == RenderMode::Dvr && scene.settings.labels.enabled)
         ctx.labelTable = &scene.labelTable;
@@ -148,7 +149,7 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
                         ctx,
                         depth ? &positions : nullptr};
     Image image = splatter.rasterize(in, *work, &stats);
-    applyBackground(image, s.mode, s.background);
+    applyBackground(image, s.mode, s.background, scene.splats.background);
     if (depth) *depth = isoDepthFromSheets(positions, plan, camera, *scene.volume);
     return image;
 }

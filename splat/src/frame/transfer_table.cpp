@@ -3,7 +3,8 @@
 
 namespace splat {
 
-TransferTable::TransferTable(const TransferFunction& tf, int n) : n_(std::max(n, 2)) {
+TransferTable::TransferTable(const TransferFunction& tf, int n, float offset)
+    : n_(std::max(n, 2)) {
     if (tf.points.empty()) {
         v_.assign(std::size_t(n_) * 4, 0.0f);
         return;
@@ -20,6 +21,7 @@ TransferTable::TransferTable(const TransferFunction& tf, int n) : n_(std::max(n,
         v_[std::size_t(i) * 4 + 2] = c.g;
         v_[std::size_t(i) * 4 + 3] = c.b;
     }
+    lo_ -= offset;
 }
 
 }  // namespace splat

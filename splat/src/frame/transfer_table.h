@@ -11,8 +11,10 @@ namespace splat {
 class TransferTable {
   public:
     TransferTable() = default;
-    explicit TransferTable(const TransferFunction& tf, int n = 4096);
-    /// Extinction per world unit and (non-premultiplied) colour at density d.
+    /// `offset`: the table is read at d - offset, i.e. lookup(x) is the transfer function at
+    /// x + offset (the splatters' sheets hold f - b; offset = b).
+    explicit TransferTable(const TransferFunction& tf, int n = 4096, float offset = 0.0f);
+    /// Extinction per world unit and (non-premultiplied) colour at density d + offset.
     void lookup(float d, float& rho, float& r, float& g, float& b) const {
         float t = (d - lo_) * inv_;
         t = std::clamp(t, 0.0f, float(n_ - 1));

@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <random>
+#include <tuple>
 
 #include "splat/atomic_file.h"
 #include "splat/error.h"
@@ -20,6 +22,18 @@ namespace fs = std::filesystem;
 float srgbEncode(float x) {
     x = std::clamp(x, 0.0f, 1.0f);
     return x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+}
+
+std::pair<float, float> defaultWindow(const std::vector<const Image*>& images) {
+    float lo = 0.0f, hi = -std::numeric_limits<float>::infinity();
+    for (const Image* im : images)
+        for (const glm::vec4& p : im->pixels)
+            if (std::isfinite(p.r)) {
+                lo = std::min(lo, p.r);
+                hi = std::max(hi, p.r);
+            }
+    if (!(hi > lo)) hi = lo + 1.0f;
+    return {lo, hi};
 }
 
 namespace {

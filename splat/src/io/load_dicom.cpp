@@ -49,6 +49,7 @@ const gdcm::Tag kBitsStored(0x0028, 0x0101);
 const gdcm::Tag kPixelRepresentation(0x0028, 0x0103);
 const gdcm::Tag kSlope(0x0028, 0x1053);
 const gdcm::Tag kIntercept(0x0028, 0x1052);
+const gdcm::Tag kPixelPadding(0x0028, 0x0120);
 
 /// GDCM reports to std::cerr unless told not to; errors reach the user as splat::Error.
 void quietGdcm() {
@@ -107,6 +108,7 @@ struct SliceInfo {
     std::optional<std::vector<double>> orientation, pixelSpacing;
     std::optional<double> thickness, between;
     double slope = 1, intercept = 0;
+    std::optional<double> padding;  ///< Pixel Padding Value (stored, not rescaled)
 };
 
 int intOf(const std::optional<std::vector<double>>& v, int fallback, const std::string& what,
@@ -283,6 +285,7 @@ SliceInfo readInfoUnguarded(const fs::path& p) {
         s.between = v->front();
     if (auto v = numbersOf(sf, ds, kSlope, name, "RescaleSlope")) s.slope = v->front();
     if (auto v = numbersOf(sf, ds, kIntercept, name, "RescaleIntercept")) s.intercept = v->front();
+    if (auto v = numbersOf(sf, ds, kPixelPadding, name, "PixelPaddingValue")) s.padding = v->front();
     return s;
 }
 
@@ -538,6 +541,15 @@ Volume loadDicomFiles(const std::string& name, const std::vector<fs::path>& file
         "DICOM " + modality + "series, " + std::to_string(slices.size()) + " files (" + name + ")";
     applyOrientation(v, M, t, what);
     for (const std::string& n : notes) addNote(v, n);
+    // Background value (issue 21): the padding value where the file says it, else the
+    // rescaled minimum for CT; other modalities take the common rule (volumeBackground).
+    if (first.padding) {
+        v.background = float(first.slope * *first.padding + first.intercept);
+        v.backgroundSource = "DICOM Pixel Padding Value";
+    } else if (first.modality == "CT") {
+        v.background = volumeStats(v, 1).minValue;
+        v.backgroundSource = "minimum of the CT data (no Pixel Padding Value)";
+    }
     return v;
 }
 

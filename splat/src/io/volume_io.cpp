@@ -115,6 +115,16 @@ Volume loadVolume(const std::string& spec, const LoadOptions& options) {
         }
     }
     applyNonFinitePolicy(v, options.nonFinite, spec);
+    // Background value b (issue 21): a loader that read it from the file said so; otherwise
+    // the common rule, and synthetic volumes (made around an empty 0) keep 0.
+    if (v.backgroundSource == Volume{}.backgroundSource) {
+        if (spec.rfind("synthetic:", 0) == 0) {
+            v.backgroundSource = "synthetic volume";
+        } else {
+            v.background = backgroundFromFaces(v);
+            v.backgroundSource = "median of the outer faces";
+        }
+    }
     return v;
 }
 

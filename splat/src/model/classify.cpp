@@ -23,7 +23,7 @@ constexpr std::size_t kPaletteSize = 65536;  // entries a 16-bit emission index 
 // Post-classification and the transfer-function-free modes need every non-zero voxel
 // whose neighbourhood can become visible. A brick is needed when the transfer function
 // is visible somewhere in the value range of the brick widened by the kernel radius
-// (and by 0, since near the border the kernel weights sum to less than 1).
+// (and by the background value b, since near the border the field tends to b).
 std::vector<char> neededBricks(const Volume& v, const TransferFunction& tf, int pad,
                                glm::ivec3& bricks) {
     bricks = (v.dims + kBrick - 1) / kBrick;
@@ -34,7 +34,7 @@ std::vector<char> neededBricks(const Volume& v, const TransferFunction& tf, int 
                 const glm::ivec3 b(bx, by, bz);
                 const glm::ivec3 lo = glm::max(b * kBrick - pad, glm::ivec3(0));
                 const glm::ivec3 hi = glm::min((b + 1) * kBrick + pad, v.dims);
-                float mn = 0.0f, mx = 0.0f;
+                float mn = v.background, mx = v.background;
                 for (int k = lo.z; k < hi.z; ++k)
                     for (int j = lo.y; j < hi.y; ++j)
                         for (int i = lo.x; i < hi.x; ++i) {
@@ -229,7 +229,7 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
             if (!intensity) return false;
         }
         if (pre) return tf.extinction(value) > 0.0f && (!edges || edgeOf(i, j, k) > 0.0f);
-        if (value == 0.0f && !(gradients && glm::length(gradientAt(volume, i, j, k)) > 0.0))
+        if (value == volume.background && !(gradients && glm::length(gradientAt(volume, i, j, k)) > 0.0))
             return false;
         if (need.empty()) return true;
         return need[(std::size_t(k / kBrick) * bricks.y + j / kBrick) * bricks.x + i / kBrick] != 0;
@@ -282,6 +282,8 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
     };
 
     SplatList s;
+    const float b = volume.background;
+    s.background = b;
     s.gradientScale = maxGradient;
     const std::size_t n = count.back();
     s.voxels = volume.voxelCount();
@@ -291,6 +293,7 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
         s.palette.resize(distinct.size());
         for (std::size_t q = 0; q < distinct.size(); ++q) s.palette[q] = emissionOf(distinct[q]);
         s.paletteDensity = distinct;
+        for (float& v : s.paletteDensity) v -= b;
         s.emissionIndex.resize(n);
     } else {
         for (auto* a : {&s.density, &s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
@@ -310,7 +313,7 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                 s.i[o] = std::uint16_t(i);
                 s.j[o] = std::uint16_t(j);
                 s.k[o] = std::uint16_t(k);
-                if (!paletted) s.density[o] = value;
+                if (!paletted) s.density[o] = value - b;
                 if (labelled) s.label[o] = float(shown[volume.index(i, j, k)]);
                 if (paletted) {
                     s.emissionIndex[o] =

@@ -15,6 +15,8 @@ Volume coarserGrid(const Volume& fine) {
     v.spacing = 2.0 * fine.spacing;
     v.origin = fine.origin + 0.5 * fine.spacing;
     v.source = fine.source + " (2x level of detail)";
+    v.background = fine.background;
+    v.backgroundSource = fine.backgroundSource;
     return v;
 }
 
@@ -86,6 +88,7 @@ SplatList coarserSplats(const SplatList& fine, const glm::ivec3& fd) {
     SplatList s;
     const std::size_t m = start.back();
     s.origin = fine.origin + 0.5 * fine.spacing;
+    s.background = fine.background;  // merged densities are means of d - b
     s.spacing = 2.0 * fine.spacing;
     s.gradientScale = fine.gradientScale;
     s.voxels = std::size_t(cd.x) * std::size_t(cd.y) * std::size_t(cd.z);

@@ -143,7 +143,7 @@ Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
     }
     splats =
         classify(*volume, settings.transfer, s.mode, s.classification, kernel.radius(), options);
-    transfer = TransferTable(settings.transfer);
+    transfer = TransferTable(settings.transfer, 4096, volume->background);
     if (s.quality.polynomialTolerance > 0) {
         poly.emplace(table);
         if (poly->maxError() > s.quality.polynomialTolerance) poly.reset();

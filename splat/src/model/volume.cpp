@@ -52,6 +52,29 @@ Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::
     return v;
 }
 
+float backgroundFromFaces(const Volume& v) {
+    if (v.data.empty()) return 0.0f;
+    std::vector<float> face;
+    const glm::ivec3 d = v.dims;
+    auto take = [&](int i, int j, int k) {
+        const float x = v.at(i, j, k);
+        if (std::isfinite(x)) face.push_back(x);
+    };
+    for (int k = 0; k < d.z; ++k)
+        for (int j = 0; j < d.y; ++j)
+            for (int i = 0; i < d.x; ++i) {
+                const bool outer = i == 0 || j == 0 || k == 0 || i == d.x - 1 || j == d.y - 1 ||
+                                   k == d.z - 1;
+                if (outer) take(i, j, k);
+                // Inner rows of an inner slice: jump to the row's last sample.
+                else if (i == 1) i = d.x - 2;
+            }
+    if (face.empty()) return 0.0f;
+    auto mid = face.begin() + std::ptrdiff_t(face.size() / 2);
+    std::nth_element(face.begin(), mid, face.end());
+    return *mid;
+}
+
 VolumeStats volumeStats(const Volume& v, int bins) {
     VolumeStats s;
     bins = std::max(bins, 1);
@@ -113,6 +136,7 @@ std::string describeVolume(const Volume& v) {
         out << buf << '\n';
     }
     line("memory:      %.1f MiB", double(v.bytes()) / (1024.0 * 1024.0));
+    line("background:  %g (%s)", double(v.background), v.backgroundSource.c_str());
     if (!v.note.empty()) out << "note:        " << v.note << '\n';
     return out.str();
 }

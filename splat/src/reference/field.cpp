@@ -5,7 +5,7 @@ namespace splat {
 
 ReferenceField::ReferenceField(const Volume& volume, const SplatList& splats,
                                const footprint::Kernel& kernel, FieldLayout layout)
-    : lut_(kernel), radius_(kernel.radius()), layout_(layout) {
+    : lut_(kernel), radius_(kernel.radius()), layout_(layout), background_(splats.background) {
     if (layout == FieldLayout::Emission)
         grid4_ = buildGrid<4>(volume, splats, lut_, radius_,
                               {&splats.extinction, &splats.r, &splats.g, &splats.b},

@@ -251,7 +251,7 @@ class ReferenceField {
 
     FieldLayout layout() const { return layout_; }
     bool fourChannels() const { return layout_ != FieldLayout::Density; }
-    /// f at a world position (Density and DensityGradient layouts).
+    /// f at a world position (Density and DensityGradient layouts): b + the grid's f - b.
     double density(const Volume& volume, const glm::dvec3& world) const {
         double v[4];
         const glm::dvec3 p = (world - volume.origin) / volume.spacing;
@@ -260,7 +260,7 @@ class ReferenceField {
         } else {
             grid1_.eval(p, v);
         }
-        return v[0];
+        return v[0] + double(background_);
     }
     const FieldGrid<4>& grid4() const { return grid4_; }
     const FieldGrid<1>& grid1() const { return grid1_; }
@@ -270,6 +270,7 @@ class ReferenceField {
     KernelLut lut_;
     double radius_;
     FieldLayout layout_;
+    float background_ = 0.0f;  ///< b (the grids hold d_i - b, SplatList::background)
     FieldGrid<4> grid4_;
     FieldGrid<1> grid1_;
 };

@@ -1,5 +1,6 @@
 // The reference ray caster (splat/DESIGN.md, "The model"): one ray per pixel through the
-// continuous fields f(x) = sum_i d_i h(|S^-1 (x - x_i)|) (and rho, e for pre-classification),
+// continuous fields f(x) = b + sum_i (d_i - b) h(|S^-1 (x - x_i)|) (b the volume's background
+// value; the grids hold f - b) and rho, e for pre-classification,
 // integrated with error control.
 //
 // Acceleration (exact, no change of the model):
@@ -73,6 +74,7 @@ class Caster {
         if (!(q.referenceTolerance > 0)) throw Error("reference: referenceTolerance must be > 0");
         if (volume.voxelCount() == 0) throw Error("reference: empty volume");
         invSpacing_ = 1.0 / volume.spacing;
+        background_ = volume.background;
         const glm::dvec3 pad = field.radius() * volume.spacing;
         clips_ = settings.clipping.enabled() &&
                  !containsBox(settings.clipping, volume.world(glm::dvec3(0.0)) - pad,
@@ -142,7 +144,7 @@ class Caster {
             rho = s[0];
             e = glm::dvec3(s[1], s[2], s[3]);
         } else if (channels == 4) {  // density and gradient: post-classified, shaded / edges
-            const glm::vec4 c = settings_.transfer.sample(s[0]);
+            const glm::vec4 c = settings_.transfer.sample(s[0] + background_);
             float r = c.r, g = c.g, b = c.b;
             float rhoF = settings_.transfer.extinctionFromOpacity(c.a);
             if (edgesPost_)
@@ -159,7 +161,7 @@ class Caster {
             rho = rhoF;
             e = glm::dvec3(r, g, b) * rho;
         } else {
-            const glm::vec4 c = settings_.transfer.sample(s[0]);
+            const glm::vec4 c = settings_.transfer.sample(s[0] + background_);
             rho = settings_.transfer.extinctionFromOpacity(c.a);
             e = glm::dvec3(c) * rho;
         }
@@ -192,7 +194,9 @@ class Caster {
         levelUsed = 0;
         hitDepth = -1;
         if (sc.segments.empty()) {
-            if (mode == RenderMode::Xray || mode == RenderMode::Mip) return glm::vec4(0, 0, 0, 1);
+            // Outside the data the field is b: x-ray (of f - b) sees 0, mip sees b.
+            if (mode == RenderMode::Xray) return glm::vec4(0, 0, 0, 1);
+            if (mode == RenderMode::Mip) return glm::vec4(glm::vec3(background_), 1.0f);
             return finish(glm::dvec4(0.0));
         }
         const std::size_t ns = sc.segments.size();
@@ -302,7 +306,7 @@ class Caster {
                     }
                 }
             } else {  // iso
-                const double level0 = settings_.isoLevel;
+                const double level0 = settings_.isoLevel - background_;  // samples: f - b
                 double fPrev = sample(0)[0];
                 // A ray entering the kept region of a clipped volume inside the surface hits
                 // the cut face (the splatters' first sheet has nothing in front either).
@@ -330,6 +334,7 @@ class Caster {
                 const double lo = std::max(seg.a, mipT - h), hi = std::min(seg.b, mipT + h);
                 mip = std::max(mip, goldenMax(g, p0, v, lo, hi));
             }
+            mip += background_;  // the samples hold f - b; outside the data a ray sees b
             return glm::dvec4(mip, mip, mip, 1.0);
         }
         if (depth < 0) return glm::dvec4(0.0);
@@ -346,7 +351,7 @@ class Caster {
     template <int C>
     double bisect(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& v, double lo,
                   double hi) const {
-        const double level = settings_.isoLevel;
+        const double level = settings_.isoLevel - background_;
         const double eps = 1e-9 * volume_.minSpacing();
         while (hi - lo > eps) {
             const double mid = 0.5 * (lo + hi);
@@ -413,6 +418,8 @@ class Caster {
     const RenderSettings& settings_;
     const ReferenceField& field_;
     glm::dvec3 invSpacing_{1.0};
+    /// b: the fields hold f - b (SplatList::background); added back where f itself is read.
+    float background_ = 0.0f;
     double stepWorld_ = 1;
     bool preDvr_ = false;
     FieldLayout layout_ = FieldLayout::Density;

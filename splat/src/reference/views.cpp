@@ -52,7 +52,7 @@ FieldView::FieldView(const Volume& volume, const std::string& kernel, double sig
     impl_ = std::make_unique<Impl>(volume, viewKernel(kernel, sigma, radius), threads);
     validateReferenceKernel(impl_->kernel);
     runOnThreads(threads, [&] {
-        // Every voxel with d != 0 (the transfer-function-free classification of xray/mip).
+        // Every voxel with d != b (the transfer-function-free classification of xray/mip).
         impl_->splats = classify(volume, TransferFunction::preset("gray-ramp").resolved(0, 1),
                                  RenderMode::Xray, Classification::Pre, impl_->kernel.radius());
         impl_->field = std::make_unique<ReferenceField>(volume, impl_->splats, impl_->kernel,
