@@ -10,6 +10,7 @@
 
 #include "splat/atomic_file.h"
 #include "splat/error.h"
+#include "splat/image_io.h"
 #include "splat/study.h"
 
 namespace splat {
@@ -164,10 +165,16 @@ void writePng(const StudyResult& r, const std::filesystem::path& path) {
         IBA::render_box(buf, x - h, y - h, x + h, y + h, p.pareto ? red : blue, true);
         if (p.pareto) label(x + 7, y - 5, p.label(), 10);  // the others: see study.csv
     }
-    AtomicFile out(path);
-    if (!buf.write(out.temporary().string()))
-        throw Error(path.string() + ": cannot write the plot (" + buf.geterror() + ")");
-    out.commit();
+    // Through writeImage: encoded in memory, written by the checked atomic writer.
+    std::vector<float> px(std::size_t(ax.width) * std::size_t(ax.height) * 3);
+    if (!buf.get_pixels(buf.roi(), OIIO::TypeDesc::FLOAT, px.data()))
+        throw Error(path.string() + ": cannot draw the plot (" + buf.geterror() + ")");
+    Image image(int(ax.width), int(ax.height));
+    for (std::size_t n = 0; n < image.pixels.size(); ++n)
+        image.pixels[n] = glm::vec4(px[3 * n], px[3 * n + 1], px[3 * n + 2], 1.0f);
+    WriteOptions display;
+    display.mapping = DisplayMapping::Display;
+    writeImage(path.string(), image, display);
 }
 
 }  // namespace
