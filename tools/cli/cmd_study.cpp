@@ -13,6 +13,7 @@
 #include "progress.h"
 #include "render_options.h"
 #include "scene_file.h"
+#include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "splat/study.h"
 #include "volume_options.h"
@@ -122,6 +123,7 @@ void registerStudy(CLI::App& app) {
         o.referenceTolerance = a->truthTolerance;
         o.pixelsPerDegree = a->ppd;
         o.cacheDir = a->report + "/cache";
+        removeStaleTemporaries(o.cacheDir);  // left by a killed run
         beginRun(*cmd);
         auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
         installInterruptHandler();

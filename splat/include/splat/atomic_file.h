@@ -34,16 +34,20 @@ class AtomicFile {
     /// Appends `size` bytes to the temporary (created on the first call). Throws
     /// splat::Error naming the target and the OS error; the temporary is then removed.
     void write(const void* bytes, std::size_t size);
-    /// Flushes the temporary to the disk (fsync), closes it with its error checked, renames
-    /// it over the target and fsyncs the folder. Throws splat::Error naming the target (the
-    /// previous target, if any, is untouched and the temporary removed).
+    /// Flushes the temporary to the disk (fsync) and closes it, errors checked; commit()
+    /// does it when not done. Call it on each of a set of files before committing any,
+    /// so that a failure leaves every previous file of the set untouched.
+    void sync();
+    /// sync(), then renames the temporary over the target and fsyncs the folder. Throws
+    /// splat::Error naming the target (the previous target, if any, is untouched and the
+    /// temporary removed).
     void commit();
 
   private:
     [[noreturn]] void fail(const std::string& what, int error);
     std::filesystem::path target_, tmp_;
     int fd_ = -1;
-    bool committed_ = false;
+    bool synced_ = false, committed_ = false;
 };
 
 /// Writes `bytes` to `path` atomically. Refuses to write through a folder or over a

@@ -846,6 +846,7 @@ void writePoppingReport(const PoppingResult& result, const std::string& dir,
     if (dir.empty()) throw Error("popping report: no folder given");
     const fs::path folder(dir);
     prepareFolder(folder);
+    removeStaleTemporaries(folder);  // left by a killed run
     // Everything is built before anything is written.
     const json summary = summaryJson(result);
     const std::string csv = metricsCsv(result);
@@ -855,9 +856,16 @@ void writePoppingReport(const PoppingResult& result, const std::string& dir,
     } catch (const Error& e) {
         throw Error((folder / "report.html").string() + ": " + e.what());
     }
-    writeTextAtomic(folder / "metrics.csv", csv);
-    writeTextAtomic(folder / "summary.json", summary.dump(2) + "\n");
-    writeTextAtomic(folder / "report.html", html);
+    // All three are written in full before any replaces a previous one: a failure leaves
+    // the previous report whole, never a mix of two runs.
+    const std::string json = summary.dump(2) + "\n";
+    AtomicFile files[] = {AtomicFile(folder / "metrics.csv"), AtomicFile(folder / "summary.json"),
+                          AtomicFile(folder / "report.html")};
+    files[0].write(csv.data(), csv.size());
+    files[1].write(json.data(), json.size());
+    files[2].write(html.data(), html.size());
+    for (AtomicFile& f : files) f.sync();
+    for (AtomicFile& f : files) f.commit();
 }
 
 }  // namespace splat

@@ -342,9 +342,13 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
                     ".exr"))
                       .string();
         if (!file.empty() && std::filesystem::exists(file)) {
-            Image img = readImage(file);
-            if (img.width == r.camera.width && img.height == r.camera.height)
-                return references[key] = std::move(img);
+            // A cached reference that does not decode whole (damaged) is rendered again.
+            try {
+                Image img = readImage(file);
+                if (img.width == r.camera.width && img.height == r.camera.height)
+                    return references[key] = std::move(img);
+            } catch (const Error&) {
+            }
         }
         if (!referenceScene) referenceScene = std::make_unique<Scene>(volume, r);
         Image img = referenceScene->render(r);

@@ -89,7 +89,7 @@ void AtomicFile::fail(const std::string& what, int error) {
 }
 
 void AtomicFile::write(const void* bytes, std::size_t size) {
-    if (committed_) throw Error(target_.string() + ": written after commit");
+    if (committed_ || synced_) throw Error(target_.string() + ": written after sync or commit");
     if (fd_ < 0) {
         fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
         if (fd_ < 0) fail("cannot create file", errno);
@@ -105,8 +105,8 @@ void AtomicFile::write(const void* bytes, std::size_t size) {
     }
 }
 
-void AtomicFile::commit() {
-    if (committed_) return;
+void AtomicFile::sync() {
+    if (committed_ || synced_) return;
     if (fd_ < 0) {
         // An external writer filled the temporary: it must be there and hold something.
         struct stat st {};
@@ -133,6 +133,12 @@ void AtomicFile::commit() {
         fs::remove(tmp_, ignored);
         throw Error(target_.string() + ": cannot write (" + osError(e) + ")");
     }
+    synced_ = true;
+}
+
+void AtomicFile::commit() {
+    if (committed_) return;
+    sync();
     if (::rename(tmp_.c_str(), target_.c_str()) != 0) fail("cannot write", errno);
     committed_ = true;
     syncFolder(target_.parent_path());
