@@ -178,6 +178,7 @@ void prepareFolder(const fs::path& dir) {
         const std::string name = it->path().filename().string();
         std::error_code ec2;
         if ((isReportFile(name) && it->is_regular_file(ec2)) || isReportTemporary(name)) continue;
+        if (name == ".frames" && it->is_directory(ec2)) continue;  // `splat popping` journal
         throw Error(d + ": the folder holds '" + name +
                     "', which is not part of a popping report; write the report into a new "
                     "or empty folder (or one holding only a previous report)");
