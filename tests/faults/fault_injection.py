@@ -12,7 +12,8 @@ that completes to byte-identical outputs:
   unwritable     a read-only tmpfs (root) or a chmod 0555 folder (not root);
   disappearing   frames deleted, truncated or emptied between a run and --resume;
   external       an ffmpeg that fails after writing part of its file, one that writes nothing;
-  killed         SIGKILL / SIGINT at random moments of render, rotate, popping and study.
+  killed         SIGKILL / SIGINT at random moments of render, rotate, popping and study,
+                 then the same command (rotate, popping, study: with --resume).
 Prints one line per case; exits 1 when any assertion failed.
 """
 import hashlib
@@ -153,7 +154,7 @@ def study_accuracy(d):
     """The study's measured accuracy (timings differ from run to run; these do not)."""
     with open(os.path.join(d, "study.json")) as f:
         j = json.load(f)
-    keys = ("label", "splats", "footprint_pixels", "rmse", "max_abs", "flip")
+    keys = ("label", "splats", "footprint_pixels", "rmse", "psnr", "max_abs", "flip")
     return [{k: p.get(k) for k in keys} for p in j["points"]]
 
 
@@ -375,11 +376,13 @@ for name, make, compare in (
             s = state(o)
             check(all(ref.get(k) == v for k, v in s.items() if not TEMP.match(k)),
                   f"{case}: a file differs from the clean run")
-        again = make(o) + (["--resume"] if name == "rotate" else [])
+        again = make(o) + (["--resume"] if name != "render" else [])
         rc, _, err = run(again)
         check(rc == 0, f"{case}, then again: {err}")
         check(compare(o, ref), f"{case}, then again: outputs differ from the clean run")
         check_clean(o, f"{case}, then again")
+        check(not os.path.exists(f"{o}/.frames") and not os.path.exists(f"{o}/.points"),
+              f"{case}, then again: the journal was not removed")
 
 for m in reversed(mounts):
     subprocess.run(["umount", m])

@@ -39,8 +39,10 @@ void prepareJournal(const CLI::App& cmd, const fs::path& dir, bool resume) {
         if (ec) throw Error(dir.string() + ": cannot clear the journal (" + ec.message() + ")");
     }
     fs::create_directories(dir, ec);
-    if (!fs::is_directory(dir, ec))
-        throw Error(dir.string() + ": cannot create the journal folder (" + ec.message() + ")");
+    std::error_code ignored;
+    if (!fs::is_directory(dir, ignored))
+        throw Error(dir.string() + ": cannot create the journal folder (" +
+                    (ec ? ec.message() : std::string("not a folder")) + ")");
     removeStaleTemporaries(dir);
     if (!same || !resume) writeTextAtomic(keyFile, key + "\n");
 }
