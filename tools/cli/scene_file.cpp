@@ -445,7 +445,7 @@ std::string canonicalCommand(const CLI::App& cmd) {
 void beginRun(const CLI::App& cmd) {
     CommandTable& t = tableOf(cmd);
     t.fixed = sceneOf(cmd);
-    json scene = t.fixed;
+    auto scene = t.fixed;
     for (const char* k : {"resume", "overwrite"}) scene.erase(k);
     runMetadata() = {{"Software", std::string("splat ") + kVersion},
                      {"splat:command", canonicalCommand(cmd)},
