@@ -12,12 +12,15 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <random>
 
 #include "cli_util.h"
 #include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
 #include "splat/study.h"
+#include "splat/volume.h"
+#include "splat/volume_io.h"
 
 namespace fs = std::filesystem;
 using splat::test::testTmpDir;
@@ -186,4 +189,28 @@ TEST_CASE("writeStudyReport on a failing write keeps the whole previous report",
     splat::writeStudyReport(r, dir.string(), "splat study");
     CHECK(slurp(dir / "study.csv").rfind("slab,ms_median", 0) == 0);
     CHECK(splat::readImage((dir / "pareto.png").string()).width > 100);
+}
+
+TEST_CASE("saveNifti on a failing write throws and keeps the previous volume", "[faults]") {
+    const fs::path dir = testTmpDir("faults_nifti");
+    splat::Volume small;
+    small.dims = {4, 4, 4};
+    small.data.assign(64, 1.0f);
+    for (const char* name : {"v.nii", "v.nii.gz"}) {
+        const fs::path file = dir / name;
+        splat::saveNifti(file.string(), small);
+        const std::string before = slurp(file);
+        splat::Volume big;
+        big.dims = {40, 40, 40};
+        big.data.resize(64000);
+        std::mt19937 random(7);  // noise: no compression brings it under the limit
+        for (float& d : big.data) d = std::uniform_real_distribution<float>(0, 1)(random);
+        {
+            FileSizeLimit limit(8192);
+            CHECK_THROWS_WITH(splat::saveNifti(file.string(), big),
+                              Catch::Contains(file.string()));
+        }
+        CHECK(slurp(file) == before);
+        CHECK(temporariesIn(dir) == 0);
+    }
 }
