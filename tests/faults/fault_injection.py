@@ -16,6 +16,7 @@ that completes to byte-identical outputs:
                  then the same command (rotate, popping, study: with --resume).
 Prints one line per case; exits 1 when any assertion failed.
 """
+import atexit
 import hashlib
 import json
 import os
@@ -35,6 +36,13 @@ VOL = "synthetic:phantom:48"
 TEMP = re.compile(r"^\..+\.tmp[0-9]+-[0-9]+(\..*)?$")
 failures = []
 mounts = []
+
+
+@atexit.register
+def unmount():
+    for m in reversed(mounts):
+        subprocess.run(["umount", m], capture_output=True)
+    mounts.clear()
 
 
 def check(cond, what):
@@ -217,6 +225,18 @@ def full_disk_cases(d, how, limit, oserr, squeeze):
           f"{case} rotate: a written frame differs from the clean run")
     with open(gif, "rb") as f:
         check(f.read() == b"previous gif", f"{case} rotate: previous GIF changed")
+    if limit is not None:
+        # Frames that fit, then a GIF or a contact sheet that does not (after every frame).
+        small = ["rotate", VOL, "--size", "32x32", "--frames", "36", "-q", "--overwrite"]
+        for flag, name in (("--gif", "sheet.gif"), ("--contact-sheet", "sheet.png")):
+            target = os.path.join(d, name)
+            with open(target, "wb") as f:
+                f.write(b"previous " + name.encode())
+            rc, _, err = run(small + ["-o", os.path.join(d, "small"), flag, target], fsize=limit)
+            check_error(rc, err, f"{case} rotate {flag}", target, oserr)
+            with open(target, "rb") as f:
+                check(f.read() == b"previous " + name.encode(), f"{case} {flag}: previous changed")
+            check_clean(os.path.join(d, "small"), f"{case} rotate {flag}")
     squeeze(None)
     rc, _, err = run(args + ["--resume"])
     check(rc == 0, f"{case} rotate --resume: {err}")
@@ -384,8 +404,8 @@ for name, make, compare in (
         check(not os.path.exists(f"{o}/.frames") and not os.path.exists(f"{o}/.points"),
               f"{case}, then again: the journal was not removed")
 
-for m in reversed(mounts):
-    subprocess.run(["umount", m])
-shutil.rmtree(WORK, ignore_errors=True) if not failures else None
+unmount()
+if not failures:
+    shutil.rmtree(WORK, ignore_errors=True)
 print(f"{len(failures)} failures" if failures else "all fault-injection cases passed")
 sys.exit(1 if failures else 0)
