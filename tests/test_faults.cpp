@@ -32,9 +32,7 @@ std::string slurp(const fs::path& p) {
     return {std::istreambuf_iterator<char>(in), {}};
 }
 
-void put(const fs::path& p, const std::string& text) {
-    std::ofstream(p, std::ios::binary) << text;
-}
+void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
 /// Files may grow to `bytes` while it lives (SIGXFSZ ignored: writes fail with EFBIG).
 class FileSizeLimit {
@@ -207,8 +205,7 @@ TEST_CASE("saveNifti on a failing write throws and keeps the previous volume", "
         for (float& d : big.data) d = std::uniform_real_distribution<float>(0, 1)(random);
         {
             FileSizeLimit limit(8192);
-            CHECK_THROWS_WITH(splat::saveNifti(file.string(), big),
-                              Catch::Contains(file.string()));
+            CHECK_THROWS_WITH(splat::saveNifti(file.string(), big), Catch::Contains(file.string()));
         }
         CHECK(slurp(file) == before);
         CHECK(temporariesIn(dir) == 0);

@@ -152,8 +152,7 @@ std::vector<bool> prepareFolder(const RotateCommand& a, const nlohmann::json& ma
         // Only a frame that decodes to the right size is kept; any other is rendered again
         // (a file damaged or truncated after it was written, or by another program).
         keep[i] = frameIsComplete(p, width, height);
-        if (!keep[i])
-            warn(p.string() + ": incomplete or unreadable frame; rendering it again");
+        if (!keep[i]) warn(p.string() + ": incomplete or unreadable frame; rendering it again");
     }
     return keep;
 }
@@ -211,8 +210,10 @@ void writeMp4(const RotateCommand& a, const std::string& ffmpeg) {
     std::string messages;
     char buf[4096];
     for (ssize_t n; spawned == 0 && (n = ::read(pipeFd[0], buf, sizeof buf)) != 0;)
-        if (n > 0) messages.append(buf, std::size_t(n));
-        else if (errno != EINTR) break;
+        if (n > 0)
+            messages.append(buf, std::size_t(n));
+        else if (errno != EINTR)
+            break;
     ::close(pipeFd[0]);
     if (spawned != 0) throw Error(a.mp4 + ": cannot run " + ffmpeg);
     int status = 0;

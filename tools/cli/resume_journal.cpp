@@ -17,8 +17,8 @@ namespace {
 /// What the journal's work depends on: the scene less the run-control options.
 std::string journalKey(const CLI::App& cmd) {
     nlohmann::ordered_json scene = sceneOf(cmd);
-    for (const char* k : {"resume", "overwrite", "quiet", "threads", "parallel-frames", "scene",
-                          "write-scene"})
+    for (const char* k :
+         {"resume", "overwrite", "quiet", "threads", "parallel-frames", "scene", "write-scene"})
         scene.erase(k);
     return scene.dump();
 }

@@ -2,9 +2,8 @@
 // The journal of a resumable command (popping's frames, study's measured points): a hidden
 // folder in the report folder that holds the work done so far, so that `--resume` after an
 // interruption does only the rest (README "Reliability").
-#include <filesystem>
-
 #include <CLI/CLI.hpp>
+#include <filesystem>
 
 namespace splat::cli {
 

@@ -3,10 +3,10 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstring>
-#include <filesystem>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <mutex>
 #include <numeric>
 
@@ -115,9 +115,9 @@ class Analyzer {
         for (std::size_t v = 0; v < views && !options_.frameJournal.empty(); ++v) {
             journaled[v] = true;
             for (std::size_t k = 0; k < kinds_.size(); ++k)
-                journaled[v] = journaled[v] && journal::hasFrame(journalFile(r.angles[v], k),
-                                                                 sweep_.base.width,
-                                                                 sweep_.base.height);
+                journaled[v] =
+                    journaled[v] && journal::hasFrame(journalFile(r.angles[v], k),
+                                                      sweep_.base.width, sweep_.base.height);
         }
         so.skip = [&](std::size_t v) { return bool(journaled[v]); };
         View prev;

@@ -462,8 +462,8 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
                     progress.step(point.label());
             }
             restorePoint(point, done->second);
-            result.visibleVoxels = std::max(result.visibleVoxels, done->second.value("visible",
-                                                                                  std::size_t(0)));
+            result.visibleVoxels =
+                std::max(result.visibleVoxels, done->second.value("visible", std::size_t(0)));
             result.points.push_back(std::move(point));
             continue;
         }

@@ -257,10 +257,9 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
     const std::vector<unsigned char> png = plotPng(r, fs::path(dir) / "pareto.png");
     // All four are written in full before any replaces a previous one: a failure leaves
     // the previous report whole, never a mix of two runs.
-    AtomicFile files[] = {AtomicFile(fs::path(dir) / "study.csv"),
-                          AtomicFile(fs::path(dir) / "study.json"),
-                          AtomicFile(fs::path(dir) / "pareto.svg"),
-                          AtomicFile(fs::path(dir) / "pareto.png")};
+    AtomicFile files[] = {
+        AtomicFile(fs::path(dir) / "study.csv"), AtomicFile(fs::path(dir) / "study.json"),
+        AtomicFile(fs::path(dir) / "pareto.svg"), AtomicFile(fs::path(dir) / "pareto.png")};
     files[0].write(csvText.data(), csvText.size());
     files[1].write(json.data(), json.size());
     files[2].write(svg.data(), svg.size());
