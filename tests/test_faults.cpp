@@ -211,3 +211,21 @@ TEST_CASE("saveNifti on a failing write throws and keeps the previous volume", "
         CHECK(temporariesIn(dir) == 0);
     }
 }
+
+TEST_CASE("a temporary that disappears before the rename is an error, not a file", "[faults]") {
+    const fs::path dir = testTmpDir("faults_vanish");
+    const fs::path file = dir / "table.csv";
+    put(file, "previous\n");
+    splat::AtomicFile out(file);
+    out.write("a,b\n", 4);
+    fs::remove(out.temporary());  // another program removes it while it is being written
+    CHECK_THROWS_WITH(out.commit(), Catch::Contains(file.string()) &&
+                                        Catch::Contains("No such file or directory"));
+    CHECK(slurp(file) == "previous\n");
+    // Its folder disappearing is named the same way.
+    const fs::path gone = dir / "gone";
+    fs::create_directories(gone);
+    splat::AtomicFile lost(gone / "x.json");
+    fs::remove_all(gone);
+    CHECK_THROWS_WITH(lost.write("{}", 2), Catch::Contains("No such file or directory"));
+}
