@@ -12,6 +12,7 @@
 #include "diagnostics.h"
 #include "progress.h"
 #include "render_options.h"
+#include "resume_journal.h"
 #include "scene_file.h"
 #include "splat/error.h"
 #include "splat/popping.h"
@@ -26,7 +27,7 @@ struct PoppingCommand {
     std::string report, sweep = "azimuth", renderers = "axis,sheet,reference";
     double from = 40, to = 50, step = 0.5, k = 5, floor = 2, ppd = 67;
     int refine = 10;
-    bool noFlip = false, quiet = false;
+    bool noFlip = false, quiet = false, resume = false;
 };
 
 std::vector<RendererKind> parseRenderers(const std::string& text) {
@@ -79,6 +80,8 @@ void registerPopping(CLI::App& app) {
     addFlag(*cmd, "--no-flip", a->noFlip, "skip the perceptual (LDR-FLIP) columns", sw);
     addOption(*cmd, "--report", a->report, "report folder (report.html, metrics.csv, summary.json)",
               out, PathKind::Output);
+    addFlag(*cmd, "--resume", a->resume,
+            "finish an interrupted run: reuse the frames it left in REPORT/.frames", out);
     addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
     cmd->footer(
         "Examples:\n"
@@ -118,6 +121,11 @@ void registerPopping(CLI::App& app) {
         // The Scene is validated against its first renderer (iso: the reference alone).
         settings.renderer = o.renderers.front();
         beginRun(*cmd);
+        // The frames rendered so far are journaled, so that --resume after an interruption
+        // renders only the rest; the journal goes once the report is written.
+        const std::string journal = a->report + "/.frames";
+        prepareJournal(*cmd, journal, a->resume);
+        o.frameJournal = journal;
         auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
         const Scene scene(volume, settings);
         installInterruptHandler();
@@ -130,10 +138,13 @@ void registerPopping(CLI::App& app) {
             result = analyzePopping(scene, sweep, o);
         } catch (const Cancelled&) {
             progress.finish();
-            throw Error("interrupted: no report written");
+            throw Error(
+                "interrupted: no report written (--resume finishes it from the frames "
+                "rendered)");
         }
         progress.finish();
         writePoppingReport(result, a->report, commandLine());
+        removeJournal(journal);
         printSummary(result);
         std::printf("wrote %s/report.html, metrics.csv, summary.json (%.1f s)\n", a->report.c_str(),
                     result.totalMs / 1000.0);

@@ -47,6 +47,7 @@ void registerRender(CLI::App& app) {
         const Renderer renderer(volume, settings);
         RenderStats stats;
         const Image image = renderer.render(&stats);
+        removeStaleTemporaries(std::filesystem::path(args->output).parent_path());
         writeImage(args->output, image, displayOptions(args->render, settings, image));
         const double skipped =
             stats.voxels ? 100.0 * (1.0 - double(stats.splats) / stats.voxels) : 0.0;

@@ -9,6 +9,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -101,13 +103,26 @@ nlohmann::json manifestOf(const RotateCommand& a, const RenderSettings& s) {
             {"shade", s.shading.enabled}};
 }
 
-/// Refuses folders whose frames would be mixed with this run's; returns the frames to keep.
-std::vector<bool> prepareFolder(const RotateCommand& a, const nlohmann::json& manifest) {
+/// True when `file` decodes as a complete image of width x height pixels.
+bool frameIsComplete(const fs::path& file, int width, int height) {
+    try {
+        const Image im = readImage(file.string());
+        return im.width == width && im.height == height;
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
+/// Refuses folders whose frames would be mixed with this run's; returns the frames to keep
+/// (those that decode completely, `width` x `height`).
+std::vector<bool> prepareFolder(const RotateCommand& a, const nlohmann::json& manifest, int width,
+                                int height) {
     std::error_code ec;
     if (fs::exists(a.outDir, ec) && !fs::is_directory(a.outDir, ec))
         throw Error(a.outDir + ": exists and is not a folder");
     std::vector<bool> keep(std::size_t(a.frames), false);
     if (!fs::is_directory(a.outDir, ec)) return keep;
+    removeStaleTemporaries(a.outDir);  // left by a killed run
     const auto frames = existingFrames(a);
     if (frames.empty()) return keep;
     const fs::path mpath = fs::path(a.outDir) / kManifest;
@@ -134,7 +149,10 @@ std::vector<bool> prepareFolder(const RotateCommand& a, const nlohmann::json& ma
         if (i >= keep.size())
             throw Error(a.outDir + ": holds frame " + std::to_string(i) + " beyond --frames " +
                         std::to_string(a.frames) + "; use --overwrite");
-        keep[i] = true;
+        // Only a frame that decodes to the right size is kept; any other is rendered again
+        // (a file damaged or truncated after it was written, or by another program).
+        keep[i] = frameIsComplete(p, width, height);
+        if (!keep[i]) warn(p.string() + ": incomplete or unreadable frame; rendering it again");
     }
     return keep;
 }
@@ -178,14 +196,38 @@ void writeMp4(const RotateCommand& a, const std::string& ffmpeg) {
     std::vector<char*> argv;
     for (auto& s : args) argv.push_back(s.data());
     argv.push_back(nullptr);
+    // ffmpeg's messages are collected, and its last line becomes our one-line error.
+    int pipeFd[2];
+    if (::pipe(pipeFd) != 0) throw Error(a.mp4 + ": cannot run " + ffmpeg);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, pipeFd[1], 2);
+    posix_spawn_file_actions_addclose(&actions, pipeFd[0]);
     pid_t pid;
-    if (posix_spawn(&pid, ffmpeg.c_str(), nullptr, nullptr, argv.data(), environ) != 0)
-        throw Error(a.mp4 + ": cannot run " + ffmpeg);
+    const int spawned = posix_spawn(&pid, ffmpeg.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(pipeFd[1]);
+    std::string messages;
+    char buf[4096];
+    for (ssize_t n; spawned == 0 && (n = ::read(pipeFd[0], buf, sizeof buf)) != 0;)
+        if (n > 0)
+            messages.append(buf, std::size_t(n));
+        else if (errno != EINTR)
+            break;
+    ::close(pipeFd[0]);
+    if (spawned != 0) throw Error(a.mp4 + ": cannot run " + ffmpeg);
     int status = 0;
-    waitpid(pid, &status, 0);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-        throw Error(a.mp4 + ": ffmpeg failed (exit status " + std::to_string(WEXITSTATUS(status)) +
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        while (!messages.empty() && std::isspace((unsigned char)messages.back()))
+            messages.pop_back();
+        const std::size_t nl = messages.rfind('\n');
+        const std::string last = nl == std::string::npos ? messages : messages.substr(nl + 1);
+        throw Error(a.mp4 + ": ffmpeg failed (" +
+                    (last.empty() ? "exit status " + std::to_string(WEXITSTATUS(status)) : last) +
                     ")");
+    }
     out.commit();
 }
 
@@ -308,7 +350,8 @@ void registerRotate(CLI::App& app) {
                                                a->from, a->to, a->frames, true)
                             : CameraPath::fromJson(a->path, settings.camera, a->frames);
         nlohmann::json manifest = manifestOf(*a, settings);
-        const std::vector<bool> keep = prepareFolder(*a, manifest);
+        const std::vector<bool> keep =
+            prepareFolder(*a, manifest, settings.camera.width, settings.camera.height);
         beginRun(*cmd);
         auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
         const Scene scene(volume, settings);

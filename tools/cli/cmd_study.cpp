@@ -12,7 +12,9 @@
 #include "diagnostics.h"
 #include "progress.h"
 #include "render_options.h"
+#include "resume_journal.h"
 #include "scene_file.h"
+#include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "splat/study.h"
 #include "volume_options.h"
@@ -27,7 +29,7 @@ struct StudyCommand {
     std::string report, views;
     int repeats = 5, warmup = 1;
     double truthStep = 0.125, truthTolerance = 1e-5, ppd = 67;
-    bool convergence = false, quiet = false;
+    bool convergence = false, quiet = false, resume = false;
 };
 
 std::vector<glm::dvec2> parseViews(const std::string& text) {
@@ -91,6 +93,8 @@ void registerStudy(CLI::App& app) {
               "report folder (study.csv, study.json, pareto.svg, pareto.png; references cached "
               "there)",
               out, PathKind::Output);
+    addFlag(*cmd, "--resume", a->resume,
+            "finish an interrupted run: keep the points it measured (REPORT/.points)", out);
     addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
     cmd->footer(
         "Examples:\n"
@@ -122,7 +126,13 @@ void registerStudy(CLI::App& app) {
         o.referenceTolerance = a->truthTolerance;
         o.pixelsPerDegree = a->ppd;
         o.cacheDir = a->report + "/cache";
+        removeStaleTemporaries(o.cacheDir);  // left by a killed run
         beginRun(*cmd);
+        // The points measured so far are journaled, so that --resume after an interruption
+        // measures only the rest; the journal goes once the report is written.
+        const std::string journal = a->report + "/.points";
+        prepareJournal(*cmd, journal, a->resume);
+        o.pointJournal = journal + "/points.json";
         auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
         installInterruptHandler();
         ProgressReporter progress("frames", a->quiet);
@@ -139,10 +149,13 @@ void registerStudy(CLI::App& app) {
             }
         } catch (const Cancelled&) {
             progress.finish();
-            throw Error("interrupted: no report written");
+            throw Error(
+                "interrupted: no report written (--resume finishes it from the points "
+                "measured)");
         }
         progress.finish();
         writeStudyReport(result, a->report, commandLine());
+        removeJournal(journal);
         printTable(result);
         std::printf("wrote %s/study.csv, study.json, pareto.svg, pareto.png (%.1f s)\n",
                     a->report.c_str(), result.totalMs / 1000.0);

@@ -402,10 +402,15 @@ nlohmann::ordered_json sceneOf(const CLI::App& cmd) {
     return j;
 }
 
+// Options that steer a run but not what its files hold: left out of the metadata, so a
+// frame rendered by `--resume` is byte-identical to one from an uninterrupted run.
+static bool isRunControl(const std::string& key) { return key == "resume" || key == "overwrite"; }
+
 std::string canonicalCommand(const CLI::App& cmd) {
     CommandTable& t = tableOf(cmd);
     std::string line = "splat " + cmd.get_name();
     for (const Entry& e : t.entries) {
+        if (isRunControl(e.key)) continue;
         if (e.getObject && !e.getObject().is_null()) {
             line += " --" + e.key + " " + shellQuoted("<inline in splat:scene>");
             continue;
@@ -435,9 +440,11 @@ std::string canonicalCommand(const CLI::App& cmd) {
 void beginRun(const CLI::App& cmd) {
     CommandTable& t = tableOf(cmd);
     t.fixed = sceneOf(cmd);
+    auto scene = t.fixed;
+    for (const char* k : {"resume", "overwrite"}) scene.erase(k);
     runMetadata() = {{"Software", std::string("splat ") + kVersion},
                      {"splat:command", canonicalCommand(cmd)},
-                     {"splat:scene", t.fixed.dump()},
+                     {"splat:scene", scene.dump()},
                      // No time stamp (OpenEXR writes one by default): a scene reproduces
                      // its images byte for byte.
                      {"DateTime", ""}};

@@ -54,6 +54,12 @@ struct PoppingOptions {
     /// images are the same.
     int parallelFrames = 0;
     ProgressFn progress;  ///< optional; called after every frame
+    /// Folder of the frame journal (empty: none). Every frame rendered is stored there
+    /// (pixels bit for bit, its time, size and checksum), and a frame found there whole is
+    /// read back instead of rendered: an interrupted analysis resumes with the images of an
+    /// uninterrupted one. The folder must exist; the caller empties it when the scene, the
+    /// sweep or the renderers change. Costs width x height x 16 bytes per frame.
+    std::string frameJournal;
 };
 
 /// A change measured at one interval width while refining an event.

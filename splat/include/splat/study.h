@@ -53,6 +53,10 @@ struct StudyOptions {
     std::string cacheDir;
     double pixelsPerDegree = 67;  ///< LDR-FLIP viewing condition
     ProgressFn progress;          ///< called after every rendered frame
+    /// JSON file of the points measured so far (empty: none), rewritten atomically after
+    /// each point; a point found there (by label) is not measured again, so an interrupted
+    /// study resumes where it stopped. The caller removes it when the study changes.
+    std::string pointJournal;
 };
 
 /// One setting of the study.

@@ -5,9 +5,12 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <mutex>
 #include <numeric>
 
+#include "frame_journal.h"
 #include "splat/flip.h"
 #include "splat/image_io.h"
 #include "splatters/splatter.h"
@@ -107,13 +110,37 @@ class Analyzer {
             report(what);
             return !cancelled_;
         };
+        // Views whose frames are all in the journal are read back, not rendered.
+        std::vector<bool> journaled(views, false);
+        for (std::size_t v = 0; v < views && !options_.frameJournal.empty(); ++v) {
+            journaled[v] = true;
+            for (std::size_t k = 0; k < kinds_.size(); ++k)
+                journaled[v] =
+                    journaled[v] && journal::hasFrame(journalFile(r.angles[v], k),
+                                                      sweep_.base.width, sweep_.base.height);
+        }
+        so.skip = [&](std::size_t v) { return bool(journaled[v]); };
         View prev;
-        renderSequence(scene_, kinds_, path, so, [&](SequenceFrame&& f) {
-            View cur{std::move(f.images), std::move(f.stats)};
-            if (f.view == 0) setWindow(cur);
-            measureView(r, f.view, cur, prev, frameMs);
+        std::size_t next = 0;
+        auto consume = [&](std::size_t v, View cur) {
+            if (v == 0) setWindow(cur);
+            measureView(r, v, cur, prev, frameMs);
             prev = std::move(cur);
+            next = v + 1;
+        };
+        auto readUpTo = [&](std::size_t end) {
+            while (next < end) consume(next, renderView(r.angles[next]));
+        };
+        renderSequence(scene_, kinds_, path, so, [&](SequenceFrame&& f) {
+            readUpTo(f.view);
+            View cur{std::move(f.images), std::move(f.stats)};
+            if (!options_.frameJournal.empty())
+                for (std::size_t k = 0; k < kinds_.size(); ++k)
+                    journal::storeFrame(journalFile(r.angles[f.view], k), cur.images[k],
+                                        cur.stats[k]);
+            consume(f.view, std::move(cur));
         });
+        readUpTo(views);
         for (std::size_t k = 0; k < kinds_.size(); ++k) {
             RendererSeries& s = r.series[k];
             s.msPerFrame = median(frameMs[k]);
@@ -252,16 +279,33 @@ class Analyzer {
         return ev;
     }
 
-    /// Every renderer's frame of one view (refinement).
+    /// The journal's file for renderer k's frame at `angle` (the angle's exact bits).
+    std::filesystem::path journalFile(double angle, std::size_t k) const {
+        std::uint64_t bits;
+        std::memcpy(&bits, &angle, sizeof bits);
+        char name[64];
+        std::snprintf(name, sizeof name, "%s_%016llx.frame", toString(kinds_[k]),
+                      static_cast<unsigned long long>(bits));
+        return std::filesystem::path(options_.frameJournal) / name;
+    }
+
+    /// Every renderer's frame of one view (refinement, and sweep views in the journal):
+    /// read back from the journal when there whole, else rendered (and journaled).
     View renderView(double angle) {
         View v;
         v.images.resize(kinds_.size());
         v.stats.resize(kinds_.size());
         RenderSettings s = scene_.settings();
         s.camera = sweep_.camera(angle);
+        const bool journaling = !options_.frameJournal.empty();
         for (std::size_t k = 0; k < kinds_.size(); ++k) {
             s.renderer = kinds_[k];
-            v.images[k] = scene_.render(s, &v.stats[k]);
+            const std::filesystem::path file = journaling ? journalFile(angle, k) : "";
+            if (!journaling || !journal::loadFrame(file, s.camera.width, s.camera.height,
+                                                   v.images[k], v.stats[k])) {
+                v.images[k] = scene_.render(s, &v.stats[k]);
+                if (journaling) journal::storeFrame(file, v.images[k], v.stats[k]);
+            }
             report(std::string(toString(kinds_[k])) + " at " + std::to_string(angle));
         }
         if (cancelled_) throw Cancelled();

@@ -179,6 +179,7 @@ void prepareFolder(const fs::path& dir) {
         const std::string name = it->path().filename().string();
         std::error_code ec2;
         if ((isReportFile(name) && it->is_regular_file(ec2)) || isReportTemporary(name)) continue;
+        if (name == ".frames" && it->is_directory(ec2)) continue;  // `splat popping` journal
         throw Error(d + ": the folder holds '" + name +
                     "', which is not part of a popping report; write the report into a new "
                     "or empty folder (or one holding only a previous report)");
@@ -842,6 +843,7 @@ void writePoppingReport(const PoppingResult& result, const std::string& dir,
     if (dir.empty()) throw Error("popping report: no folder given");
     const fs::path folder(dir);
     prepareFolder(folder);
+    removeStaleTemporaries(folder);  // left by a killed run
     // Everything is built before anything is written.
     const json summary = summaryJson(result);
     const std::string csv = metricsCsv(result);
@@ -851,9 +853,16 @@ void writePoppingReport(const PoppingResult& result, const std::string& dir,
     } catch (const Error& e) {
         throw Error((folder / "report.html").string() + ": " + e.what());
     }
-    writeTextAtomic(folder / "metrics.csv", csv);
-    writeTextAtomic(folder / "summary.json", summary.dump(2) + "\n");
-    writeTextAtomic(folder / "report.html", html);
+    // All three are written in full before any replaces a previous one: a failure leaves
+    // the previous report whole, never a mix of two runs.
+    const std::string json = summary.dump(2) + "\n";
+    AtomicFile files[] = {AtomicFile(folder / "metrics.csv"), AtomicFile(folder / "summary.json"),
+                          AtomicFile(folder / "report.html")};
+    files[0].write(csv.data(), csv.size());
+    files[1].write(json.data(), json.size());
+    files[2].write(html.data(), html.size());
+    for (AtomicFile& f : files) f.sync();
+    for (AtomicFile& f : files) f.commit();
 }
 
 }  // namespace splat

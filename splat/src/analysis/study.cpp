@@ -7,8 +7,10 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
 #include "splat/metrics.h"
@@ -110,6 +112,40 @@ std::string referenceKey(const RenderSettings& s, const StudyOptions& o) {
       << o.referenceTolerance << '|' << s.background.r << ',' << s.background.g << ','
       << s.background.b << ',' << s.background.a;
     return k.str();
+}
+
+/// A measured point as the journal keeps it (doubles round-trip exactly; NaN as null).
+nlohmann::json pointJson(const StudyPoint& p) {
+    auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+    return {{"label", p.label()},
+            {"ms_median", p.msMedian},
+            {"ms_min", p.msMin},
+            {"ms_max", p.msMax},
+            {"ms_mad", p.msMad},
+            {"peak_mib", p.peakMiB},
+            {"splats", p.splats},
+            {"footprint_pixels", p.footprintPixels},
+            {"footprint_pixel_rate", p.footprintPixelRate},
+            {"rmse", num(p.rmse)},
+            {"psnr", num(p.psnr)},
+            {"max_abs", num(p.maxAbs)},
+            {"flip", num(p.flip)}};
+}
+
+void restorePoint(StudyPoint& p, const nlohmann::json& j) {
+    auto num = [&](const char* k) { return j.at(k).is_null() ? NAN : j.at(k).get<double>(); };
+    p.msMedian = num("ms_median");
+    p.msMin = num("ms_min");
+    p.msMax = num("ms_max");
+    p.msMad = num("ms_mad");
+    p.peakMiB = num("peak_mib");
+    p.splats = j.at("splats").get<std::size_t>();
+    p.footprintPixels = j.at("footprint_pixels").get<std::size_t>();
+    p.footprintPixelRate = num("footprint_pixel_rate");
+    p.rmse = num("rmse");
+    p.psnr = num("psnr");
+    p.maxAbs = num("max_abs");
+    p.flip = num("flip");
 }
 
 class Progress {
@@ -342,9 +378,13 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
                     ".exr"))
                       .string();
         if (!file.empty() && std::filesystem::exists(file)) {
-            Image img = readImage(file);
-            if (img.width == r.camera.width && img.height == r.camera.height)
-                return references[key] = std::move(img);
+            // A cached reference that does not decode whole (damaged) is rendered again.
+            try {
+                Image img = readImage(file);
+                if (img.width == r.camera.width && img.height == r.camera.height)
+                    return references[key] = std::move(img);
+            } catch (const Error&) {
+            }
         }
         if (!referenceScene) referenceScene = std::make_unique<Scene>(volume, r);
         Image img = referenceScene->render(r);
@@ -355,6 +395,17 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         }
         return references[key] = std::move(img);
     };
+
+    // Points measured by an interrupted run (StudyOptions::pointJournal), by label.
+    std::map<std::string, nlohmann::json> journaled;
+    if (!options.pointJournal.empty() && std::filesystem::exists(options.pointJournal)) {
+        try {
+            std::ifstream in(options.pointJournal);
+            for (const auto& p : nlohmann::json::parse(in)) journaled[p.at("label")] = p;
+        } catch (const std::exception&) {
+            journaled.clear();  // unreadable: measured again
+        }
+    }
 
     std::unique_ptr<Scene> scene;
     std::string sceneKey = "?";
@@ -399,6 +450,24 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         frame.quality.tileSize = s.quality.tileSize;
         frame.quality.lod = s.quality.lod;
         point.settings = frame;
+        if (auto done = journaled.find(point.label()); done != journaled.end()) {
+            // Measured by an interrupted run: its figures are kept, and its references
+            // loaded as that run did (the PSNR scale is the peak of those seen so far).
+            for (std::size_t v = 0; v < views.size(); ++v) {
+                frame.camera = views[v];
+                frame.camera.width = s.camera.width;
+                frame.camera.height = s.camera.height;
+                (void)referenceFor(frame);
+                for (int r = 0; r < options.warmup + options.repeats; ++r)
+                    progress.step(point.label());
+            }
+            restorePoint(point, done->second);
+            result.visibleVoxels =
+                std::max(result.visibleVoxels, done->second.value("visible", std::size_t(0)));
+            result.points.push_back(std::move(point));
+            continue;
+        }
+        std::size_t visibleHere = 0;
         std::vector<double> ms;
         double sumSq = 0, sumMax = 0, sumFlip = 0;
         for (std::size_t v = 0; v < views.size(); ++v) {
@@ -417,6 +486,7 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
                 point.footprintPixels = st.footprintPixels;
             }
             result.visibleVoxels = std::max(result.visibleVoxels, st.splats);
+            visibleHere = std::max(visibleHere, st.splats);
             const double peakHere = peakMemoryMiB();
             point.peakMiB = std::max(point.peakMiB, peakHere);
             const Image& ref = referenceFor(frame);
@@ -449,6 +519,14 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         point.msMad = median(dev);
         point.footprintPixelRate =
             point.msMedian > 0 ? double(point.footprintPixels) / (point.msMedian / 1000.0) : 0;
+        if (!options.pointJournal.empty()) {
+            nlohmann::json j = pointJson(point);
+            j["visible"] = visibleHere;
+            journaled[point.label()] = j;
+            nlohmann::json all = nlohmann::json::array();
+            for (const auto& [label, p] : journaled) all.push_back(p);
+            writeTextAtomic(options.pointJournal, all.dump() + "\n");
+        }
         result.points.push_back(std::move(point));
     }
     markPareto(result.points);

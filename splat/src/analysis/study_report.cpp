@@ -10,6 +10,7 @@
 
 #include "splat/atomic_file.h"
 #include "splat/error.h"
+#include "splat/image_io.h"
 #include "splat/study.h"
 
 namespace splat {
@@ -128,7 +129,7 @@ std::string svgPlot(const StudyResult& r) {
     return s.str();
 }
 
-void writePng(const StudyResult& r, const std::filesystem::path& path) {
+std::vector<unsigned char> plotPng(const StudyResult& r, const std::filesystem::path& path) {
     namespace IBA = OIIO::ImageBufAlgo;
     const Axes ax = Axes::of(r.points);
     OIIO::ImageBuf buf(OIIO::ImageSpec(int(ax.width), int(ax.height), 3, OIIO::TypeDesc::UINT8));
@@ -164,10 +165,20 @@ void writePng(const StudyResult& r, const std::filesystem::path& path) {
         IBA::render_box(buf, x - h, y - h, x + h, y + h, p.pareto ? red : blue, true);
         if (p.pareto) label(x + 7, y - 5, p.label(), 10);  // the others: see study.csv
     }
-    AtomicFile out(path);
-    if (!buf.write(out.temporary().string()))
-        throw Error(path.string() + ": cannot write the plot (" + buf.geterror() + ")");
-    out.commit();
+    // Encoded in memory; written with the other report files by the checked atomic writer.
+    std::vector<float> px(std::size_t(ax.width) * std::size_t(ax.height) * 3);
+    if (!buf.get_pixels(buf.roi(), OIIO::TypeDesc::FLOAT, px.data()))
+        throw Error(path.string() + ": cannot draw the plot (" + buf.geterror() + ")");
+    Image image(int(ax.width), int(ax.height));
+    for (std::size_t n = 0; n < image.pixels.size(); ++n)
+        image.pixels[n] = glm::vec4(px[3 * n], px[3 * n + 1], px[3 * n + 2], 1.0f);
+    WriteOptions display;
+    display.mapping = DisplayMapping::Display;
+    try {
+        return encodeImage(image, ".png", display);
+    } catch (const Error& e) {
+        throw Error(path.string() + ": " + e.what());
+    }
 }
 
 }  // namespace
@@ -178,6 +189,7 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (!fs::is_directory(dir)) throw Error(dir + ": cannot create the report folder");
+    removeStaleTemporaries(dir);  // left by a killed run
     // CSV: one row per setting.
     std::vector<std::string> knobNames;
     for (const auto& k : r.options.sweeps) knobNames.push_back(k.name);
@@ -197,7 +209,7 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
             << num(p.footprintPixelRate) << ',' << num(p.rmse) << ',' << num(p.psnr) << ','
             << num(p.maxAbs) << ',' << num(p.flip) << ',' << (p.pareto ? 1 : 0) << '\n';
     }
-    writeTextAtomic(fs::path(dir) / "study.csv", csv.str());
+    const std::string csvText = csv.str();
 
     nlohmann::json j;
     j["command"] = commandLine;
@@ -241,9 +253,19 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
         o["order"] = c.order;
         j["convergence"].push_back(o);
     }
-    writeTextAtomic(fs::path(dir) / "study.json", j.dump(2) + "\n");
-    writeTextAtomic(fs::path(dir) / "pareto.svg", svgPlot(r));
-    writePng(r, fs::path(dir) / "pareto.png");
+    const std::string json = j.dump(2) + "\n", svg = svgPlot(r);
+    const std::vector<unsigned char> png = plotPng(r, fs::path(dir) / "pareto.png");
+    // All four are written in full before any replaces a previous one: a failure leaves
+    // the previous report whole, never a mix of two runs.
+    AtomicFile files[] = {
+        AtomicFile(fs::path(dir) / "study.csv"), AtomicFile(fs::path(dir) / "study.json"),
+        AtomicFile(fs::path(dir) / "pareto.svg"), AtomicFile(fs::path(dir) / "pareto.png")};
+    files[0].write(csvText.data(), csvText.size());
+    files[1].write(json.data(), json.size());
+    files[2].write(svg.data(), svg.size());
+    files[3].write(png.data(), png.size());
+    for (AtomicFile& f : files) f.sync();
+    for (AtomicFile& f : files) f.commit();
 }
 
 }  // namespace splat

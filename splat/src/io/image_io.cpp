@@ -86,42 +86,63 @@ void checkImagePath(const std::string& path) {
     if (fs::is_directory(path)) throw Error(path + ": is a folder, not an image file name");
 }
 
+namespace {
+/// Encodes one image with OpenImageIO into memory (an IOVecOutput proxy): the encoder's
+/// errors are its own, and the bytes then reach the disk through AtomicFile's checked
+/// writes, so a full disk can never be mistaken for a written file.
+std::vector<unsigned char> encodeToMemory(const std::string& ext, OIIO::ImageSpec spec,
+                                          const void* pixels) {
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    const std::string name = "memory" + ext;
+    auto out = OIIO::ImageOutput::create(name);
+    if (!out) throw Error("cannot create an image writer for '" + ext + "'");
+    if (!out->supports("ioproxy"))
+        throw Error("this OpenImageIO cannot encode '" + ext + "' in memory");
+    void* ptr = &proxy;
+    spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &ptr);
+    bool ok = out->open(name, spec) && out->write_image(OIIO::TypeDesc::FLOAT, pixels);
+    std::string err = out->geterror();
+    ok = out->close() && ok;
+    if (err.empty()) err = out->geterror();
+    if (!ok || bytes.empty())
+        throw Error("cannot encode image (" + (err.empty() ? "encoder failed" : err) + ")");
+    return bytes;
+}
+}  // namespace
+
 void writeImage(const std::string& path, const Image& image, const WriteOptions& options) {
     checkImagePath(path);
     const std::string ext = lowerExtension(path);
     const bool isFloat = ext == ".exr" || ext == ".tif" || ext == ".tiff";
     if (image.width < 1 || image.height < 1) throw Error(path + ": image is empty");
 
-    AtomicFile file(path);
-    const std::string tmp = file.temporary().string();
-    auto out = OIIO::ImageOutput::create(tmp);
-    if (!out) throw Error(path + ": cannot create an image writer for '" + ext + "'");
-    bool ok;
-    if (isFloat) {
-        OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
-        spec.channelnames = {"R", "G", "B", "A"};
-        spec.alpha_channel = 3;
-        addMetadata(spec, options, ext != ".exr");
-        ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
-    } else {
-        const bool png = ext == ".png";
-        if (options.bitDepth != 8 && !(png && options.bitDepth == 16))
-            throw Error(path + ": bit depth " + std::to_string(options.bitDepth) +
-                        " is not supported (8, or 16 for .png)");
-        const int channels = png && options.alpha ? 4 : 3;
-        const std::vector<float> v = displayValues(image, options, channels);
-        OIIO::ImageSpec spec(
-            image.width, image.height, channels,
-            options.bitDepth == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
-        if (channels == 4) spec.alpha_channel = 3;
-        addMetadata(spec, options, false);
-        ok = out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, v.data());
+    std::vector<unsigned char> bytes;
+    try {
+        if (isFloat) {
+            OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
+            spec.channelnames = {"R", "G", "B", "A"};
+            spec.alpha_channel = 3;
+            addMetadata(spec, options, ext != ".exr");
+            bytes = encodeToMemory(ext, spec, image.pixels.data());
+        } else {
+            const bool png = ext == ".png";
+            if (options.bitDepth != 8 && !(png && options.bitDepth == 16))
+                throw Error("bit depth " + std::to_string(options.bitDepth) +
+                            " is not supported (8, or 16 for .png)");
+            const int channels = png && options.alpha ? 4 : 3;
+            const std::vector<float> v = displayValues(image, options, channels);
+            OIIO::ImageSpec spec(
+                image.width, image.height, channels,
+                options.bitDepth == 16 ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
+            if (channels == 4) spec.alpha_channel = 3;
+            addMetadata(spec, options, false);
+            bytes = encodeToMemory(ext, spec, v.data());
+        }
+    } catch (const Error& e) {
+        throw Error(path + ": " + e.what());
     }
-    const std::string err = out->geterror();
-    ok = out->close() && ok;
-    if (!ok)
-        throw Error(path + ": cannot write image (" + (err.empty() ? "write failed" : err) + ")");
-    file.commit();
+    writeFileAtomic(path, bytes.data(), bytes.size());
 }
 
 std::vector<unsigned char> encodeImage(const Image& image, const std::string& ext,

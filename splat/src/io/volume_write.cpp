@@ -76,10 +76,13 @@ void saveNifti(const std::string& path, const Volume& v) {
     }
     nifti_image_write(nim);
     nifti_image_free(nim);
-    std::error_code ec;
-    if (!fs::exists(tmp, ec) || fs::file_size(tmp, ec) == 0) {
-        throw Error(path + ": cannot write NIfTI file");
-    }
+    // niftilib does not report a failed write (a full disk): the file is read back whole
+    // and compared before it replaces anything (issue 23).
+    nifti_image* back = nifti_image_read(tmp.string().c_str(), 1);
+    const bool whole = back && back->data && std::size_t(back->nvox) * back->nbyper == v.bytes() &&
+                       std::memcmp(back->data, v.data.data(), v.bytes()) == 0;
+    if (back) nifti_image_free(back);
+    if (!whole) throw Error(path + ": cannot write NIfTI file (the file written is incomplete)");
     out.commit();
 }
 
