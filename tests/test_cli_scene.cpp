@@ -226,6 +226,7 @@ TEST_CASE("iso levels: absolute levels and fractions of the range ending in n", 
                                       "--mode",    "iso",
                                       "--size",    "24x24",
                                       "--azimuth", "90",
+                                      "--background-value", "0",  // the ramp fills its faces
                                       "-o",        (dir / name).string()};
         if (!level.empty()) {
             args.push_back("--iso-level");
