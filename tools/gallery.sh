@@ -65,3 +65,8 @@ $S slices $CH2 --axis z --every 12 --scale-bar 50 -o $tmp/slices && cp $tmp/slic
 $S mpr $CH2 --plane 0,0,10,0.3,0.2,1 --size 256x256 --pixel-size 0.8 --scale-bar 50 -o $G/tech_mpr_oblique.png
 printf '{"points": [[-60, -20, 10], [-30, 40, 20], [30, 40, 20], [60, -20, 10]], "lateral": [0, 0, 1], "width": 160}\n' > $tmp/curve.json
 $S cpr $CH2 --curve $tmp/curve.json -o $G/tech_cpr.png
+# CT in Hounsfield units (issue 21): the Shepp-Logan head in HU (air -1000, b = -1000), the
+# CT look chosen from the data (no --tf: ct-hu), cut open at x = 63.5; post-classified; MIP.
+$S render synthetic:ct-phantom:128 --azimuth 120 --elevation 15 --size 320x320 --clip-plane 63.5,0,0,1,0,0 --shade -o $G/ct_hu_clipped.png
+$S render synthetic:ct-phantom:128 --classify post --azimuth 120 --elevation 15 --size 320x320 --clip-plane 63.5,0,0,1,0,0 -o $G/ct_hu_post.png
+$S render synthetic:ct-phantom:128 --mode mip --azimuth 90 --size 320x320 -o $G/ct_hu_mip.png

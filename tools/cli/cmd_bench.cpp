@@ -69,6 +69,7 @@ void registerBench(CLI::App& app) {
         loadOptionsFromArgs(a->volume);
         beginRun(*cmd);
         const Volume volume = loadVolumeFromArgs(a->volume);
+        settings = withDataDefaults(a->render, settings, volume);
         nlohmann::json out;
         out["volume"] = a->volume.spec;
         out["renderer"] = toString(settings.renderer);

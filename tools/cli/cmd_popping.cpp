@@ -127,6 +127,7 @@ void registerPopping(CLI::App& app) {
         prepareJournal(*cmd, journal, a->resume);
         o.frameJournal = journal;
         auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
+        settings = withDataDefaults(a->render, settings, *volume);
         const Scene scene(volume, settings);
         installInterruptHandler();
         ProgressReporter progress("frames", a->quiet);

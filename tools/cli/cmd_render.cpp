@@ -40,10 +40,11 @@ void registerRender(CLI::App& app) {
         checkImageOutput(args->output);
         RenderUse use;
         use.imageExt = lowerExtension(args->output);
-        const RenderSettings settings = settingsFromArgs(args->render, use);
+        RenderSettings settings = settingsFromArgs(args->render, use);
         loadOptionsFromArgs(args->volume);  // malformed volume options: usage errors, now
         beginRun(*cmd);
         const Volume volume = loadVolumeFromArgs(args->volume);
+        settings = withDataDefaults(args->render, settings, volume);
         const Renderer renderer(volume, settings);
         RenderStats stats;
         const Image image = renderer.render(&stats);

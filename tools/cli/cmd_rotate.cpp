@@ -324,7 +324,7 @@ void registerRotate(CLI::App& app) {
             warn("--fps applies to --gif and --mp4 only; ignored");
         RenderUse use;
         use.imageExt = "." + a->format;
-        const RenderSettings settings = settingsFromArgs(a->render, use);
+        RenderSettings settings = settingsFromArgs(a->render, use);
         loadOptionsFromArgs(a->volume);
         std::string ffmpeg;
         if (!a->mp4.empty()) {
@@ -354,6 +354,7 @@ void registerRotate(CLI::App& app) {
             prepareFolder(*a, manifest, settings.camera.width, settings.camera.height);
         beginRun(*cmd);
         auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
+        settings = withDataDefaults(a->render, settings, *volume);
         const Scene scene(volume, settings);
         std::error_code ec;
         fs::create_directories(a->outDir, ec);

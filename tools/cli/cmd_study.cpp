@@ -105,7 +105,7 @@ void registerStudy(CLI::App& app) {
         prepareCommand(*cmd, {"volume", "report"});
         RenderUse use;
         use.oneRenderer = false;
-        const RenderSettings settings = settingsFromArgs(a->render, use);
+        RenderSettings settings = settingsFromArgs(a->render, use);
         StudyOptions o;
         asUsage([&] {
             for (const auto& s : a->sweeps) o.sweeps.push_back(parseKnob(s));
@@ -134,6 +134,7 @@ void registerStudy(CLI::App& app) {
         prepareJournal(*cmd, journal, a->resume);
         o.pointJournal = journal + "/points.json";
         auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
+        settings = withDataDefaults(a->render, settings, *volume);
         installInterruptHandler();
         ProgressReporter progress("frames", a->quiet);
         o.progress = [&](std::size_t d, std::size_t t, const std::string& w) {

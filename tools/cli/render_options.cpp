@@ -224,6 +224,18 @@ TransferFunction transferFromArgs(const RenderArgs& a) {
 
 }  // namespace
 
+RenderSettings withDataDefaults(const RenderArgs& a, RenderSettings s, const Volume& volume) {
+    const bool chosen = !a.tfInline.is_null() || (a.cmd && a.cmd->get_option("--tf")->count() > 0);
+    if (chosen || s.mode != RenderMode::Dvr || s.labels.enabled || !looksLikeHounsfield(volume))
+        return s;
+    s.transfer = TransferFunction::preset("ct-hu");
+    std::fprintf(stderr,
+                 "splat: CT in Hounsfield units (background %g, %s): transfer function ct-hu "
+                 "(choose another with --tf)\n",
+                 double(volume.background), volume.backgroundSource.c_str());
+    return s;
+}
+
 RenderSettings settingsFromArgs(RenderArgs& a, const RenderUse& use) {
     RenderSettings s = asUsage([&] { return parseSettings(a); });
     // The transfer function first: a preset may carry the mode, which decides what applies.

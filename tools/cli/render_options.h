@@ -46,6 +46,10 @@ RenderSettings settingsFromArgs(RenderArgs& args, const RenderUse& use);
 
 /// Display mapping for 8-bit outputs: sRGB for dvr/iso; for mip/xray the --window, or
 /// [0, max value of the image]. Carries this run's metadata.
+/// Defaults that depend on the data: with no --tf (nor an inline one), dvr of a volume that
+/// looksLikeHounsfield renders with the preset ct-hu; says so on stderr.
+RenderSettings withDataDefaults(const RenderArgs& a, RenderSettings s, const Volume& volume);
+
 WriteOptions displayOptions(const RenderArgs& args, const RenderSettings& s, const Image& image);
 
 /// Refuses an output image name before any work: an unsupported extension (UsageError), a

@@ -55,7 +55,7 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
     const std::string g = "Volume";
     addOption(cmd, "VOLUME", args.spec,
               "volume file (.nii .nii.gz .nrrd .nhdr .mhd .mha .raw), folder of slices or DICOM "
-              "files, or synthetic:NAME[:N] (phantom, blob, cube, sphere, marschner-lobb)",
+              "files, or synthetic:NAME[:N] (phantom, ct-phantom, blob, cube, sphere, marschner-lobb)",
               g, PathKind::Input);
     addOption(cmd, "--dims", args.dims, "raw data: dimensions XxYxZ, e.g. 256x256x128", g);
     addOption(cmd, "--type", args.type,

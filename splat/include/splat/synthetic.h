@@ -14,6 +14,8 @@ std::vector<std::string> syntheticNames();
 /// Default N for a name when none is given (phantom: 128, others: 64).
 int syntheticDefaultSize(const std::string& name);
 
+/// - `ct-phantom`: the same head in Hounsfield units (HU = 1000 (d - 1): air -1000, skull
+///   +1000), background value -1000.
 /// - `phantom`: 3D Shepp-Logan head phantom (Kak & Slaney ellipsoids), densities 0..2,
 ///   the head's long axis along z (upright).
 /// - `blob`: one Gaussian, d(p) = exp(-|p - c|^2 / (2 s^2)) with s = N / 8.

@@ -68,6 +68,11 @@ Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::
 /// Padding Value) and CT series use that instead; `splat info` prints which.
 float backgroundFromFaces(const Volume& v);
 
+/// True when the data look like CT in Hounsfield units: the background value lies in
+/// [-3100, -900] (air at -1000 HU, or a scanner's padding down to -3024). The CLI then
+/// renders dvr with the absolute preset `ct-hu` unless --tf chooses another.
+bool looksLikeHounsfield(const Volume& v);
+
 /// Statistics of a volume's samples.
 struct VolumeStats {
     float minValue = 0, maxValue = 0;

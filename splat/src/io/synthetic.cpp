@@ -63,10 +63,12 @@ void fill(Volume& v, F f) {
 }  // namespace
 
 std::vector<std::string> syntheticNames() {
-    return {"phantom", "blob", "cube", "sphere", "marschner-lobb"};
+    return {"phantom", "ct-phantom", "blob", "cube", "sphere", "marschner-lobb"};
 }
 
-int syntheticDefaultSize(const std::string& name) { return name == "phantom" ? 128 : 64; }
+int syntheticDefaultSize(const std::string& name) {
+    return name == "phantom" || name == "ct-phantom" ? 128 : 64;
+}
 
 Volume makeSynthetic(const std::string& name, int n) {
     bool known = false;
@@ -81,7 +83,7 @@ Volume makeSynthetic(const std::string& name, int n) {
                     ": size must be between 1 and 2048");
     Volume v = makeVolume({n, n, n}, glm::dvec3(1.0), "synthetic:" + name);
     const double c = (n - 1) * 0.5;
-    if (name == "phantom") {
+    if (name == "phantom" || name == "ct-phantom") {
         // Index -> phantom coordinates: the cube [-1, 1]^3 spans the N samples. The
         // phantom's longest axis (y, semi-axis 0.92) becomes world +z so the head is
         // upright; phantom z becomes world -y (keeps the frame right-handed).
@@ -112,6 +114,13 @@ Volume makeSynthetic(const std::string& name, int n) {
         fill(v, [&](int i, int j, int k) {
             return marschnerLobb(-1 + i * s, -1 + j * s, -1 + k * s);
         });
+    }
+    if (name == "ct-phantom") {
+        // The same head in Hounsfield units: HU = 1000 (d - 1), so air (d = 0) is -1000, the
+        // skull (d = 2) +1000, brain (d = 1.02) +20, ventricles 0, the small features +40.
+        for (float& d : v.data) d = std::round(1000.0f * (d - 1.0f));
+        v.background = -1000.0f;
+        v.backgroundSource = "synthetic CT in HU (air)";
     }
     v.source = "synthetic:" + name + ":" + std::to_string(n);
     return v;

@@ -37,6 +37,14 @@ TransferFunction makePreset(const std::string& name) {
         tf.points = {pt(0.0f, 0, 0, 0, 0), pt(0.12f, 0.75f, 0.5f, 0.4f, 0),
                      pt(0.3f, 0.9f, 0.65f, 0.55f, 0.08f), pt(0.6f, 1.0f, 0.85f, 0.75f, 0.3f),
                      pt(1.0f, 1, 1, 1, 0.6f)};
+    } else if (name == "ct-hu") {
+        // Absolute Hounsfield units (not normalized): air and lung clear, skin and fat
+        // faint, soft tissue (about 40 HU) translucent red, bone (300 HU and up) opaque.
+        tf.normalized = false;
+        tf.points = {pt(-1000.0f, 0, 0, 0, 0),       pt(-500.0f, 0.85f, 0.55f, 0.45f, 0),
+                     pt(-100.0f, 0.9f, 0.6f, 0.5f, 0.01f), pt(40.0f, 0.95f, 0.5f, 0.4f, 0.04f),
+                     pt(150.0f, 0.95f, 0.55f, 0.45f, 0.05f), pt(300.0f, 1, 0.95f, 0.85f, 0.5f),
+                     pt(3000.0f, 1, 1, 1, 0.9f)};
     } else if (name == "mip-gray" || name == "xray") {
         // Projections of the density: the points are a grey ramp (used only if an explicit
         // --mode dvr overrides the preset's mode); the mode comes with the preset.
@@ -90,7 +98,7 @@ std::string readText(const std::string& path) {
 }  // namespace
 
 std::vector<std::string> TransferFunction::presetNames() {
-    return {"ct-bone", "ct-soft", "mri-head", "gray-ramp", "mip-gray", "xray"};
+    return {"ct-bone", "ct-soft", "ct-hu", "mri-head", "gray-ramp", "mip-gray", "xray"};
 }
 
 TransferFunction TransferFunction::preset(const std::string& name) { return makePreset(name); }

@@ -75,6 +75,10 @@ float backgroundFromFaces(const Volume& v) {
     return *mid;
 }
 
+bool looksLikeHounsfield(const Volume& v) {
+    return v.background >= -3100.0f && v.background <= -900.0f;
+}
+
 VolumeStats volumeStats(const Volume& v, int bins) {
     VolumeStats s;
     bins = std::max(bins, 1);
