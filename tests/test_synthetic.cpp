@@ -25,7 +25,7 @@ TEST_CASE("synthetic volumes are deterministic and sized N^3", "[volume]") {
     CHECK(loadVolume("synthetic:cube").dims == glm::ivec3(64));
     CHECK(loadVolume("synthetic:blob:17").dims == glm::ivec3(17));
     CHECK_THAT(errorOf([] { makeSynthetic("teapot", 16); }),
-               Catch::Contains("unknown synthetic volume (available: phantom, blob"));
+               Catch::Contains("unknown synthetic volume (available: phantom, ct-phantom, blob"));
     CHECK_THAT(errorOf([] { makeSynthetic("cube", 0); }), Catch::Contains("between 1 and 2048"));
     CHECK_THAT(errorOf([] { loadVolume("synthetic:cube:abc"); }),
                Catch::Contains("size must be an integer"));
