@@ -17,6 +17,9 @@ class Renderer {
   public:
     /// Does not copy the volume: it must outlive the Renderer.
     Renderer(const Volume& volume, const RenderSettings& settings);
+    /// A temporary volume is moved in and owned (see Scene).
+    Renderer(Volume&& volume, const RenderSettings& settings);
+    Renderer(const Volume&& volume, const RenderSettings& settings) = delete;
     Renderer(std::shared_ptr<const Volume> volume, const RenderSettings& settings);
 
     Image render(RenderStats* stats = nullptr) const;

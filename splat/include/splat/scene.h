@@ -20,10 +20,19 @@ namespace splat {
 class Scene {
   public:
     /// Classifies `volume` with settings.mode, .classification, .transfer, .kernel* and
-    /// .shading, on settings.threads threads. Throws splat::Error on impossible settings.
+    /// .shading, on settings.threads threads. Throws splat::Error (one line) on impossible
+    /// settings and on volumes the loaders would refuse: no samples, non-finite spacing or
+    /// origin, NaN/Inf samples; and on transfer functions that TransferFunction::validate
+    /// refuses (no points, unsorted or non-finite points, unit distance outside [1e-6, 1e6]).
     Scene(std::shared_ptr<const Volume> volume, const RenderSettings& settings);
     /// Does not copy the volume: it must outlive the Scene.
     Scene(const Volume& volume, const RenderSettings& settings);
+    /// A temporary volume is moved into the Scene, which then owns it (no dangling
+    /// reference: `Scene scene(makeSynthetic("blob", 32), s)` is safe).
+    Scene(Volume&& volume, const RenderSettings& settings);
+    /// A const temporary can be neither borrowed past the statement nor moved: refused at
+    /// compile time.
+    Scene(const Volume&& volume, const RenderSettings& settings) = delete;
     ~Scene();
     Scene(Scene&&) noexcept;
     Scene& operator=(Scene&&) noexcept;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
 
 #include "frame/frame.h"
 #include "model/level_of_detail.h"
@@ -66,23 +67,75 @@ void validateScene(const Volume& v, const RenderSettings& s) {
     if (v.voxelCount() == 0 || v.data.size() != v.voxelCount())
         throw Error("volume is empty or its sample count does not match its dimensions");
     validateGeometry(v);
+    // The loaders' NaN policy at the library boundary (issue 24): an in-memory volume with
+    // NaN/Inf samples is refused, not rendered differently by each renderer.
+    const std::size_t bad = std::size_t(std::count_if(
+        v.data.begin(), v.data.end(), [](float d) { return !std::isfinite(d); }));
+    if (bad > 0)
+        throw Error("volume has " + std::to_string(bad) +
+                    " NaN/Inf samples; replace them (the loaders' --nan-policy zero does)");
+    if (!std::isfinite(v.background)) throw Error("volume background value is NaN or Inf");
+    s.transfer.validate("transfer function");
     validateFrame(s);
     if (!(s.quality.polynomialTolerance >= 0)) throw Error("polynomial tolerance must be >= 0");
 }
 
-/// The settings that belong to a Scene (classification and tables), which a frame may not
-/// change.
-bool sameScenePart(const RenderSettings& a, const RenderSettings& b) {
-    return a.mode == b.mode && a.classification == b.classification && a.kernel == b.kernel &&
-           a.kernelSigma == b.kernelSigma && a.kernelRadius == b.kernelRadius &&
-           a.shading.enabled == b.shading.enabled && a.edges.gain == b.edges.gain &&
-           a.edges.exponent == b.edges.exponent &&
-           a.clipping.planes.size() == b.clipping.planes.size() &&
-           a.clipping.cropBox == b.clipping.cropBox && a.labels.enabled == b.labels.enabled &&
-           a.quality.footprintResolution == b.quality.footprintResolution &&
-           a.quality.slabRadialResolution == b.quality.slabRadialResolution &&
-           a.quality.slabDepthResolution == b.quality.slabDepthResolution &&
-           a.quality.polynomialTolerance == b.quality.polynomialTolerance;
+bool sameTransfer(const TransferFunction& a, const TransferFunction& b) {
+    if (a.points.size() != b.points.size() || a.unitDistance != b.unitDistance ||
+        a.normalized != b.normalized)
+        return false;
+    for (std::size_t n = 0; n < a.points.size(); ++n)
+        if (a.points[n].value != b.points[n].value || a.points[n].rgba != b.points[n].rgba)
+            return false;
+    return true;
+}
+
+bool sameClipping(const Clipping& a, const Clipping& b) {
+    if (a.planes.size() != b.planes.size() || a.cropBox != b.cropBox) return false;
+    if (a.cropBox && (a.boxMin != b.boxMin || a.boxMax != b.boxMax)) return false;
+    for (std::size_t n = 0; n < a.planes.size(); ++n)
+        if (a.planes[n].point != b.planes[n].point || a.planes[n].normal != b.planes[n].normal)
+            return false;
+    return true;
+}
+
+/// The one rule for what a frame may change (issue 24): the settings that belong to a Scene
+/// (its classification and tables) are fixed at construction; a frame that differs in one of
+/// them is refused with the field's name, never silently rendered with the Scene's value.
+/// Returns the first such field of `frame` that differs from both the settings the Scene was
+/// given and the ones it resolved (a frame may pass either), or "" when none does.
+std::string changedSceneField(const RenderSettings& frame, const RenderSettings& given,
+                              const RenderSettings& resolved) {
+    auto differs = [&](auto get) { return !(get(frame) == get(given)) && !(get(frame) == get(resolved)); };
+    if (differs([](const RenderSettings& s) { return s.mode; })) return "mode";
+    if (differs([](const RenderSettings& s) { return s.classification; })) return "classification";
+    if (differs([](const RenderSettings& s) { return s.kernel; })) return "kernel";
+    if (differs([](const RenderSettings& s) { return s.kernelSigma; })) return "kernelSigma";
+    if (differs([](const RenderSettings& s) { return s.kernelRadius; })) return "kernelRadius";
+    if (!sameTransfer(frame.transfer, given.transfer) &&
+        !sameTransfer(frame.transfer, resolved.transfer))
+        return "transfer";
+    const auto shading = [](const RenderSettings& s) {
+        const Shading& h = s.shading;
+        return std::make_tuple(h.enabled, h.ambient, h.diffuse, h.specular, h.shininess,
+                               h.headlight, h.light);
+    };
+    if (differs(shading)) return "shading";
+    if (differs([](const RenderSettings& s) { return std::make_pair(s.edges.gain, s.edges.exponent); }))
+        return "edges";
+    if (!sameClipping(frame.clipping, given.clipping)) return "clipping";
+    const auto labels = [](const RenderSettings& s) {
+        const Labels& l = s.labels;
+        return std::make_tuple(l.enabled, l.volume.get(), l.table, l.selection);
+    };
+    if (differs(labels)) return "labels";
+    const auto tables = [](const RenderSettings& s) {
+        const Quality& q = s.quality;
+        return std::make_tuple(q.footprintResolution, q.slabRadialResolution,
+                               q.slabDepthResolution, q.polynomialTolerance);
+    };
+    if (differs(tables)) return "quality (footprint/slab table resolutions, polynomial tolerance)";
+    return "";
 }
 
 }  // namespace
@@ -275,10 +328,14 @@ Scene::Scene(std::shared_ptr<const Volume> volume, const RenderSettings& setting
     validateScene(*volume, settings);
     runOnThreads(settings.threads,
                  [&] { impl_ = std::make_unique<Impl>(std::move(volume), settings); });
+    impl_->given = settings;
 }
 
 Scene::Scene(const Volume& volume, const RenderSettings& settings)
     : Scene(std::shared_ptr<const Volume>(&volume, [](const Volume*) {}), settings) {}
+
+Scene::Scene(Volume&& volume, const RenderSettings& settings)
+    : Scene(std::make_shared<const Volume>(std::move(volume)), settings) {}
 
 Scene::~Scene() = default;
 Scene::Scene(Scene&&) noexcept = default;
@@ -290,18 +347,14 @@ const SplatList& Scene::splats() const { return impl_->splats; }
 const footprint::Kernel& Scene::kernel() const { return impl_->kernel; }
 
 Image Scene::render(const RenderSettings& frame, RenderStats* stats) const {
-    if (!sameScenePart(frame, impl_->settings))
-        throw Error(
-            "scene: a frame cannot change the mode, classification, kernel, shading or table "
-            "resolutions; build a new Scene for those");
     return renderFrame(*impl_, frameSettings(frame), stats);
 }
 
 RenderSettings Scene::frameSettings(const RenderSettings& frame) const {
-    if (!sameScenePart(frame, impl_->settings))
-        throw Error(
-            "scene: a frame cannot change the mode, classification, kernel, shading or table "
-            "resolutions; build a new Scene for those");
+    const std::string field = changedSceneField(frame, impl_->given, impl_->settings);
+    if (!field.empty())
+        throw Error("scene: a frame cannot change RenderSettings::" + field +
+                    " (the Scene classified with it); build a new Scene for that");
     RenderSettings s = frame;
     s.transfer = impl_->settings.transfer;
     s.shading = impl_->settings.shading;
@@ -334,6 +387,9 @@ Renderer::Renderer(const Volume& volume, const RenderSettings& settings)
     : scene_(volume, settings), settings_(scene_.settings()) {
     settings_.renderer = settings.renderer;
 }
+
+Renderer::Renderer(Volume&& volume, const RenderSettings& settings)
+    : Renderer(std::make_shared<const Volume>(std::move(volume)), settings) {}
 
 Renderer::Renderer(std::shared_ptr<const Volume> volume, const RenderSettings& settings)
     : scene_(std::move(volume), settings), settings_(scene_.settings()) {

@@ -36,6 +36,7 @@ struct FrameWorkspace {
 struct Scene::Impl {
     std::shared_ptr<const Volume> volume;
     RenderSettings settings;  ///< transfer function resolved
+    RenderSettings given;     ///< as the Scene was constructed (frames are checked against it)
     footprint::Kernel kernel;
     SplatList splats;  ///< (k, j, i) order
     TransferTable transfer;
