@@ -43,6 +43,12 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool imageOutput) {
     addOption(cmd, "--fov", a.fov, "perspective: vertical field of view, degrees", cam);
     addOption(cmd, "--distance", a.distance,
               "perspective: eye distance from the volume centre, world units (0 = fit)", cam);
+    addOption(cmd, "--eye", a.eye,
+              "free camera: eye position X,Y,Z (world; with --look-at, replaces the orbit)", cam);
+    addOption(cmd, "--look-at", a.lookAt,
+              "free camera: the point X,Y,Z at the image centre (default: the volume centre)",
+              cam);
+    addOption(cmd, "--up", a.up, "free camera: up vector X,Y,Z (default 0,0,1)", cam);
     addOption(cmd, "--renderer", a.renderer,
               "axis (axis-aligned sheets) | sheet (image-aligned slabs) | reference (ray caster)",
               ren);
@@ -143,6 +149,19 @@ RenderSettings parseSettings(const RenderArgs& a) {
     s.camera.pixelSize = a.pixelSize;
     s.camera.fovDeg = a.fov;
     s.camera.distance = a.distance;
+    if (!a.eye.empty() || !a.lookAt.empty() || !a.up.empty()) {
+        auto vec3 = [](const std::string& text, const char* what) {
+            const std::vector<double> v = parseNumbers(text, what);
+            if (v.size() != 3) throw Error(std::string(what) + " needs X,Y,Z");
+            for (double x : v) requireIn(x, -1e12, 1e12, what);
+            return glm::dvec3(v[0], v[1], v[2]);
+        };
+        if (a.eye.empty()) throw Error("--look-at and --up need --eye (the free camera)");
+        s.camera.lookAtSet = true;
+        s.camera.eye = vec3(a.eye, "--eye");
+        s.camera.lookAt = a.lookAt.empty() ? glm::dvec3(std::nan("")) : vec3(a.lookAt, "--look-at");
+        if (!a.up.empty()) s.camera.upHint = vec3(a.up, "--up");
+    }
     if (!std::isfinite(a.slab) || !(a.slab >= 1e-3) || a.slab > 1e4)
         throw Error("--slab: slab thickness must be between 0.001 and 10000 voxels (got " +
                     CLI::detail::to_string(a.slab) + ")");
@@ -224,16 +243,22 @@ TransferFunction transferFromArgs(const RenderArgs& a) {
 
 }  // namespace
 
+// --eye without --look-at looks at the volume centre (known once the volume is loaded).
+RenderSettings withFreeCameraTarget(RenderSettings s, const Volume& volume) {
+    if (s.camera.lookAtSet && std::isnan(s.camera.lookAt.x)) s.camera.lookAt = volume.center();
+    return s;
+}
+
 RenderSettings withDataDefaults(const RenderArgs& a, RenderSettings s, const Volume& volume) {
     const bool chosen = !a.tfInline.is_null() || (a.cmd && a.cmd->get_option("--tf")->count() > 0);
     if (chosen || s.mode != RenderMode::Dvr || s.labels.enabled || !looksLikeHounsfield(volume))
-        return s;
+        return withFreeCameraTarget(s, volume);
     s.transfer = TransferFunction::preset("ct-hu");
     std::fprintf(stderr,
                  "splat: CT in Hounsfield units (background %g, %s): transfer function ct-hu "
                  "(choose another with --tf)\n",
                  double(volume.background), volume.backgroundSource.c_str());
-    return s;
+    return withFreeCameraTarget(s, volume);
 }
 
 RenderSettings settingsFromArgs(RenderArgs& a, const RenderUse& use) {

@@ -24,6 +24,14 @@ struct CameraParams {
     /// Perspective: distance of the eye from the volume centre, world units (0: the
     /// distance at which the bounding sphere fits the field of view).
     double distance = 0;
+    /// A free camera (as vtkCamera's position / focal point / view up), instead of the orbit
+    /// about the volume centre: when `lookAtSet`, the view runs from `eye` towards `lookAt`
+    /// (world), image up is `upHint` made perpendicular to the view, and azimuth, elevation
+    /// and distance are unused. `lookAt` is the image centre (off-centre views); perspective
+    /// rays start at `eye` (focal distance |lookAt - eye|), orthographic rays start in front
+    /// of the whole volume. Default pixel size: as the orbit camera (the bounding sphere fits).
+    bool lookAtSet = false;
+    glm::dvec3 eye{0.0}, lookAt{0.0}, upHint{0.0, 0.0, 1.0};
 };
 
 struct Ray {
@@ -55,6 +63,7 @@ class Camera {
     glm::dvec3 project(const glm::dvec3& world) const;
 
   private:
+    void lookAtCamera(const CameraParams& p, const Volume& volume, double side);
     CameraParams params_;
 };
 

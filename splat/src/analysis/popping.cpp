@@ -375,6 +375,9 @@ std::vector<double> Sweep::angles() const {
 }
 
 CameraParams Sweep::camera(double angle) const {
+    if (base.lookAtSet)
+        throw Error("sweep: a free camera (--eye/--look-at) does not turn; sweeps orbit the "
+                    "volume centre by azimuth or elevation");
     CameraParams c = base;
     (this->angle == Angle::Azimuth ? c.azimuthDeg : c.elevationDeg) = angle;
     return c;

@@ -33,6 +33,9 @@ CameraPath CameraPath::turn(const CameraParams& base, Angle angle, double from, 
     if (frames < 1 || frames > kMaxFrames)
         throw Error("a sequence needs 1 to " + std::to_string(kMaxFrames) + " frames");
     if (!std::isfinite(from) || !std::isfinite(to)) throw Error("--from/--to must be finite");
+    if (base.lookAtSet)
+        throw Error("a turn orbits the volume centre by azimuth or elevation; a free camera "
+                    "(--eye/--look-at) does not turn: give its views as a camera path");
     CameraPath p;
     for (int f = 0; f < frames; ++f) {
         const double t =

@@ -35,14 +35,18 @@ Camera::Camera(const CameraParams& params, const Volume& volume) : params_(param
         !(params.fovDeg > 0.1 && params.fovDeg < 170))
         throw Error("perspective field of view must be between 0.1 and 170 degrees");
 
+    boundingRadius = 0.5 * glm::length(glm::dvec3(volume.dims) * volume.spacing);
+    const double side = double(std::min(params.width, params.height));
+    if (params.lookAtSet) {
+        lookAtCamera(params, volume, side);
+        return;
+    }
     const double a = params.azimuthDeg * kPi / 180.0, e = params.elevationDeg * kPi / 180.0;
     view = glm::dvec3(-std::sin(a) * std::cos(e), std::cos(a) * std::cos(e), -std::sin(e));
     right = glm::dvec3(std::cos(a), std::sin(a), 0.0);
     up = glm::cross(right, view);
 
     target = volume.center();
-    boundingRadius = 0.5 * glm::length(glm::dvec3(volume.dims) * volume.spacing);
-    const double side = double(std::min(params.width, params.height));
     if (params.projection == Projection::Orthographic) {
         pixelSize = params.pixelSize > 0 ? params.pixelSize : 2.0 * boundingRadius / side;
         eye = target - view * (1.5 * boundingRadius + 1.0);
@@ -52,6 +56,37 @@ Camera::Camera(const CameraParams& params, const Volume& volume) : params_(param
         focal = params.distance > 0 ? params.distance : boundingRadius / std::sin(half) + 1e-9;
         eye = target - view * focal;
         pixelSize = params.pixelSize > 0 ? params.pixelSize : 2.0 * focal * std::tan(half) / side;
+    }
+}
+
+void Camera::lookAtCamera(const CameraParams& p, const Volume& volume, double side) {
+    auto finite = [](const glm::dvec3& v) {
+        return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+    };
+    if (!finite(p.eye) || !finite(p.lookAt) || !finite(p.upHint))
+        throw Error("camera eye, look-at point and up vector must be finite");
+    const glm::dvec3 d = p.lookAt - p.eye;
+    const double dist = glm::length(d);
+    if (!(dist > 0)) throw Error("camera eye and look-at point must differ");
+    view = d / dist;
+    const glm::dvec3 r = glm::cross(view, p.upHint);
+    if (!(glm::length(r) > 1e-9 * glm::length(p.upHint)) || !(glm::length(p.upHint) > 0))
+        throw Error("camera up vector must not be zero or parallel to the view direction");
+    right = glm::normalize(r);
+    up = glm::cross(right, view);
+    target = p.lookAt;
+    const glm::dvec3 centre = volume.center();
+    if (p.projection == Projection::Orthographic) {
+        pixelSize = p.pixelSize > 0 ? p.pixelSize : 2.0 * boundingRadius / side;
+        // Rays start on a plane in front of the whole volume (its bounding sphere).
+        const double back = glm::dot(target - centre, view) + 1.5 * boundingRadius + 1.0;
+        eye = target - view * std::max(back, 1.0);
+        focal = glm::length(target - eye);
+    } else {
+        const double half = 0.5 * p.fovDeg * kPi / 180.0;
+        eye = p.eye;
+        focal = dist;
+        pixelSize = p.pixelSize > 0 ? p.pixelSize : 2.0 * focal * std::tan(half) / side;
     }
 }
 
