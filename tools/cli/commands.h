@@ -18,6 +18,7 @@ void registerStudy(CLI::App& app);       // cmd_study.cpp
 void registerSlices(CLI::App& app);      // cmd_slices.cpp
 void registerMpr(CLI::App& app);         // cmd_mpr.cpp
 void registerCpr(CLI::App& app);         // cmd_cpr.cpp
+void registerIso(CLI::App& app);         // cmd_iso.cpp
 void registerCompletion(CLI::App& app);  // cmd_completion.cpp (hidden)
 
 /// The command line as typed (for reports that say how to reproduce them).

@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
     registerPopping(app);
     registerStudy(app);
     registerSlices(app);
+    registerIso(app);
     registerMpr(app);
     registerCpr(app);
     registerCompletion(app);
