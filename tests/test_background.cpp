@@ -87,7 +87,10 @@ const char* name(RendererKind r) {
 }
 
 // A corner pixel: its ray crosses the volume's bounding box but only air.
-const glm::vec4& corner(const Image& im) { return im.at(im.width / 2 - 13, im.height / 2 - 13); }
+const glm::vec4& corner(const Image& im) {
+    const int d = im.width * 13 / 40;
+    return im.at(im.width / 2 - d, im.height / 2 - d);
+}
 
 }  // namespace
 
@@ -194,5 +197,38 @@ TEST_CASE("background: the rule and where it comes from", "[background]") {
         INFO(bad);
         CHECK(r.status == 2);
         CHECK(r.err.find("--background-value") != std::string::npos);
+    }
+}
+
+TEST_CASE("background: clipping and level of detail cut and merge to b", "[background]") {
+    const float c = 1000.0f;
+    const Volume hu = huPhantom();
+    const Volume up = shifted(hu, c);
+    for (RendererKind r : {RendererKind::Axis, RendererKind::Sheet, RendererKind::Reference}) {
+        INFO(name(r));
+        // What a clip plane cuts away becomes b (air), in mip and post-classified dvr.
+        RenderSettings mip = settingsFor(r, RenderMode::Mip);
+        mip.clipping.planes.push_back({hu.center(), glm::dvec3(1, 0, 0)});
+        const Image a = render(hu, mip);
+        CHECK(maxAbsDiff(a, render(up, mip), c) < 1e-3);
+        CHECK_THAT(corner(a).r, Catch::Matchers::WithinAbs(kAir, 0.5));
+        RenderSettings post = settingsFor(r, RenderMode::Dvr, Classification::Post);
+        post.transfer = tissueTf(-300.0f);
+        post.clipping = mip.clipping;
+        RenderSettings postUp = post;
+        postUp.transfer = shiftedTf(post.transfer, c);
+        CHECK(maxAbsDiff(render(hu, post), render(up, postUp)) < 2e-5);
+    }
+    // Level of detail (splatters): the merged levels average d - b.
+    for (RendererKind r : {RendererKind::Axis, RendererKind::Sheet}) {
+        INFO(name(r) << " lod");
+        RenderSettings s = settingsFor(r, RenderMode::Mip);
+        s.camera.width = s.camera.height = 12;  // voxels smaller than pixels: a coarser level
+        s.quality.lod = 4;
+        RenderStats st;
+        const Image a = render(hu, s, &st);
+        CHECK(st.lodLevel > 0);
+        CHECK(maxAbsDiff(a, render(up, s), c) < 1e-3);
+        CHECK_THAT(a.at(0, 0).r, Catch::Matchers::WithinAbs(kAir, 0.5));  // only air there
     }
 }
