@@ -229,6 +229,9 @@ TEST_CASE("background: clipping and level of detail cut and merge to b", "[backg
         const Image a = render(hu, s, &st);
         CHECK(st.lodLevel > 0);
         CHECK(maxAbsDiff(a, render(up, s), c) < 1e-3);
-        CHECK_THAT(a.at(0, 0).r, Catch::Matchers::WithinAbs(kAir, 0.5));  // only air there
+        // The image corner: air blurred by the coarse level's wide kernel, never 0 (the old
+        // field's value outside the data).
+        CHECK(a.at(0, 0).r >= kAir - 0.5f);
+        CHECK(a.at(0, 0).r < -900.0f);
     }
 }
