@@ -15,16 +15,7 @@
 
 namespace splat {
 
-/// Progress of a long computation: `done` of `total` units, what is being done. Returning
-/// false cancels it cleanly (the call throws splat::Cancelled; nothing is left half-done).
-using ProgressFn =
-    std::function<bool(std::size_t done, std::size_t total, const std::string& what)>;
-
-/// Thrown when a ProgressFn returned false.
-class Cancelled : public Error {
-  public:
-    Cancelled() : Error("cancelled") {}
-};
+// ProgressFn and Cancelled: splat/settings.h.
 
 /// The views of a sequence.
 struct CameraPath {

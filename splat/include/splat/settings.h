@@ -4,15 +4,30 @@
 // trade speed for accuracy. Every such knob lives in Quality, so that a speed/accuracy
 // study can move any of them; defaults are the figures the README's tables are made with.
 #include <glm/glm.hpp>
+#include <cstddef>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "splat/camera.h"
+#include "splat/error.h"
 #include "splat/transfer.h"
 
 namespace splat {
+
+/// Progress of a long computation: `done` of `total` units, what is being done. Returning
+/// false cancels it cleanly (the call throws splat::Cancelled; nothing is left half-done).
+using ProgressFn =
+    std::function<bool(std::size_t done, std::size_t total, const std::string& what)>;
+
+/// Thrown when a ProgressFn returned false.
+class Cancelled : public Error {
+  public:
+    Cancelled() : Error("cancelled") {}
+};
+
 
 enum class RendererKind { Axis, Sheet, Reference };
 enum class RenderMode { Dvr, Mip, Xray, Iso };
@@ -121,6 +136,12 @@ struct RenderSettings {
     Labels labels;                             ///< dvr: segmentation labels
     int threads = 0;                           ///< every stage of a frame; 0: all cores
     Quality quality;
+    /// Progress inside one frame (issue 24): called, serialised, after every screen tile of
+    /// a splatter (`what` "tiles"; the streaming path: after every chunk, "chunks") and every
+    /// image row of the reference ray caster ("rows"), with a total known up front. Returning
+    /// false cancels the frame: the tiles and rows not yet started are skipped and render
+    /// throws splat::Cancelled (worst-case latency: the slowest single tile or row in flight).
+    ProgressFn progress;
 };
 
 /// Counters of one frame.

@@ -25,6 +25,7 @@
 
 #include "frame/chunk_binning.h"
 #include "frame/compositing.h"
+#include "frame/frame_progress.h"
 #include "frame/projection.h"
 #include "frame/sheet_buffer.h"
 #include "frame/tile_binning.h"
@@ -248,7 +249,9 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
         std::vector<SheetBuffer<NCh>*> ptr;
     };
     tbb::enumerable_thread_specific<Ring> rings;
+    FrameProgress progress(in.settings.progress, std::size_t(g.count()), "tiles");
     tbb::parallel_for(0, g.count(), 1, [&](int t) {
+        if (progress.stopped()) return;
         const DenormalsAreZero ftz;  // footprint tails must not hit slow denormal paths
         const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
         constexpr bool surface = kSurfacePolicy<Policy>;  // issue 13: also when clipped
@@ -268,7 +271,9 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
         }
         acc.resolve(image, ox, oy, in.settings.mode);
         if (surface && in.isoPositions) acc.resolvePositions(*in.isoPositions, ox, oy);
+        progress.tick();
     });
+    progress.finish();
     if (stats) {
         stats->pathScalePixels = pathScale.size();
         stats->tilesMs =
@@ -330,6 +335,7 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
     double binMs = 0, tilesMs = 0;
     std::size_t hidden = 0;
     tbb::enumerable_thread_specific<std::vector<SplatRecord>> sortScratch;
+    FrameProgress progress(in.settings.progress, sc.count, "chunks");
     for (std::size_t c = 0; c < sc.count; ++c) {
         const auto t0 = Clock::now();
         const Occlusion occlusion(g, tiles, cull);
@@ -338,7 +344,7 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
                            occlusion, bins);
         const auto t1 = Clock::now();
         tbb::parallel_for(0, g.count(), 1, [&](int t) {
-            if (bins.begin[t] == bins.begin[t + 1]) return;
+            if (bins.begin[t] == bins.begin[t + 1] || progress.stopped()) return;
             const DenormalsAreZero ftz;
             const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
             sortBySheet(cutter, &bins.records[bins.begin[t]], &bins.records[bins.begin[t + 1]],
@@ -354,6 +360,8 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
         });
         binMs += ms(t0, t1);
         tilesMs += ms(t1, Clock::now());
+        progress.tick();
+        progress.finish();
     }
     const auto t2 = Clock::now();
     Image image(g.width, g.height);

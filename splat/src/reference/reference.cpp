@@ -43,6 +43,7 @@
 #include "model/clip_region.h"
 #include "model/scene_impl.h"
 #include "model/shading_model.h"
+#include "frame/frame_progress.h"
 #include "reference/field.h"
 #include "reference/reference_frame.h"
 #include "splat/error.h"
@@ -97,11 +98,12 @@ class Caster {
         Image image(w, h);
         if (depth) *depth = Image(w, h);
         std::atomic<int> finest{0};
+        FrameProgress progress(settings_.progress, std::size_t(h), "rows");
         auto body = [&](const tbb::blocked_range<int>& rows) {
             RayScratch<4> s4;
             RayScratch<1> s1;
             int localFinest = 0;
-            for (int y = rows.begin(); y != rows.end(); ++y)
+            for (int y = rows.begin(); y != rows.end() && !progress.stopped(); ++y) {
                 for (int x = 0; x < w; ++x) {
                     int level = 0;
                     double hitDepth = -1;
@@ -113,11 +115,14 @@ class Caster {
                                               : glm::vec4(0.0f);
                     localFinest = std::max(localFinest, level);
                 }
+                progress.tick();
+            }
             int cur = finest.load();
             while (localFinest > cur && !finest.compare_exchange_weak(cur, localFinest)) {
             }
         };
         tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), body);
+        progress.finish();
         if (stats)
             stats->referenceStep = settings_.quality.referenceStep / double(1 << finest.load());
         return image;
