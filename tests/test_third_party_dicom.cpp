@@ -68,3 +68,18 @@ TEST_CASE("DICOM: third-party files GDCM or splat cannot read are refused in one
     CHECK_THAT(errorOf([&] { loadVolume((kPydicom / "MR_truncated.dcm").string()); }),
                Catch::Contains("element (7fe0,0010) declares 8192 bytes, the file holds 8130"));
 }
+
+TEST_CASE("DICOM: a Siemens mosaic is refused, not read as one flat slice",
+          "[volume][dicom][thirdparty]") {
+    const fs::path mosaic = "/usr/lib/python3/dist-packages/nibabel/tests/data/0.dcm";
+    if (!fs::exists(mosaic)) {
+        WARN("skipped: python3-nibabel's test files are missing (tools/setup.sh)");
+        return;
+    }
+    // nibabel reads it as 48 slices of 36 x 36 tiled 7 x 7 in one 256 x 256 image (its CSA
+    // header's NumberOfImagesInMosaic); splat refuses it by name instead of one flat slice.
+    CHECK_THAT(errorOf([&] { loadVolume(mosaic.string()); }),
+               Catch::EndsWith("0.dcm: Siemens mosaic DICOM (ImageType MOSAIC: the slices are "
+                               "tiled in one 256 x 256 image) is not supported; convert it "
+                               "first (e.g. dcm2niix)"));
+}

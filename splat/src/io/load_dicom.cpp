@@ -42,6 +42,7 @@ const gdcm::Tag kSeriesUid(0x0020, 0x000e);
 const gdcm::Tag kSeriesNumber(0x0020, 0x0011);
 const gdcm::Tag kSeriesDescription(0x0008, 0x103e);
 const gdcm::Tag kModality(0x0008, 0x0060);
+const gdcm::Tag kImageType(0x0008, 0x0008);
 const gdcm::Tag kInstanceNumber(0x0020, 0x0013);
 const gdcm::Tag kPosition(0x0020, 0x0032);
 const gdcm::Tag kOrientation(0x0020, 0x0037);
@@ -109,6 +110,7 @@ struct SliceInfo {
     int seriesNumber = -1, instance = -1;
     int rows = 0, columns = 0, frames = 1, samples = 1, bitsAllocated = 16, bitsStored = 16;
     bool signedPixels = false;
+    bool mosaic = false;  ///< ImageType holds MOSAIC: a Siemens mosaic, slices tiled in one image
     DicomLayout layout;
     std::uint64_t fileSize = 0;
     std::optional<glm::dvec3> position;
@@ -347,6 +349,8 @@ SliceInfo readHeaderWithGdcm(const fs::path& p, const DicomLayout& layout,
     s.uid = textOf(sf, ds, kSeriesUid);
     s.description = textOf(sf, ds, kSeriesDescription);
     s.modality = textOf(sf, ds, kModality);
+    const std::string imageType = textOf(sf, ds, kImageType);
+    s.mosaic = ("\\" + imageType + "\\").find("\\MOSAIC\\") != std::string::npos;
     s.seriesNumber =
         intOf(numbersOf(sf, ds, kSeriesNumber, name, "SeriesNumber"), -1, name, "SeriesNumber");
     s.instance = intOf(numbersOf(sf, ds, kInstanceNumber, name, "InstanceNumber"), -1, name,
@@ -593,6 +597,10 @@ Volume loadDicomFiles(const std::string& name, const std::vector<fs::path>& file
     const SliceInfo& first = slices.front();
     for (const SliceInfo& s : slices) {
         const std::string sn = displayName(s.path);
+        if (s.mosaic)
+            throw Error(sn + ": Siemens mosaic DICOM (ImageType MOSAIC: the slices are tiled in "
+                        "one " + std::to_string(s.columns) + " x " + std::to_string(s.rows) +
+                        " image) is not supported; convert it first (e.g. dcm2niix)");
         if (s.frames != 1)
             throw Error(sn + ": multi-frame DICOM (" + std::to_string(s.frames) +
                         " frames) is not supported");
