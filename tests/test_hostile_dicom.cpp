@@ -222,6 +222,12 @@ TEST_CASE("DICOM: GDCM dying on a file is one error line, never the process",
     fs::copy_file(dir / "nested.dcm", series / "b.dcm");
     CHECK_THAT(errorOf([&] { loadVolume(series.string()); }),
                Catch::Contains("b.dcm: malformed DICOM file (GDCM reading the header died"));
+    // A group-fffe tag that is no item or delimiter (found by fuzz_dicom seeded with
+    // pydicom's files: GDCM read (fffe,650d) as an element and allocated its 3.7 GB).
+    writeBytes(dir / "itemtag.dcm", bytes.substr(0, dataSet) +
+                                        tagOf(0xFFFE, 0x650D, 0xE0000000u) + "ABCD");
+    CHECK_THAT(errorOf([&] { loadVolume((dir / "itemtag.dcm").string()); }),
+               Catch::EndsWith("itemtag.dcm: malformed DICOM file (invalid item tag (fffe,650d))"));
     // The process is still here and reads the good file.
     CHECK(loadVolume((dir / "ok.dcm").string()).data[0] == 7.0f);
 }

@@ -201,6 +201,10 @@ DicomLayout checkDicomLengths(const std::vector<unsigned char>& b, const std::st
         if (group == 0xFFFE) {  // item or delimiter: tag + 4-byte length, no VR
             const std::uint32_t len = read32(pos + 4, be);
             pos += 8;
+            // PS3.5 7.5: group fffe holds only the item (e000) and the item (e00d) and
+            // sequence (e0dd) delimiters; GDCM reads anything else as an element.
+            if (element != 0xE000 && element != 0xE00D && element != 0xE0DD)
+                fail("invalid item tag " + hexTag(group, element));
             if (element == 0xE000 && len != 0xFFFFFFFFu && len > b.size() - pos)
                 fail("an item declares " + std::to_string(len) + " bytes, the file holds " +
                      std::to_string(b.size() - pos));
