@@ -167,7 +167,7 @@ def classify(label, path, kind, splat):
         return "same", ""
     if "warning" in s["stderr"]:
         first = [l for l in s["stderr"].splitlines() if "warning" in l][0]
-        return "warned", "; ".join(problems) + " — " + first.split(": ", 2)[-1][:90]
+        return "warned", "; ".join(problems) + " — " + first.split(": ", 3)[-1][:90]
     return "WRONG", "; ".join(problems)
 
 
