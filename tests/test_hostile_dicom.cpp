@@ -228,6 +228,16 @@ TEST_CASE("DICOM: GDCM dying on a file is one error line, never the process",
                                         tagOf(0xFFFE, 0x650D, 0xE0000000u) + "ABCD");
     CHECK_THAT(errorOf([&] { loadVolume((dir / "itemtag.dcm").string()); }),
                Catch::EndsWith("itemtag.dcm: malformed DICOM file (invalid item tag (fffe,650d))"));
+    // An element that runs past the end of its item of defined length: GDCM resumes at
+    // the item's declared end, the walk would not (found by fuzz_dicom: GDCM then read a
+    // 540 MB length the walk never saw).
+    writeBytes(dir / "crossing.dcm",
+               bytes.substr(0, dataSet) + tagOf(0x0008, 0x1140, 20) +
+                   tagOf(0xFFFE, 0xE000, 10) + tagOf(0x0008, 0x1150, 4) + "ABCD" +
+                   tagOf(0x0010, 0x0010, 0) + bytes.substr(dataSet));
+    CHECK_THAT(errorOf([&] { loadVolume((dir / "crossing.dcm").string()); }),
+               Catch::EndsWith("crossing.dcm: malformed DICOM file (an element crosses the end "
+                               "of its item or sequence)"));
     // The process is still here and reads the good file.
     CHECK(loadVolume((dir / "ok.dcm").string()).data[0] == 7.0f);
 }

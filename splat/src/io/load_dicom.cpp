@@ -184,7 +184,17 @@ DicomLayout checkDicomLengths(const std::vector<unsigned char>& b, const std::st
     // One entry per open sequence of undefined length: true when its content is implicit
     // VR little endian (an undefined-length UN, PS3.5 6.2.2, and everything inside it).
     std::vector<bool> scopes;
+    // The ends of the open items and sequences of defined length: GDCM reads such a value
+    // as a bounded block and resumes at its declared end, so an element that crosses that
+    // end would make GDCM and this walk part ways (found by fuzz_dicom): refused.
+    std::vector<std::size_t> ends;
+    auto within = [&](std::uint64_t upTo) {
+        if (!ends.empty() && upTo > ends.back())
+            fail("an element crosses the end of its item or sequence");
+    };
     while (pos < b.size()) {
+        while (!ends.empty() && pos == ends.back()) ends.pop_back();
+        within(pos);
         if (b.size() - pos < 8) fail("truncated element header");
         if (inMeta && read16(pos, false) != 0x0002) {
             inMeta = false;
@@ -208,6 +218,10 @@ DicomLayout checkDicomLengths(const std::vector<unsigned char>& b, const std::st
             if (element == 0xE000 && len != 0xFFFFFFFFu && len > b.size() - pos)
                 fail("an item declares " + std::to_string(len) + " bytes, the file holds " +
                      std::to_string(b.size() - pos));
+            if (element == 0xE000 && len != 0xFFFFFFFFu) {
+                within(pos + len);
+                if (len > 0) ends.push_back(pos + len);
+            }
             if (element == 0xE0DD && !scopes.empty()) scopes.pop_back();
             continue;  // walk into items; delimiters have no value
         }
@@ -277,6 +291,8 @@ DicomLayout checkDicomLengths(const std::vector<unsigned char>& b, const std::st
         if (len > b.size() - pos)
             fail("element " + hexTag(group, element) + " declares " + std::to_string(len) +
                  " bytes, the file holds " + std::to_string(b.size() - pos));
+        within(pos + len);
+        if (sequence && len > 0) ends.push_back(pos + std::size_t(len));
         if (inMeta && group == 0x0002 && element == 0x0010)
             syntax.assign(reinterpret_cast<const char*>(&b[pos]), std::size_t(len));
         if (!sequence) pos += std::size_t(len);  // a sequence's items are checked too
