@@ -202,6 +202,15 @@ DicomLayout checkDicomLengths(const std::vector<unsigned char>& b, const std::st
                 syntax.pop_back();
             if (syntax == "1.2.840.10008.1.2.1.99")
                 fail("deflated transfer syntax is not supported");
+            // GDCM guesses the encoding when the meta group or its transfer syntax is missing
+            // or unknown, and its guess can part ways with this walk (found by fuzz_dicom):
+            // such files are refused, not guessed at.
+            if (pos == 132) fail("no file meta information (group 0002) after DICM");
+            if (syntax.empty()) fail("no transfer syntax (0002,0010) in the file meta information");
+            if (syntax != "1.2.840.10008.1.2" && syntax != "1.2.840.10008.1.2.1" &&
+                syntax != "1.2.840.10008.1.2.2" && syntax != "1.2.840.10008.1.2.5" &&
+                !syntax.starts_with("1.2.840.10008.1.2.4."))
+                fail("unknown transfer syntax '" + syntax.substr(0, 64) + "'");
             explicitVr = syntax != "1.2.840.10008.1.2";
             bigEndian = syntax == "1.2.840.10008.1.2.2";
         }
