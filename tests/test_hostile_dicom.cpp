@@ -167,7 +167,7 @@ TEST_CASE("DICOM element lengths are checked before GDCM allocates", "[volume][d
     std::memcpy(&bytes[at + 4], &huge, 4);
     writeBytes(dir / "huge.dcm", bytes);
     CHECK_THAT(errorOf([&] { loadVolume((dir / "huge.dcm").string()); }),
-               Catch::Contains("huge.dcm: malformed DICOM file (element (32736,16) declares "
+               Catch::Contains("huge.dcm: malformed DICOM file (element (7fe0,0010) declares "
                                "4211081216 bytes, the file holds 24)"));
     // A file that ends right after its meta group made Debian's GDCM abort on an assert
     // (found by fuzz_dicom); so would a sequence in the meta group.
@@ -188,4 +188,56 @@ TEST_CASE("DICOM element lengths are checked before GDCM allocates", "[volume][d
     writeBytes(dir / "nopreamble.dcm", bytes.substr(132));
     CHECK_THAT(errorOf([&] { loadVolume((dir / "nopreamble.dcm").string()); }),
                Catch::Contains("no DICM marker"));
+}
+
+namespace {
+std::string le16(unsigned v) { return {char(v & 0xFF), char(v >> 8 & 0xFF)}; }
+std::string le32(std::uint32_t v) { return le16(v & 0xFFFF) + le16(v >> 16); }
+std::string tagOf(unsigned g, unsigned e, std::uint32_t len) { return le16(g) + le16(e) + le32(len); }
+}  // namespace
+
+TEST_CASE("DICOM: GDCM dying on a file is one error line, never the process",
+          "[volume][dicom][hostile]") {
+    auto dir = testTmpDir("dicom_gdcm_abort");
+    DicomSlice s;
+    s.stored.assign(12, 7);
+    writeDicomSlice(dir / "ok.dcm", s);
+    const std::string bytes = readTextFile(dir / "ok.dcm");
+    const std::size_t dataSet = bytes.find(std::string("\x08\x00", 2), 132);
+    REQUIRE(dataSet != std::string::npos);
+    // An implicit-VR sequence (0008,1140) of undefined length whose item of undefined length
+    // never ends (no item delimiter): Debian's GDCM aborts in gdcm::DataSet::ReadNested
+    // (SIGABRT). Every length is within the file, so the element walk lets it through.
+    const std::string nested = tagOf(0x0008, 0x1140, 0xFFFFFFFFu) +
+                               tagOf(0xFFFE, 0xE000, 0xFFFFFFFFu) + tagOf(0x0010, 0x0010, 4) +
+                               "ABCD" + tagOf(0xFFFE, 0xE0DD, 0) + tagOf(0x0010, 0x0020, 4) +
+                               "EFGH";
+    writeBytes(dir / "nested.dcm", bytes.substr(0, dataSet) + nested);
+    CHECK_THAT(errorOf([&] { loadVolume((dir / "nested.dcm").string()); }),
+               Catch::EndsWith("nested.dcm: malformed DICOM file (GDCM reading the header died "
+                               "on it with SIGABRT, a failed assertion)"));
+    // In a series, the error names the file GDCM died on, and the good slices do not hide it.
+    auto series = testTmpDir("dicom_gdcm_abort_series");
+    fs::copy_file(dir / "ok.dcm", series / "a.dcm");
+    fs::copy_file(dir / "nested.dcm", series / "b.dcm");
+    CHECK_THAT(errorOf([&] { loadVolume(series.string()); }),
+               Catch::Contains("b.dcm: malformed DICOM file (GDCM reading the header died"));
+    // A group-fffe tag that is no item or delimiter (found by fuzz_dicom seeded with
+    // pydicom's files: GDCM read (fffe,650d) as an element and allocated its 3.7 GB).
+    writeBytes(dir / "itemtag.dcm", bytes.substr(0, dataSet) +
+                                        tagOf(0xFFFE, 0x650D, 0xE0000000u) + "ABCD");
+    CHECK_THAT(errorOf([&] { loadVolume((dir / "itemtag.dcm").string()); }),
+               Catch::EndsWith("itemtag.dcm: malformed DICOM file (invalid item tag (fffe,650d))"));
+    // An element that runs past the end of its item of defined length: GDCM resumes at
+    // the item's declared end, the walk would not (found by fuzz_dicom: GDCM then read a
+    // 540 MB length the walk never saw).
+    writeBytes(dir / "crossing.dcm",
+               bytes.substr(0, dataSet) + tagOf(0x0008, 0x1140, 20) +
+                   tagOf(0xFFFE, 0xE000, 10) + tagOf(0x0008, 0x1150, 4) + "ABCD" +
+                   tagOf(0x0010, 0x0010, 0) + bytes.substr(dataSet));
+    CHECK_THAT(errorOf([&] { loadVolume((dir / "crossing.dcm").string()); }),
+               Catch::EndsWith("crossing.dcm: malformed DICOM file (an element crosses the end "
+                               "of its item or sequence)"));
+    // The process is still here and reads the good file.
+    CHECK(loadVolume((dir / "ok.dcm").string()).data[0] == 7.0f);
 }

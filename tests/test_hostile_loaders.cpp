@@ -208,6 +208,30 @@ TEST_CASE("NIfTI-2 and ANALYZE 7.5", "[volume][hostile]") {
         fs::remove(dir / "a.img");
         CHECK_THAT(loadError((dir / "a.hdr").string()), Catch::Contains("does not exist"));
     }
+    SECTION("ANALYZE 7.5 with the SPM scale factor (funused1) and offset (funused2)") {
+        // nibabel 5.0 (Spm2AnalyzeImage, what nibabel.load picks) reads voxel 23 of this
+        // pair as 0.25 * 23 + 3 = 8.75; then the calibration-range fallback: with funused1
+        // 0, (cal_max - cal_min) / (glmax - glmin) = 10 / 100 and cal_min - 0.1 * glmin.
+        nifti_1_header h = niftiHeader();
+        std::memset(h.magic, 0, 4);
+        h.dim[1] = 4;
+        h.dim[2] = 3;
+        h.dim[3] = 2;
+        h.vox_offset = 0;
+        h.scl_slope = 0.25f;  // dime.funused1 in ANALYZE 7.5
+        h.scl_inter = 3.0f;   // dime.funused2
+        writeBytes(dir / "s.hdr", std::string(reinterpret_cast<const char*>(&h), sizeof h));
+        writeBytes(dir / "s.img", data);
+        CHECK(loadVolume((dir / "s.hdr").string()).data[23] == 0.25f * 23 + 3);
+        h.scl_slope = 0;
+        h.scl_inter = 0;
+        h.cal_min = 5;
+        h.cal_max = 15;
+        h.glmin = 20;
+        h.glmax = 120;
+        writeBytes(dir / "s.hdr", std::string(reinterpret_cast<const char*>(&h), sizeof h));
+        CHECK(loadVolume((dir / "s.hdr").string()).data[23] == Approx(0.1 * 23 + 5 - 0.1 * 20));
+    }
 }
 
 TEST_CASE("hostile raw: header bytes that wrap, .raw.gz", "[volume][hostile]") {

@@ -55,6 +55,31 @@ fi
 seeds="$build/seeds"
 rm -rf "$seeds"
 "$build/tests/fuzz/splat_fuzz_seeds" "$seeds" >/dev/null
+# Third-party files as seeds (Debian's python3-nibabel and python3-pydicom test data, when
+# installed): every DICOM for fuzz_dicom, every NIfTI-1/2 and ANALYZE pair for fuzz_nifti
+# (a pair as header + kDataMarker + image, fuzz_util.h), every .nii.gz for fuzz_nifti_gz.
+nib=/usr/lib/python3/dist-packages/nibabel
+pyd=/usr/lib/python3/dist-packages/pydicom/data/test_files
+third=0
+for f in "$nib"/tests/data/*.dcm "$nib"/nicom/tests/data/*.dcm "$pyd"/*.dcm "$pyd"/*/*.dcm; do
+  [[ -f $f ]] && cp "$f" "$seeds/dicom/third_$(basename "$f")" && third=$((third + 1))
+done
+for f in "$nib"/nicom/tests/data/*.dcm.gz; do
+  [[ -f $f ]] && gzip -dc "$f" >"$seeds/dicom/third_$(basename "$f" .gz)" && third=$((third + 1))
+done
+for f in "$nib"/tests/data/*.nii; do
+  [[ -f $f ]] && cp "$f" "$seeds/nifti/third_$(basename "$f")" && third=$((third + 1))
+done
+for f in "$nib"/tests/data/*.hdr; do
+  img="${f%.hdr}.img"
+  [[ -f $img ]] || continue
+  { cat "$f"; printf '\n@@DATA@@\n'; cat "$img"; } >"$seeds/nifti/third_$(basename "$f")"
+  third=$((third + 1))
+done
+for f in "$nib"/tests/data/*.nii.gz; do
+  [[ -f $f ]] && gzip -dc "$f" >"$seeds/nifti_gz/third_$(basename "$f" .gz)" && third=$((third + 1))
+done
+[[ $third -gt 0 ]] && echo "fuzz.sh: $third third-party seed files (nibabel, pydicom)"
 mkdir -p "$build/corpus" "$build/findings" "$build/logs"
 
 # -malloc_limit_mb: no input may make a loader allocate more than 512 MB (every seed and

@@ -160,7 +160,24 @@ Header parseHeader(const std::string& bytes, const std::string& name) {
         h.singleFile = false;
     }
     copyDims(n1, h);
-    if (h.version == 1) copyTransforms(n1, h);  // ANALYZE has other fields there
+    if (h.version == 1) {
+        copyTransforms(n1, h);  // ANALYZE has other fields there
+    } else {
+        // ANALYZE 7.5 as SPM writes it (and nibabel reads it): the scale factor in
+        // dime.funused1 and the offset in dime.funused2, the bytes NIfTI-1 later named
+        // scl_slope and scl_inter; without a usable factor, the calibration range over the
+        // stored range (cal_max - cal_min) / (glmax - glmin) when both are non-zero.
+        const double f1 = n1.scl_slope, f2 = n1.scl_inter;
+        if (std::isfinite(f1) && f1 != 0) {
+            h.sclSlope = f1;
+            h.sclInter = std::isfinite(f2) ? f2 : 0.0;
+        } else if (n1.glmax != n1.glmin && n1.cal_max != n1.cal_min &&
+                   std::isfinite(n1.cal_max) && std::isfinite(n1.cal_min)) {
+            h.sclSlope = (double(n1.cal_max) - double(n1.cal_min)) /
+                         (double(n1.glmax) - double(n1.glmin));
+            h.sclInter = double(n1.cal_min) - h.sclSlope * double(n1.glmin);
+        }
+    }
     return h;
 }
 

@@ -1,0 +1,222 @@
+#!/usr/bin/python3
+"""Conformance of splat's loaders against nibabel and pydicom (issue 22).
+
+Runs `splat info` over every NIfTI / ANALYZE / DICOM file of the two third-party corpora
+Debian ships (python3-nibabel's nibabel/tests/data and nibabel/nicom/tests/data,
+python3-pydicom's pydicom/data/test_files) and compares what splat reads with what the
+oracle reads, in quantities that do not depend on splat's reorientation (splat makes every
+volume upright by axis flips/permutations):
+
+  * dimensions (as a sorted triple),
+  * the world bounding box of the voxel centres, RAS millimetres (a left-right mirror or a
+    dropped rotation moves it),
+  * the scaled values: minimum, maximum and mean.
+
+Each file is one of
+  same      read identically (within 1e-3 mm and 1e-4 relative in the mean),
+  refused   splat refuses it with one line (the reason is printed in the table),
+  warned    splat reads it differently and says so on stderr (oblique: rotation dropped),
+  WRONG     splat reads it differently and says nothing: a failure of this test,
+  n/a       the oracle cannot read it either (not an image, a codec pydicom lacks, ...).
+
+Usage: conformance.py SPLAT [--table FILE]   exit 1 when any file is WRONG or splat crashed.
+"""
+import glob
+import gzip
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import warnings
+
+import numpy as np
+
+warnings.filterwarnings("ignore")
+
+NIB = "/usr/lib/python3/dist-packages/nibabel"
+PYD = "/usr/lib/python3/dist-packages/pydicom/data/test_files"
+
+
+def corpus(tmp):
+    """(label, path, kind) of every NIfTI/ANALYZE/DICOM file of both corpora."""
+    files = []
+    for p in sorted(glob.glob(NIB + "/tests/data/*")):
+        b = os.path.basename(p)
+        if b.endswith((".nii", ".nii.gz", ".hdr")):
+            files.append(("nibabel/" + b, p, "nifti"))
+        elif b.endswith(".dcm"):
+            files.append(("nibabel/" + b, p, "dicom"))
+    for p in sorted(glob.glob(NIB + "/nicom/tests/data/*")):
+        b = os.path.basename(p)
+        if b.endswith(".dcm"):
+            files.append(("nibabel/nicom/" + b, p, "dicom"))
+        elif b.endswith(".dcm.gz"):
+            out = os.path.join(tmp, b[:-3])
+            with gzip.open(p) as src, open(out, "wb") as dst:
+                shutil.copyfileobj(src, dst)
+            files.append(("nibabel/nicom/" + b, out, "dicom"))
+    for p in sorted(glob.glob(PYD + "/*.dcm")):
+        files.append(("pydicom/" + os.path.basename(p), p, "dicom"))
+    return files
+
+
+def splat_read(splat, path):
+    r = subprocess.run([splat, "info", path], capture_output=True, text=True, timeout=60)
+    out = {"rc": r.returncode, "stderr": r.stderr.strip()}
+    for line in r.stdout.splitlines():
+        key, _, value = line.partition(":")
+        value = value.strip()
+        if key == "dimensions":
+            out["dims"] = tuple(int(x) for x in value.split("(")[0].split(" x "))
+        elif key == "origin":
+            a, _, b = value.partition(", last sample at ")
+            out["first"] = np.array([float(x) for x in a.strip("()").split(",")])
+            out["last"] = np.array([float(x) for x in b.strip("()").split(",")])
+        elif key == "values":
+            rng, _, mean = value.partition(", mean ")
+            lo, _, hi = rng.partition(" .. ")
+            out["values"] = (float(lo), float(hi), float(mean))
+    return out
+
+
+def box(affine, dims):
+    """World bounding box (min, max) of the voxel centres of a 3D grid."""
+    corners = np.array([[i, j, k, 1] for i in (0, dims[0] - 1) for j in (0, dims[1] - 1)
+                        for k in (0, dims[2] - 1)], float)
+    w = (affine @ corners.T)[:3]
+    return w.min(axis=1), w.max(axis=1)
+
+
+def nibabel_read(path):
+    import nibabel as nib
+    img = nib.load(path)
+    data = np.asarray(img.dataobj, dtype=np.float64)
+    while data.ndim > 3:  # splat loads the first volume of a 4D file
+        data = data[..., 0]
+    while data.ndim < 3:
+        data = data[..., None]
+    return data.shape, img.affine, data
+
+
+def pydicom_read(path):
+    import pydicom
+    ds = pydicom.dcmread(path)
+    a = ds.pixel_array.astype(np.float64)
+    if a.ndim != 2:
+        raise ValueError("not one scalar frame: pixel array shape %s" % (a.shape,))
+    if int(getattr(ds, "NumberOfFrames", 1) or 1) != 1:
+        raise ValueError("not one scalar frame: %s frames" % ds.NumberOfFrames)
+    a = a * float(getattr(ds, "RescaleSlope", 1) or 1) + float(getattr(ds, "RescaleIntercept", 0) or 0)
+    rows, cols = a.shape
+    affine = np.eye(4)
+    if "ImagePositionPatient" in ds and "ImageOrientationPatient" in ds:
+        o = [float(x) for x in ds.ImageOrientationPatient]
+        dy, dx = ([float(x) for x in ds.PixelSpacing] if "PixelSpacing" in ds else (1.0, 1.0))
+        r, c = np.array(o[:3]), np.array(o[3:])
+        lps = np.eye(4)
+        lps[:3, 0] = r * dx
+        lps[:3, 1] = c * dy
+        lps[:3, 2] = np.cross(r, c)
+        lps[:3, 3] = [float(x) for x in ds.ImagePositionPatient]
+        affine = np.diag([-1.0, -1.0, 1.0, 1.0]) @ lps  # LPS -> RAS
+        geometry = True
+    else:
+        geometry = False
+    return (cols, rows, 1), affine, a, geometry
+
+
+def classify(label, path, kind, splat):
+    s = splat_read(splat, path)
+    try:
+        if kind == "nifti":
+            shape, affine, data = nibabel_read(path)
+            geometry = True
+        else:
+            shape, affine, data, geometry = pydicom_read(path)
+    except ValueError as e:  # the oracle reads it, but not as one scalar 3D image
+        if s["rc"] > 0 and str(e).startswith("not one scalar frame"):
+            return "refused", reason(s, path)
+        return classify_oracle_failure(s, path, e)
+    except Exception as e:  # the oracle cannot read it either
+        return classify_oracle_failure(s, path, e)
+
+    if s["rc"] < 0:
+        return "WRONG", "splat died with signal %d" % -s["rc"]
+    if s["rc"] != 0:
+        return "refused", reason(s, path)
+    problems = []
+    if tuple(sorted(s["dims"])) != tuple(sorted(int(x) for x in shape)):
+        problems.append("dims %s, oracle %s" % (s["dims"], tuple(shape)))
+    lo, hi, mean = s["values"]
+    if not (np.isclose(lo, data.min(), rtol=1e-5, atol=1e-3) and
+            np.isclose(hi, data.max(), rtol=1e-5, atol=1e-3) and
+            np.isclose(mean, data.mean(), rtol=2e-5, atol=1e-3)):
+        problems.append("values %g..%g mean %g, oracle %g..%g mean %g" %
+                        (lo, hi, mean, data.min(), data.max(), data.mean()))
+    if geometry and not problems:
+        bmin, bmax = box(affine, shape)
+        smin = np.minimum(s["first"], s["last"])
+        smax = np.maximum(s["first"], s["last"])
+        # `splat info` prints 6 significant digits.
+        tol = 1e-3 + 1e-5 * np.abs(np.concatenate([bmin, bmax])).max()
+        err = max(np.abs(smin - bmin).max(), np.abs(smax - bmax).max())
+        if err > tol:
+            problems.append("voxel-centre box off by %.3g mm" % err)
+    if not problems:
+        return "same", ""
+    if "warning" in s["stderr"]:
+        first = [l for l in s["stderr"].splitlines() if "warning" in l][0]
+        return "warned", "; ".join(problems) + " — " + first.split(": ", 3)[-1][:90]
+    return "WRONG", "; ".join(problems)
+
+
+def classify_oracle_failure(s, path, e):
+    oracle = "%s: %s" % (type(e).__name__, str(e).splitlines()[0][:70] if str(e) else "")
+    if s["rc"] < 0:
+        return "WRONG", "splat died with signal %d" % -s["rc"]
+    if s["rc"] == 0:
+        return "n/a", "splat reads it; the oracle cannot (%s)" % oracle
+    return "n/a", "the oracle refuses too; splat: " + reason(s, path)
+
+
+def reason(s, path):
+    err = s["stderr"].splitlines()[-1] if s["stderr"] else "(no message)"
+    err = err.replace("splat: error: ", "").replace(path + ": ", "")
+    return err.replace("|", "/")[:150]
+
+
+def main():
+    if len(sys.argv) < 2:
+        print(__doc__)
+        return 2
+    splat = sys.argv[1]
+    table = sys.argv[sys.argv.index("--table") + 1] if "--table" in sys.argv else None
+    if not os.path.isdir(NIB) or not os.path.isdir(PYD):
+        print("conformance: python3-nibabel / python3-pydicom are not installed (tools/setup.sh)")
+        return 1
+    tmp = tempfile.mkdtemp(prefix="splat_conformance_")
+    try:
+        rows = [(label,) + classify(label, path, kind, splat)
+                for label, path, kind in corpus(tmp)]
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    counts = {}
+    for _, result, _ in rows:
+        counts[result] = counts.get(result, 0) + 1
+    lines = ["| file | result | detail |", "|---|---|---|"]
+    lines += ["| %s | %s | %s |" % r for r in rows]
+    summary = ", ".join("%s %d" % (k, counts[k]) for k in sorted(counts))
+    text = "\n".join(lines) + "\n\n%d files: %s\n" % (len(rows), summary)
+    if table:
+        with open(table, "w") as f:
+            f.write(text)
+    for r in rows:
+        if r[1] == "WRONG":
+            print("WRONG: %s: %s" % (r[0], r[2]))
+    print("conformance: %d files: %s" % (len(rows), summary))
+    return 1 if counts.get("WRONG", 0) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
