@@ -10,6 +10,7 @@
 
 #include "cli_util.h"
 #include "splat/image_io.h"
+#include "splat/metrics.h"
 #include "splat/render.h"
 #include "splat/volume_io.h"
 
@@ -234,4 +235,45 @@ TEST_CASE("background: clipping and level of detail cut and merge to b", "[backg
         CHECK(a.at(0, 0).r >= kAir - 0.5f);
         CHECK(a.at(0, 0).r < -900.0f);
     }
+}
+
+// Gradients at the volume's faces: outside the data the field is b, so a voxel on a face has
+// the neighbour b across it (central differences with b beyond the border). A tissue
+// cylinder cut by the top and bottom faces of a CT volume has a real surface there, and
+// padding the volume with a layer of air changes nothing: not the field, and with the b
+// neighbour not the normals or the gradient magnitudes of shading and edge enhancement
+// either (one-sided differences at the border lit the cut faces as if they had no surface).
+TEST_CASE("background: shading and edges at faces the data touch; padding with b is invisible",
+          "[background]") {
+    const int n = 24;
+    auto cylinder = [&](int pad) {
+        const int m = n + 2 * pad;
+        Volume v = makeVolume(glm::ivec3(m), glm::dvec3(1.0), "HU cylinder");
+        std::fill(v.data.begin(), v.data.end(), kAir);
+        const double c = (n - 1) / 2.0;
+        for (int k = 0; k < n; ++k)
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i)
+                    if (std::hypot(i - c, j - c) < 8.0) v.at(i + pad, j + pad, k + pad) = kTissue;
+        v.origin = glm::dvec3(-pad);  // the same world positions
+        v.background = kAir;
+        return v;
+    };
+    const Volume hu = cylinder(0), padded = cylinder(1), up = shifted(hu, 1000.0f);
+    for (RendererKind r : {RendererKind::Axis, RendererKind::Sheet, RendererKind::Reference})
+        for (int edges = 0; edges < 2; ++edges) {
+            INFO(name(r) << (edges ? " shaded with edges" : " shaded"));
+            RenderSettings s = settingsFor(r, RenderMode::Dvr);
+            s.camera.elevationDeg = 50;  // the top face in view
+            s.camera.pixelSize = 1.0;    // the same pixels for both volumes
+            s.transfer = tissueTf(-300.0f);
+            for (auto& p : s.transfer.points) p.rgba.a = std::min(1.0f, 6.0f * p.rgba.a);
+            s.shading.enabled = true;
+            if (edges) s.edges.gain = 1.0f;
+            const Image a = render(hu, s);
+            CHECK(maxAbsDiff(a, render(padded, s)) < 1e-5);
+            RenderSettings sUp = s;
+            sUp.transfer = shiftedTf(s.transfer, 1000.0f);
+            CHECK(maxAbsDiff(a, render(up, sUp)) < 2e-5);
+        }
 }

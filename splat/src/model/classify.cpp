@@ -48,18 +48,20 @@ std::vector<char> neededBricks(const Volume& v, const TransferFunction& tf, int 
     return need;
 }
 
-// -grad d / |grad d| by central differences (one-sided at the border), in world units; 0
-// where the gradient vanishes.
+// grad d by central differences in world units. Beyond the border the field is the
+// background value b (f -> b outside the data), so a face voxel's missing neighbour is b:
+// tissue cut by a face has a surface there, as the reference sees in the field.
 glm::dvec3 gradientAt(const Volume& v, int i, int j, int k) {
     glm::dvec3 g(0.0);
     const int p[3] = {i, j, k};
+    const double b = v.background;
     for (int a = 0; a < 3; ++a) {
         int lo[3] = {i, j, k}, hi[3] = {i, j, k};
-        lo[a] = std::max(p[a] - 1, 0);
-        hi[a] = std::min(p[a] + 1, v.dims[a] - 1);
-        if (hi[a] == lo[a]) continue;
-        g[a] = (double(v.at(hi[0], hi[1], hi[2])) - v.at(lo[0], lo[1], lo[2])) /
-               ((hi[a] - lo[a]) * v.spacing[a]);
+        lo[a] = p[a] - 1;
+        hi[a] = p[a] + 1;
+        const double dlo = lo[a] >= 0 ? double(v.at(lo[0], lo[1], lo[2])) : b;
+        const double dhi = hi[a] < v.dims[a] ? double(v.at(hi[0], hi[1], hi[2])) : b;
+        g[a] = (dhi - dlo) / (2.0 * v.spacing[a]);
     }
     return g;
 }
