@@ -7,7 +7,8 @@ RAS geometry is written
   * as NIfTI by nibabel, in RAS index order and again stored radiologically (x flipped, a
     negative x axis in the affine),
   * as a DICOM series by pydicom (LPS: columns to patient left, rows to posterior, as
-    scanners write),
+    scanners write), and as one Siemens mosaic (the slices tiled 3 x 3, a CSA header with
+    NumberOfImagesInMosaic; nibabel, the oracle, checks the file),
   * as NRRD by teem (`teem-unu make`): `space: left-posterior-superior` with negative space
     directions, as 3D Slicer writes, and in RAS,
   * as MetaImage by hand as ITK writes it (identity TransformMatrix, LPS Offset, samples
@@ -23,11 +24,16 @@ Usage: world_frame.py SPLAT    exit 1 on any difference.
 """
 import os
 import shutil
+import struct
 import subprocess
 import sys
 import tempfile
 
+import warnings
+
 import numpy as np
+
+warnings.filterwarnings("ignore")  # nibabel: "The DICOM readers are highly experimental"
 
 DIMS = (12, 10, 8)  # i (R), j (A), k (S)
 SPACING = np.array([1.5, 1.2, 2.0])
@@ -109,6 +115,81 @@ def write_dicom(folder, data, affine):
     return [("DICOM series LPS (pydicom)", series)]
 
 
+def csa2(tags):
+    """A Siemens CSA2 header ("SV10") holding `tags`: (name, vr, [item strings])."""
+    out = b"SV10" + b"\x04\x03\x02\x01" + struct.pack("<2I", len(tags), 77)
+    for name, vr, items in tags:
+        n_items = max(6, len(items))
+        syngodt = {"US": 10, "SH": 22, "FD": 4}[vr]  # Siemens' type codes (GDCM checks them)
+        out += struct.pack("<64si4s3i", name.encode(), len(items), vr.encode(), syngodt, n_items,
+                           77)
+        for k in range(n_items):
+            data = (items[k].encode() + b"\0") if k < len(items) else b""
+            out += struct.pack("<4i", len(data), len(data), 77, len(data)) + data
+            out += b"\0" * (-len(data) % 4)
+    return out
+
+
+def write_mosaic(folder, data, affine):
+    """One Siemens mosaic: the 8 slices tiled 3 x 3 (one tile empty), as a scanner writes it."""
+    import pydicom
+    from pydicom.dataset import Dataset, FileMetaDataset
+    from pydicom.uid import ExplicitVRLittleEndian, generate_uid
+    lps = np.diag([-1.0, -1.0, 1.0])
+    r = lps @ -affine[:3, 0] / SPACING[0]
+    c = lps @ -affine[:3, 1] / SPACING[1]
+    n = lps @ affine[:3, 2] / SPACING[2]
+    m = int(np.ceil(np.sqrt(DIMS[2])))
+    rows, cols = DIMS[1], DIMS[0]  # one tile
+    image = np.zeros((m * rows, m * cols), np.int16)
+    for k in range(DIMS[2]):
+        y0, x0 = (k // m) * rows, (k % m) * cols
+        image[y0:y0 + rows, x0:x0 + cols] = data[::-1, ::-1, k].T
+    # ImagePositionPatient is the whole mosaic's (Siemens): the first tile's first pixel moved
+    # back by half the size difference (nibabel's MosaicWrapper undoes exactly this).
+    first = lps @ (affine @ [DIMS[0] - 1, DIMS[1] - 1, 0, 1])[:3]
+    ipp = first - c * SPACING[1] * (m * rows - rows) / 2 - r * SPACING[0] * (m * cols - cols) / 2
+    meta = FileMetaDataset()
+    meta.MediaStorageSOPClassUID = "1.2.840.10008.5.1.4.1.1.4"
+    meta.MediaStorageSOPInstanceUID = generate_uid()
+    meta.TransferSyntaxUID = ExplicitVRLittleEndian
+    ds = Dataset()
+    ds.file_meta = meta
+    ds.SOPClassUID = meta.MediaStorageSOPClassUID
+    ds.SOPInstanceUID = meta.MediaStorageSOPInstanceUID
+    ds.StudyInstanceUID, ds.SeriesInstanceUID = generate_uid(), generate_uid()
+    ds.Modality = "MR"
+    ds.ImageType = ["ORIGINAL", "PRIMARY", "M", "MOSAIC"]
+    ds.InstanceNumber = 1
+    ds.ImagePositionPatient = [float("%.6f" % x) for x in ipp]
+    ds.ImageOrientationPatient = [float("%.9f" % x) for x in list(r) + list(c)]
+    ds.PixelSpacing = [float(SPACING[1]), float(SPACING[0])]
+    ds.SpacingBetweenSlices = float(SPACING[2])
+    ds.Rows, ds.Columns = image.shape
+    ds.SamplesPerPixel = 1
+    ds.PhotometricInterpretation = "MONOCHROME2"
+    ds.BitsAllocated, ds.BitsStored, ds.HighBit = 16, 16, 15
+    ds.PixelRepresentation = 1
+    ds.add_new(0x00290010, "LO", "SIEMENS CSA HEADER")
+    ds.add_new(0x00291010, "OB", csa2([("NumberOfImagesInMosaic", "US", [str(DIMS[2])]),
+                                       ("AcquisitionMatrixText", "SH", ["%dp*%d" % (rows, cols)]),
+                                       ("SliceNormalVector", "FD",
+                                        ["%.8f" % x for x in n])]))
+    ds.PixelData = image.astype("<i2").tobytes()
+    ds.is_little_endian, ds.is_implicit_VR = True, False
+    ds.preamble = b"\0" * 128
+    p = os.path.join(folder, "mosaic.dcm")
+    pydicom.dcmwrite(p, ds, write_like_original=False)
+    # The oracle: nibabel reads this file with the marker where the volume has it.
+    from nibabel.nicom import dicomwrappers
+    w = dicomwrappers.wrapper_from_file(p)
+    got = w.get_data()
+    idx = np.unravel_index(np.argmax(got), got.shape)
+    pos = lps @ (w.affine @ (list(idx) + [1]))[:3]
+    assert np.abs(pos - (affine @ (list(MARKER) + [1]))[:3]).max() < 1e-3, pos
+    return [("DICOM Siemens mosaic (pydicom, CSA)", p)]
+
+
 def vec(v):
     return "(" + ",".join("%.9g" % x for x in v) + ")"
 
@@ -182,6 +263,7 @@ def check(splat, tmp, name, rotation):
     os.makedirs(folder)
     data, affine = volume(), ras_affine(rotation)
     files = (write_nifti(folder, data, affine) + write_dicom(folder, data, affine) +
+             write_mosaic(folder, data, affine) +
              write_nrrd(folder, data, affine) + write_metaimage(folder, data, affine))
     expected = (affine @ (list(MARKER) + [1]))[:3]
     failures = []
