@@ -28,7 +28,6 @@ import struct
 import subprocess
 import sys
 import tempfile
-
 import warnings
 
 import numpy as np
