@@ -323,7 +323,7 @@ TEST_CASE("hostile NRRD and MetaImage: data checked before allocating", "[volume
         CHECK_THAT(le.note, Catch::Contains("no 'endian' field: little-endian assumed for its "
                                             "2-byte samples"));
         CHECK_THAT(loadError(nrrd("nanorigin.nrrd", "endian: little\nspace origin: (0,nan,0)\n")),
-                   Catch::Contains("nanorigin.nrrd: cannot parse vector '0 nan 0'"));
+                   Catch::Contains("nanorigin.nrrd: NRRD space origin '(0,nan,0)' is not finite"));
     }
     SECTION("NRRD text values must fit the type") {
         for (const char* value : {"1.7", "-5", "300", "nan"}) {
@@ -384,16 +384,20 @@ TEST_CASE("data files stay in the header's folder unless allowed", "[volume][hos
     };
     LoadOptions allow;
     allow.allowOutsideDataFiles = true;
+    // The file's last sample (value 7): MetaImage is LPS, its x and y flip into RAS.
+    auto last = [](const Volume& v, const std::string& p) {
+        return p.ends_with(".mhd") ? v.at(0, 0, 1) : v.at(1, 1, 1);
+    };
     for (const Case& c : cases) {
         const std::string p = (root / "hdr" / c.name).string();
         writeBytes(p, c.text);
         INFO(c.name);
         if (c.inside) {
-            CHECK(loadVolume(p).data[7] == 7.0f);
+            CHECK(last(loadVolume(p), p) == 7.0f);
         } else {
             CHECK_THAT(loadError(p), Catch::StartsWith(p + ": data file '") &&
                                          Catch::Contains("is outside the header's folder"));
-            CHECK(loadVolume(p, allow).data[7] == 7.0f);
+            CHECK(last(loadVolume(p, allow), p) == 7.0f);
         }
     }
     // The CLI flag.

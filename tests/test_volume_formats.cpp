@@ -84,14 +84,22 @@ TEST_CASE("NIfTI: scl_slope/scl_inter and a flipped, permuted sform", "[volume]"
         Volume w = loadVolume((dir / "noscale.nii").string());
         CHECK(w.at(3, 2, 1) == float(f(3, 2, 1)));
     }
-    SECTION("an oblique sform is reported in the note") {
+    SECTION("an oblique sform is kept as the volume's direction") {
         const double a = 10.0 * M_PI / 180.0;
         const float c = float(std::cos(a)), s = float(std::sin(a));
-        const float rot[3][4] = {{c, -s, 0, 0}, {s, c, 0, 0}, {0, 0, 1, 0}};
+        const float rot[3][4] = {{c, -s, 0, 5}, {s, c, 0, -7}, {0, 0, 1, 9}};
         writeBytes(dir / "oblique.nii", niftiFile(fd, values, 1.0f, 0.0f, rot));
         Volume w = loadVolume((dir / "oblique.nii").string());
         CHECK(w.dims == fd);
-        CHECK_THAT(w.note, Catch::Contains("oblique") && Catch::Contains("10.00 degrees"));
+        CHECK(w.note.empty());
+        REQUIRE(w.rotated());
+        // Every voxel where the sform puts it.
+        for (int k = 0; k < fd.z; ++k)
+            for (int j = 0; j < fd.y; ++j)
+                for (int i = 0; i < fd.x; ++i) {
+                    const glm::dvec3 sform(c * i - s * j + 5, s * i + c * j - 7, k + 9);
+                    CHECK(glm::length(w.worldPosition(glm::dvec3(i, j, k)) - sform) < 1e-5);
+                }
     }
 }
 
@@ -106,10 +114,11 @@ TEST_CASE("NRRD: attached raw, big-endian, space directions and origin", "[volum
     Volume v = loadVolume((dir / "be.nrrd").string());
     REQUIRE(v.dims == glm::ivec3(3, 2, 2));
     CHECK(v.spacing == glm::dvec3(0.5, 0.75, 2.0));
-    // y was flipped: the new first row is the file's last row.
-    CHECK(v.origin == glm::dvec3(1.0, 2.0 - 0.75, 3.0));
-    CHECK(v.at(0, 0, 0) == 3.0f);
-    CHECK(v.at(2, 1, 1) == 8.0f);
+    // LPS -> RAS: the directions become (-0.5,0,0) (0,0.75,0) (0,0,2) from (-1,-2,3), so x
+    // is flipped: the new first column is the file's last, at RAS (-1 - 2 * 0.5, -2, 3).
+    CHECK(v.origin == glm::dvec3(-2.0, -2.0, 3.0));
+    CHECK(v.at(0, 0, 0) == 2.0f);
+    CHECK(v.at(2, 1, 1) == 9.0f);
     CHECK_THAT(v.source, Catch::Contains("NRRD int16"));
 }
 
@@ -155,8 +164,13 @@ TEST_CASE("MetaImage: .mhd with separate data, compressed .mha, MSB", "[volume]"
     Volume v = loadVolume((dir / "vol.mhd").string());
     REQUIRE(v.dims == glm::ivec3(5, 3, 2));
     CHECK(v.spacing == glm::dvec3(0.5, 0.5, 1.5));
-    CHECK(v.origin == glm::dvec3(-1, -2, -3));
-    for (std::size_t i = 0; i < values.size(); ++i) REQUIRE(v.data[i] == float(values[i]));
+    // MetaImage is LPS (ITK): Offset (-1,-2,-3) is RAS (1,2,-3) and the identity matrix's x
+    // and y run to RAS -x, -y, so both are flipped: RAS origin (1 - 4 * 0.5, 2 - 2 * 0.5, -3).
+    CHECK(v.origin == glm::dvec3(-1, 1, -3));
+    for (int k = 0; k < 2; ++k)
+        for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 5; ++i)
+                REQUIRE(v.at(i, j, k) == float(values[std::size_t((k * 3 + 2 - j) * 5 + 4 - i)]));
 
     std::string packed = deflateBytes(samples<double>(values), false);
     writeBytes(dir / "c.mha",
@@ -166,7 +180,7 @@ TEST_CASE("MetaImage: .mhd with separate data, compressed .mha, MSB", "[volume]"
                    std::to_string(packed.size()) + "\nElementDataFile = LOCAL\n" + packed);
     Volume c = loadVolume((dir / "c.mha").string());
     REQUIRE(c.dims == glm::ivec3(5, 3, 2));
-    CHECK(c.data[29] == 29.0f);
+    CHECK(c.at(0, 0, 1) == 29.0f);  // file sample (4, 2, 1): x and y flipped (LPS)
     CHECK_THAT(c.source, Catch::Contains("compressed"));
 
     for (const char* t :
@@ -180,7 +194,7 @@ TEST_CASE("MetaImage: .mhd with separate data, compressed .mha, MSB", "[volume]"
                                                   : samples<float>(ramp(8));
         writeBytes(dir / "t.mha", "NDims = 3\nDimSize = 2 2 2\nElementType = " + type +
                                       "\nElementDataFile = LOCAL\n" + data);
-        CHECK(loadVolume((dir / "t.mha").string()).data[7] == 7.0f);
+        CHECK(loadVolume((dir / "t.mha").string()).at(0, 0, 1) == 7.0f);
     }
 }
 

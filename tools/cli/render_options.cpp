@@ -245,7 +245,8 @@ TransferFunction transferFromArgs(const RenderArgs& a) {
 
 // --eye without --look-at looks at the volume centre (known once the volume is loaded).
 RenderSettings withFreeCameraTarget(RenderSettings s, const Volume& volume) {
-    if (s.camera.lookAtSet && std::isnan(s.camera.lookAt.x)) s.camera.lookAt = volume.center();
+    if (s.camera.lookAtSet && std::isnan(s.camera.lookAt.x))
+        s.camera.lookAt = volume.direction * volume.center();  // world
     return s;
 }
 

@@ -3,6 +3,10 @@
 // the view direction (-sin a cos e, cos a cos e, -sin e), image right (cos a, sin a, 0) and
 // image up = right x view. The view is centred on the volume centre; pixel (0, 0) is the
 // top-left corner and pixel centres sit at half-integers.
+//
+// CameraParams are world (RAS) quantities; a Camera's vectors and points are in the volume's
+// frame (Volume::direction^T times world; the same as world unless the volume is oblique),
+// the frame every renderer works in, so an oblique volume is seen in its true orientation.
 #include <glm/glm.hpp>
 
 #include "splat/volume.h"
@@ -47,8 +51,8 @@ class Camera {
     int height() const { return params_.height; }
     bool perspective() const { return params_.projection == Projection::Perspective; }
 
-    glm::dvec3 right, up, view;  ///< unit vectors; view points into the scene
-    glm::dvec3 target;           ///< volume centre (world)
+    glm::dvec3 right, up, view;  ///< unit vectors (volume frame); view points into the scene
+    glm::dvec3 target;           ///< volume centre or look-at point (volume frame)
     glm::dvec3 eye;              ///< perspective eye (orthographic: target - view * radius)
     double pixelSize = 1;        ///< world units per pixel at the target's depth
     double focal = 1;            ///< perspective: distance of the target plane from the eye

@@ -1,8 +1,10 @@
 #pragma once
-// A scalar volume: samples d_i at integer index positions p = (i, j, k), world position
-// x = origin + S p with S = diag(spacing). Samples are x fastest, then y, then z; stored as
-// float in `data` (owned), or in the caller's memory or a file's type (u8/i16/u16/f32,
-// read as raw * scale + offset) without a float copy: Volume::borrow.
+// A scalar volume: samples d_i at integer index positions p = (i, j, k), position
+// x = origin + S p with S = diag(spacing) in the volume's frame, world position
+// R x with R = direction (a rotation; the identity unless the file is oblique). World is
+// RAS+ millimetres (NIfTI's frame; every loader converts into it). Samples are x fastest,
+// then y, then z; stored as float in `data` (owned), or in the caller's memory or a file's
+// type (u8/i16/u16/f32, read as raw * scale + offset) without a float copy: Volume::borrow.
 #include <cstddef>
 #include <cstdint>
 #include <glm/glm.hpp>
@@ -27,7 +29,13 @@ const char* sampleTypeName(SampleType type);
 struct Volume {
     glm::ivec3 dims{0};       ///< samples along x, y, z (all >= 1 for a valid volume)
     glm::dvec3 spacing{1.0};  ///< world units (usually mm) between samples per axis
-    glm::dvec3 origin{0.0};   ///< world position of sample (0, 0, 0)
+    glm::dvec3 origin{0.0};   ///< position of sample (0, 0, 0) in the volume's frame
+    /// Rotation from the volume's frame to the world frame (RAS): world = direction * x for
+    /// a volume-frame position x. Loaders put here what is left of a file's index-to-world
+    /// affine after the nearest axis permutation and flips (an oblique acquisition); the
+    /// renderers work in the volume's frame and the Camera turns its world parameters into
+    /// it (splat/DESIGN.md "World frame"). Identity: the volume frame is the world frame.
+    glm::dmat3 direction{1.0};
     /// The samples of an owned float volume: dims.x * dims.y * dims.z, x fastest (the
     /// loaders fill it). Empty for a borrowed or typed volume (sampleData() is then the
     /// storage); read samples with at() or value(), which work for every storage.
@@ -104,8 +112,13 @@ struct Volume {
     float at(int i, int j, int k) const { return value(index(i, j, k)); }
     /// Writable sample of an owned float volume (`data`); not for borrowed or typed storage.
     float& at(int i, int j, int k) { return data[index(i, j, k)]; }
-    /// World position of a (possibly fractional) index position.
+    /// Volume-frame position of a (possibly fractional) index position: the renderers'
+    /// coordinates (the world position when `direction` is the identity).
     glm::dvec3 world(const glm::dvec3& p) const { return origin + spacing * p; }
+    /// World (RAS) position of a (possibly fractional) index position.
+    glm::dvec3 worldPosition(const glm::dvec3& p) const { return direction * world(p); }
+    /// True when `direction` is not the identity (an oblique volume).
+    bool rotated() const { return direction != glm::dmat3(1.0); }
     /// World position of the volume centre, index (n - 1) / 2 on every axis.
     glm::dvec3 center() const { return world((glm::dvec3(dims) - 1.0) * 0.5); }
     /// Smallest spacing: the world length of "one voxel" in splat/DESIGN.md.

@@ -8,28 +8,30 @@
 // CT) through each file's rescale, and the LPS patient coordinates become the RAS world
 // NIfTI uses, so the same orientation code makes a head upright. A folder holding several
 // series needs LoadOptions::dicomSeries (CLI: --series UID).
+#include <fcntl.h>
+#include <gdcmCSAHeader.h>
 #include <gdcmDicts.h>
+#include <gdcmElement.h>
 #include <gdcmGlobal.h>
 #include <gdcmImageReader.h>
 #include <gdcmReader.h>
+#include <gdcmSplitMosaicFilter.h>
 #include <gdcmStringFilter.h>
 #include <gdcmTrace.h>
+#include <sys/mman.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <map>
 #include <new>
 #include <sstream>
-
-#include <csignal>
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "splat/error.h"
 #include "volume_detail.h"
@@ -124,7 +126,9 @@ struct SliceInfo {
     int seriesNumber = -1, instance = -1;
     int rows = 0, columns = 0, frames = 1, samples = 1, bitsAllocated = 16, bitsStored = 16;
     bool signedPixels = false;
-    bool mosaic = false;  ///< ImageType holds MOSAIC: a Siemens mosaic, slices tiled in one image
+    bool mosaic = false;   ///< ImageType holds MOSAIC: a Siemens mosaic, slices tiled in one image
+    int mosaicImages = 0;  ///< NumberOfImagesInMosaic of the Siemens CSA image header (0: none)
+    std::optional<glm::dvec3> csaNormal;  ///< SliceNormalVector of the CSA image header
     DicomLayout layout;
     std::uint64_t fileSize = 0;
     std::optional<glm::dvec3> position;
@@ -228,6 +232,15 @@ DicomLayout checkDicomLengths(const std::vector<unsigned char>& b, const std::st
                 fail("unknown transfer syntax '" + syntax.substr(0, 64) + "'");
             explicitVr = syntax != "1.2.840.10008.1.2";
             bigEndian = syntax == "1.2.840.10008.1.2.2";
+            // A data set written in implicit VR under an explicit-VR transfer syntax (pydicom's
+            // SC_rgb_jpeg.dcm): no VR where the first element's VR belongs. pydicom guesses
+            // and reads it; GDCM's recovery runs out of memory on it. Refused, naming that.
+            if (explicitVr && b.size() - pos >= 8) {
+                const char vr[2] = {char(b[pos + 4]), char(b[pos + 5])};
+                if (!isVr(longVrs, vr) && !isVr(shortVrs, vr))
+                    fail("the data set is encoded in implicit VR, but its transfer syntax " +
+                         syntax + " says explicit VR");
+            }
         }
         const bool forced = !scopes.empty() && scopes.back();
         const bool ex = inMeta || (explicitVr && !forced), be = !inMeta && bigEndian && !forced;
@@ -352,7 +365,8 @@ void survivesInChild(const std::string& name, const char* what, F work) {
                 std::fclose(f);
             }
             if (pages > 0) {
-                const rlim_t cap = rlim_t(pages) * rlim_t(sysconf(_SC_PAGESIZE)) + (rlim_t(1) << 30);
+                const rlim_t cap =
+                    rlim_t(pages) * rlim_t(sysconf(_SC_PAGESIZE)) + (rlim_t(1) << 30);
                 const rlimit limit{cap, cap};
                 setrlimit(RLIMIT_AS, &limit);
             }
@@ -390,8 +404,7 @@ void survivesInChild(const std::string& name, const char* what, F work) {
     }
 }
 
-SliceInfo readHeaderWithGdcm(const fs::path& p, const DicomLayout& layout,
-                             std::uint64_t fileSize);
+SliceInfo readHeaderWithGdcm(const fs::path& p, const DicomLayout& layout, std::uint64_t fileSize);
 
 /// One file's element walk (checkDicomLengths), before GDCM sees it.
 struct Checked {
@@ -400,8 +413,33 @@ struct Checked {
     std::uint64_t fileSize = 0;
 };
 
-SliceInfo readHeaderWithGdcm(const fs::path& p, const DicomLayout& layout,
-                             std::uint64_t fileSize) {
+/// A Siemens mosaic's CSA image header (private group 0029, "SIEMENS CSA HEADER"): the
+/// number of slices tiled in the image and the slice normal, as nibabel's MosaicWrapper and
+/// dcm2niix read them.
+void readMosaicHeader(const gdcm::File& file, SliceInfo& s) {
+    s.mosaicImages =
+        int(std::min(gdcm::SplitMosaicFilter::GetNumberOfImagesInMosaic(file), 1u << 20));
+    gdcm::CSAHeader csa;
+    const gdcm::PrivateTag& tag = csa.GetCSAImageHeaderInfoTag();
+    const gdcm::DataSet& ds = file.GetDataSet();
+    if (!ds.FindDataElement(tag) || !csa.LoadFromDataElement(ds.GetDataElement(tag)) ||
+        !csa.FindCSAElementByName("SliceNormalVector"))
+        return;
+    const gdcm::CSAElement& e = csa.GetCSAElementByName("SliceNormalVector");
+    const gdcm::ByteValue* bv = e.IsEmpty() ? nullptr : e.GetByteValue();
+    if (!bv || !bv->GetPointer()) return;
+    // The items as text, "x\\y\\z".
+    std::string text(bv->GetPointer(), bv->GetLength());
+    for (char& ch : text)
+        if (ch == '\\' || ch == '\0') ch = ' ';
+    std::istringstream in(text);
+    glm::dvec3 n;
+    if (in >> n.x >> n.y >> n.z && std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z) &&
+        glm::length(n) > 0.5)
+        s.csaNormal = n;
+}
+
+SliceInfo readHeaderWithGdcm(const fs::path& p, const DicomLayout& layout, std::uint64_t fileSize) {
     const std::string name = displayName(p);
     gdcm::Reader reader;
     reader.SetFileName(p.string().c_str());
@@ -418,6 +456,7 @@ SliceInfo readHeaderWithGdcm(const fs::path& p, const DicomLayout& layout,
     s.modality = textOf(sf, ds, kModality);
     const std::string imageType = textOf(sf, ds, kImageType);
     s.mosaic = ("\\" + imageType + "\\").find("\\MOSAIC\\") != std::string::npos;
+    if (s.mosaic) readMosaicHeader(reader.GetFile(), s);
     s.seriesNumber =
         intOf(numbersOf(sf, ds, kSeriesNumber, name, "SeriesNumber"), -1, name, "SeriesNumber");
     s.instance = intOf(numbersOf(sf, ds, kInstanceNumber, name, "InstanceNumber"), -1, name,
@@ -450,7 +489,8 @@ SliceInfo readHeaderWithGdcm(const fs::path& p, const DicomLayout& layout,
         s.between = v->front();
     if (auto v = numbersOf(sf, ds, kSlope, name, "RescaleSlope")) s.slope = v->front();
     if (auto v = numbersOf(sf, ds, kIntercept, name, "RescaleIntercept")) s.intercept = v->front();
-    if (auto v = numbersOf(sf, ds, kPixelPadding, name, "PixelPaddingValue")) s.padding = v->front();
+    if (auto v = numbersOf(sf, ds, kPixelPadding, name, "PixelPaddingValue"))
+        s.padding = v->front();
     return s;
 }
 
@@ -484,9 +524,9 @@ void storedToReal(const unsigned char* raw, std::size_t count, std::size_t size,
             v |= std::uint64_t(raw[at]) << (8 * k);
         }
         v &= mask;
-        const double value =
-            signedPixels && (v & signBit) ? double(std::int64_t(v) - std::int64_t(mask) - 1)
-                                          : double(v);
+        const double value = signedPixels && (v & signBit)
+                                 ? double(std::int64_t(v) - std::int64_t(mask) - 1)
+                                 : double(v);
         out[i] = float(slope * value + intercept);
     }
 }
@@ -584,8 +624,8 @@ std::vector<SliceInfo> readInfos(const std::vector<fs::path>& files) {
     // Every header is first parsed in one child process for the whole series (one fork per
     // series, not per slice: README "Input files" has the measured cost); the child records
     // which file it is in, so a death names the file.
-    auto* at = static_cast<std::size_t*>(
-        mmap(nullptr, sizeof(std::size_t), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0));
+    auto* at = static_cast<std::size_t*>(mmap(nullptr, sizeof(std::size_t), PROT_READ | PROT_WRITE,
+                                              MAP_SHARED | MAP_ANONYMOUS, -1, 0));
     if (at == MAP_FAILED) throw Error("DICOM: out of memory");
     *at = 0;
     struct Unmap {
@@ -609,7 +649,8 @@ std::vector<SliceInfo> readInfos(const std::vector<fs::path>& files) {
     std::vector<SliceInfo> infos;
     infos.reserve(files.size());
     for (const Checked& c : checked)
-        infos.push_back(guarded(c.path, [&] { return readHeaderWithGdcm(c.path, c.layout, c.fileSize); }));
+        infos.push_back(
+            guarded(c.path, [&] { return readHeaderWithGdcm(c.path, c.layout, c.fileSize); }));
     return infos;
 }
 
@@ -633,6 +674,107 @@ std::vector<DicomSeriesInfo> groupSeries(const std::vector<SliceInfo>& infos) {
         return a.seriesNumber != b.seriesNumber ? a.seriesNumber < b.seriesNumber : a.uid < b.uid;
     });
     return out;
+}
+
+/// Background value (issue 21): the padding value where the file says it, else the
+/// rescaled minimum for CT; other modalities take the common rule (volumeBackground).
+void setBackground(Volume& v, const SliceInfo& first) {
+    if (first.padding) {
+        v.background = float(first.slope * *first.padding + first.intercept);
+        v.backgroundSource = "DICOM Pixel Padding Value";
+    } else if (first.modality == "CT") {
+        v.background = volumeStats(v, 1).minValue;
+        v.backgroundSource = "minimum of the CT data (no Pixel Padding Value)";
+    }
+}
+
+/// A Siemens mosaic (issue 22): one file holds a volume, its n = NumberOfImagesInMosaic
+/// slices tiled m x m (m = ceil(sqrt n)) in one image, row by row; read as nibabel's
+/// MosaicWrapper reads it. ImagePositionPatient is that of the whole tiled image's first
+/// pixel, so the first slice's is moved by half the difference between the mosaic's and a
+/// tile's size along the rows and columns; slices are stacked along the slice normal (the
+/// sign of the CSA SliceNormalVector) at SpacingBetweenSlices (else SliceThickness). A
+/// series of mosaic files is a time series: its first file is loaded, with a warning.
+Volume loadMosaic(const std::string& name, std::vector<SliceInfo> files) {
+    std::vector<std::string> notes;
+    if (files.size() > 1) {
+        std::stable_sort(files.begin(), files.end(), [](const SliceInfo& a, const SliceInfo& b) {
+            return a.instance < b.instance;
+        });
+        notes.push_back("Siemens mosaic series of " + std::to_string(files.size()) +
+                        " files (one volume each): only the first was loaded");
+    }
+    const SliceInfo& s = files.front();
+    const std::string sn = displayName(s.path);
+    if (s.mosaicImages < 1)
+        throw Error(sn +
+                    ": Siemens mosaic DICOM (ImageType MOSAIC) without NumberOfImagesInMosaic "
+                    "in its CSA image header: the slices tiled in its " +
+                    std::to_string(s.columns) + " x " + std::to_string(s.rows) +
+                    " image cannot be told apart");
+    const int m = int(std::ceil(std::sqrt(double(s.mosaicImages)) - 1e-9));
+    if (s.rows % m != 0 || s.columns % m != 0)
+        throw Error(sn + ": Siemens mosaic of " + std::to_string(s.mosaicImages) +
+                    " images does not tile its " + std::to_string(s.columns) + " x " +
+                    std::to_string(s.rows) + " image in " + std::to_string(m) + " x " +
+                    std::to_string(m) + " tiles");
+    const int tileRows = s.rows / m, tileCols = s.columns / m;
+    const glm::ivec3 dims(tileCols, tileRows, s.mosaicImages);
+    checkedVoxelCount(dims, name);
+
+    std::vector<float> image(std::size_t(s.rows) * std::size_t(s.columns));
+    readPixels(s, image.data());
+    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
+    for (int k = 0; k < dims.z; ++k) {
+        const int r0 = (k / m) * tileRows, c0 = (k % m) * tileCols;
+        for (int j = 0; j < tileRows; ++j)
+            std::copy_n(image.data() + std::size_t(r0 + j) * std::size_t(s.columns) + c0, tileCols,
+                        v.data.data() + v.index(0, j, k));
+    }
+
+    double dx = 1, dy = 1;
+    if (s.pixelSpacing) {
+        dy = (*s.pixelSpacing)[0];
+        dx = (*s.pixelSpacing)[1];
+    } else {
+        notes.push_back("DICOM: no PixelSpacing, 1 x 1 mm pixels assumed");
+    }
+    double gap = 1;
+    if (s.between && *s.between > 0)
+        gap = *s.between;
+    else if (s.thickness && *s.thickness > 0)
+        gap = *s.thickness;
+    glm::dmat3 M(glm::dvec3(dx, 0, 0), glm::dvec3(0, dy, 0), glm::dvec3(0, 0, gap));
+    glm::dvec3 t(0.0);
+    std::string what = "DICOM spacing";
+    if (s.position && s.orientation) {
+        const std::vector<double>& o = *s.orientation;
+        glm::dvec3 r(o[0], o[1], o[2]), c(o[3], o[4], o[5]);
+        if (!(glm::length(r) > 0.5) || !(glm::length(c) > 0.5) ||
+            std::abs(glm::dot(glm::normalize(r), glm::normalize(c))) > 1e-3)
+            throw Error(sn + ": DICOM ImageOrientationPatient is not two orthogonal unit vectors");
+        // nibabel: the normal from the orientation (r, c as given), its sign from the CSA
+        // SliceNormalVector (without one, column x row direction).
+        glm::dvec3 n = glm::cross(r, c);
+        if (s.csaNormal ? glm::dot(n, *s.csaNormal) < 0 : true) n = -n;
+        const glm::dvec3 first = *s.position + r * (dx * double(s.columns - tileCols) / 2) +
+                                 c * (dy * double(s.rows - tileRows) / 2);
+        const glm::dmat3 lpsToRas(glm::dvec3(-1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, 1));
+        M = lpsToRas * glm::dmat3(r * dx, c * dy, n * gap);
+        t = lpsToRas * first;
+        what = "DICOM ImageOrientationPatient";
+    } else {
+        notes.push_back(
+            "DICOM: no ImagePositionPatient/ImageOrientationPatient, orientation "
+            "unknown");
+    }
+    std::string modality = s.modality.empty() ? "" : s.modality + " ";
+    v.source = "DICOM " + modality + "Siemens mosaic, " + std::to_string(dims.z) + " slices (" +
+               name + ")";
+    applyOrientation(v, M, t, what);
+    for (const std::string& n : notes) addNote(v, n);
+    setBackground(v, s);
+    return v;
 }
 
 }  // namespace
@@ -665,10 +807,8 @@ Volume loadDicomFiles(const std::string& name, const std::vector<fs::path>& file
     const SliceInfo& first = slices.front();
     for (const SliceInfo& s : slices) {
         const std::string sn = displayName(s.path);
-        if (s.mosaic)
-            throw Error(sn + ": Siemens mosaic DICOM (ImageType MOSAIC: the slices are tiled in "
-                        "one " + std::to_string(s.columns) + " x " + std::to_string(s.rows) +
-                        " image) is not supported; convert it first (e.g. dcm2niix)");
+        if (s.mosaic != first.mosaic)
+            throw Error(sn + ": series mixes Siemens mosaic and single-slice DICOM files");
         if (s.frames != 1)
             throw Error(sn + ": multi-frame DICOM (" + std::to_string(s.frames) +
                         " frames) is not supported");
@@ -691,6 +831,7 @@ Volume loadDicomFiles(const std::string& name, const std::vector<fs::path>& file
                         std::to_string(s.rows) + ", the first slice is " +
                         std::to_string(first.columns) + " x " + std::to_string(first.rows));
     }
+    if (first.mosaic) return loadMosaic(name, std::move(slices));
     if (slices.size() > std::size_t(INT32_MAX)) throw Error(name + ": too many slices");
     const glm::ivec3 dims(first.columns, first.rows, int(slices.size()));
     checkedVoxelCount(dims, name);
@@ -722,6 +863,9 @@ Volume loadDicomFiles(const std::string& name, const std::vector<fs::path>& file
             std::abs(glm::dot(glm::normalize(r), glm::normalize(c))) > 1e-3)
             throw Error(displayName(first.path) +
                         ": DICOM ImageOrientationPatient is not two orthogonal unit vectors");
+        // The file's r and c as given (PS3.3 C.7.6.2.1.1's equation, as nibabel and pydicom
+        // use them; their rounding in the file is not normalised away), the normal unit.
+        const glm::dvec3 r0 = r, c0 = c;
         r = glm::normalize(r);
         c = glm::normalize(c);
         const glm::dvec3 n = glm::cross(r, c);
@@ -766,7 +910,7 @@ Volume loadDicomFiles(const std::string& name, const std::vector<fs::path>& file
         // Columns (index x) run along r, rows (index y) along c, slices along n; LPS
         // patient coordinates become RAS (x and y negated), the convention of NIfTI.
         const glm::dmat3 lpsToRas(glm::dvec3(-1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, 1));
-        M = lpsToRas * glm::dmat3(r * dx, c * dy, n * gap);
+        M = lpsToRas * glm::dmat3(r0 * dx, c0 * dy, n * gap);
         t = lpsToRas * *slices.front().position;
     } else {
         const bool numbered = std::all_of(slices.begin(), slices.end(),
@@ -797,15 +941,7 @@ Volume loadDicomFiles(const std::string& name, const std::vector<fs::path>& file
         "DICOM " + modality + "series, " + std::to_string(slices.size()) + " files (" + name + ")";
     applyOrientation(v, M, t, what);
     for (const std::string& n : notes) addNote(v, n);
-    // Background value (issue 21): the padding value where the file says it, else the
-    // rescaled minimum for CT; other modalities take the common rule (volumeBackground).
-    if (first.padding) {
-        v.background = float(first.slope * *first.padding + first.intercept);
-        v.backgroundSource = "DICOM Pixel Padding Value";
-    } else if (first.modality == "CT") {
-        v.background = volumeStats(v, 1).minValue;
-        v.backgroundSource = "minimum of the CT data (no Pixel Padding Value)";
-    }
+    setBackground(v, first);
     return v;
 }
 

@@ -7,6 +7,10 @@
 // Position), TransformMatrix (row a = direction of index axis a, as ITK writes it),
 // BinaryDataByteOrderMSB (alias ElementByteOrderMSB), CompressedData (zlib stream),
 // HeaderSize (bytes to skip in the data file, -1 = data at the end).
+//
+// Its physical space is LPS, as ITK (and so SimpleITK, 3D Slicer, elastix) writes it:
+// TransformMatrix and Offset are LPS and AnatomicalOrientation only names the matrix's
+// axes; both are turned into splat's world frame, RAS (splat/DESIGN.md "World frame").
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -150,8 +154,10 @@ Volume loadMetaImage(const fs::path& p, const LoadOptions& options) {
     for (int a = 0; a < 3; ++a)
         if (!std::isfinite(spacing[a]) || spacing[a] <= 0)
             throw Error(name + ": invalid MetaImage ElementSpacing '" + sp + "'");
+    // LPS -> RAS: x and y negated.
+    const glm::dvec3 lpsToRas(-1.0, -1.0, 1.0);
     glm::dmat3 M;
-    for (int a = 0; a < 3; ++a) M[a] = dirs[a] * spacing[a];
+    for (int a = 0; a < 3; ++a) M[a] = lpsToRas * dirs[a] * spacing[a];
     // AnatomicalOrientation repeats what the matrix says (ITK's "from" letters, identity =
     // RAI); the matrix decides. A disagreement is worth a warning, an invalid code an error.
     const std::string anat = toLower(get("anatomicalorientation"));
@@ -229,7 +235,7 @@ Volume loadMetaImage(const fs::path& p, const LoadOptions& options) {
 
     v.source = std::string("MetaImage ") + sampleTypeName(*type) +
                (compressed ? " compressed" : "") + " (" + p.filename().string() + ")";
-    applyOrientation(v, M, origin, "TransformMatrix");
+    applyOrientation(v, M, lpsToRas * origin, "TransformMatrix");
     for (const std::string& n : notes) addNote(v, n);
     return v;
 }

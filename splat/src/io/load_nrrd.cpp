@@ -4,10 +4,15 @@
 // "field: value" lines ("#" starts a comment, "key:=value" is a key/value pair we
 // ignore). In a .nrrd the header ends at the first blank line and the data follows; a
 // .nhdr names its data with "data file:" (relative to the header's folder). Fields we
-// use: type, dimension (2 or 3), sizes, encoding (raw, gzip/gz, text/txt/ascii),
-// endian, spacings or space directions, space origin, byte skip, line skip.
+// use: type, dimension (2 or 3), sizes, encoding (all five: raw, gzip/gz, bzip2/bz2,
+// text/txt/ascii, hex), endian, spacings or space (or space dimension) with space
+// directions and space origin, byte skip, line skip. Geometry in a named space is turned
+// into splat's world frame, RAS (splat/DESIGN.md "World frame").
+#include <cctype>
 #include <cmath>
+#include <initializer_list>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "splat/error.h"
@@ -18,9 +23,11 @@ namespace fs = std::filesystem;
 namespace splat::detail {
 namespace {
 
-// Parses "(a,b,c)" vectors separated by spaces; "none" entries become nullopt.
-std::vector<std::optional<glm::dvec3>> parseVectors(const std::string& s, const std::string& what) {
-    std::vector<std::optional<glm::dvec3>> out;
+// Parses "(a,b,c)" vectors of `n` components separated by spaces; "none" entries become
+// nullopt.
+std::vector<std::optional<std::vector<double>>> parseVectors(const std::string& s, std::size_t n,
+                                                             const std::string& what) {
+    std::vector<std::optional<std::vector<double>>> out;
     std::size_t i = 0;
     while (i < s.size()) {
         if (std::isspace(static_cast<unsigned char>(s[i]))) {
@@ -40,11 +47,115 @@ std::vector<std::optional<glm::dvec3>> parseVectors(const std::string& s, const 
         for (char& c : inner)
             if (c == ',') c = ' ';
         std::istringstream in(inner);
-        glm::dvec3 v;
-        if (!(in >> v.x >> v.y >> v.z)) throw Error(what + ": cannot parse vector '" + inner + "'");
+        std::vector<double> v;
+        std::string word;
+        while (in >> word) {
+            char* end = nullptr;
+            const double d = std::strtod(word.c_str(), &end);
+            if (end == word.c_str() || *end)
+                throw Error(what + ": cannot parse vector '" + inner + "'");
+            v.push_back(d);
+        }
+        if (v.size() != n)
+            throw Error(what + ": vector '(" + s.substr(i + 1, close - i - 1) + ")' has " +
+                        std::to_string(v.size()) + " components, the space has " +
+                        std::to_string(n));
         out.push_back(v);
         i = close + 1;
     }
+    return out;
+}
+
+/// A NRRD space (format spec, "space"): its dimension and the signs that take its first
+/// three coordinates to RAS. Spaces without anatomy (scanner-xyz, 3D-right-handed) are
+/// taken as RAS; 3D-left-handed has its x negated so that the picture is not mirrored.
+struct NrrdSpace {
+    std::size_t dimension = 3;
+    glm::dvec3 toRas{1.0};
+    const char* note = nullptr;  ///< warning for a space without anatomical meaning
+};
+
+std::optional<NrrdSpace> nrrdSpace(const std::string& name) {
+    const std::string n = toLower(name);
+    auto is = [&](std::initializer_list<const char*> names) {
+        for (const char* c : names)
+            if (n == toLower(c)) return true;
+        return false;
+    };
+    const glm::dvec3 ras(1, 1, 1), las(-1, 1, 1), lps(-1, -1, 1);
+    if (is({"right-anterior-superior", "RAS"})) return NrrdSpace{3, ras, nullptr};
+    if (is({"left-anterior-superior", "LAS"})) return NrrdSpace{3, las, nullptr};
+    if (is({"left-posterior-superior", "LPS"})) return NrrdSpace{3, lps, nullptr};
+    if (is({"right-anterior-superior-time", "RAST"})) return NrrdSpace{4, ras, nullptr};
+    if (is({"left-anterior-superior-time", "LAST"})) return NrrdSpace{4, las, nullptr};
+    if (is({"left-posterior-superior-time", "LPST"})) return NrrdSpace{4, lps, nullptr};
+    const char* none = "NRRD space has no anatomical orientation: its axes are taken as RAS";
+    const char* left =
+        "NRRD space 3D-left-handed has no anatomical orientation: its x axis is negated to "
+        "give a right-handed RAS frame";
+    if (is({"scanner-xyz"})) return NrrdSpace{3, ras, none};
+    if (is({"scanner-xyz-time"})) return NrrdSpace{4, ras, none};
+    if (is({"3D-right-handed"})) return NrrdSpace{3, ras, none};
+    if (is({"3D-right-handed-time"})) return NrrdSpace{4, ras, none};
+    if (is({"3D-left-handed"})) return NrrdSpace{3, las, left};
+    if (is({"3D-left-handed-time"})) return NrrdSpace{4, las, left};
+    return std::nullopt;
+}
+
+/// The spatial part of a space vector: its first three components in RAS (a time space's
+/// fourth component must be 0 for a spatial axis or the origin).
+glm::dvec3 spatial(const std::vector<double>& v, const NrrdSpace& space, const std::string& what,
+                   const std::string& field) {
+    if (v.size() == 4 && v[3] != 0)
+        throw Error(what + ": NRRD " + field + " has a time component (" + std::to_string(v[3]) +
+                    ") on a spatial axis");
+    glm::dvec3 out(0.0);
+    for (std::size_t c = 0; c < std::min<std::size_t>(3, v.size()); ++c)
+        out[int(c)] = v[c] * space.toRas[int(c)];
+    return out;
+}
+
+/// NRRD hex encoding: two hex digits per byte (either case), whitespace anywhere between
+/// bytes; exactly `expected` bytes, in the file's byte order.
+std::vector<unsigned char> decodeHex(const unsigned char* data, std::size_t size,
+                                     std::size_t expected, const std::string& what) {
+    // Two characters per byte at least: a shorter text is refused before allocating.
+    if (size / 2 < expected)
+        throw Error(what + ": truncated data: " + std::to_string(expected) +
+                    " bytes need at least " + std::to_string(2 * expected) +
+                    " hex digits, the file holds " + std::to_string(size) + " characters");
+    std::vector<unsigned char> out;
+    out.reserve(expected);
+    int high = -1;
+    for (std::size_t i = 0; i < size; ++i) {
+        const unsigned char c = data[i];
+        if (std::isspace(c)) {
+            if (high >= 0) throw Error(what + ": NRRD hex data splits a byte with white space");
+            continue;
+        }
+        int d;
+        if (c >= '0' && c <= '9')
+            d = c - '0';
+        else if (c >= 'a' && c <= 'f')
+            d = c - 'a' + 10;
+        else if (c >= 'A' && c <= 'F')
+            d = c - 'A' + 10;
+        else
+            throw Error(what + ": NRRD hex data has a character that is not a hex digit at byte " +
+                        std::to_string(i));
+        if (high < 0) {
+            high = d;
+            continue;
+        }
+        if (out.size() == expected)
+            throw Error(what + ": hex data holds more than the " + std::to_string(expected) +
+                        " bytes the header describes");
+        out.push_back((unsigned char)(high * 16 + d));
+        high = -1;
+    }
+    if (high >= 0 || out.size() != expected)
+        throw Error(what + ": truncated data: expected " + std::to_string(expected) +
+                    " bytes of hex data, found " + std::to_string(out.size()));
     return out;
 }
 
@@ -135,17 +246,42 @@ Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
         throw Error(name +
                     ": NRRD header has both 'spacings' and 'space directions' (the format "
                     "forbids it: the two could disagree); keep one");
+    // The space: a named one (converted to RAS) or "space dimension" (taken as RAS).
+    NrrdSpace space;
+    const bool haveSpace = !field("space").empty() || !field("space dimension").empty();
+    if (!field("space").empty() && !field("space dimension").empty())
+        throw Error(name +
+                    ": NRRD header has both 'space' and 'space dimension' (the format "
+                    "forbids it)");
+    if (!field("space").empty()) {
+        auto named = nrrdSpace(field("space"));
+        if (!named) throw Error(name + ": unknown NRRD space '" + field("space") + "'");
+        space = *named;
+        if (space.note) notes.push_back(space.note);
+    } else if (!field("space dimension").empty()) {
+        const std::string sd = field("space dimension");
+        if (sd != "2" && sd != "3")
+            throw Error(name + ": NRRD space dimension " + sd + " not supported (need 2 or 3)");
+        space.dimension = std::size_t(sd[0] - '0');
+        if (!field("space directions").empty())
+            notes.push_back("NRRD space has no anatomical orientation: its axes are taken as RAS");
+    }
     if (!field("space directions").empty()) {
-        auto dirs = parseVectors(field("space directions"), name);
+        if (!haveSpace)
+            notes.push_back("NRRD 'space directions' without 'space': its axes are taken as RAS");
+        auto dirs = parseVectors(field("space directions"), space.dimension, name);
         if (int(dirs.size()) != dimension)
             throw Error(name + ": 'space directions' has " + std::to_string(dirs.size()) +
                         " entries, dimension is " + std::to_string(dimension));
         for (int a = 0; a < dimension; ++a) {
             if (!dirs[a]) throw Error(name + ": 'space directions' is 'none' for a spatial axis");
-            M[a] = *dirs[a];
-            if (!std::isfinite(M[a].x) || !std::isfinite(M[a].y) || !std::isfinite(M[a].z) ||
-                glm::length(M[a]) <= 0)
-                throw Error(name + ": 'space directions' has a zero, NaN or Inf vector for axis " +
+            for (double c : *dirs[a])
+                if (!std::isfinite(c))
+                    throw Error(name + ": 'space directions' has a NaN or Inf vector for axis " +
+                                std::to_string(a));
+            M[a] = spatial(*dirs[a], space, name, "space directions");
+            if (!(glm::length(M[a]) > 0))
+                throw Error(name + ": 'space directions' has a zero vector for axis " +
                             std::to_string(a));
         }
         if (dimension == 2) M[2] = glm::normalize(glm::cross(M[0], M[1])) * glm::length(M[0]);
@@ -169,21 +305,25 @@ Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
         }
     }
     if (!field("space origin").empty()) {
-        auto o = parseVectors(field("space origin"), name);
+        auto o = parseVectors(field("space origin"), space.dimension, name);
         if (o.size() != 1 || !o[0])
             throw Error(name + ": bad NRRD space origin '" + field("space origin") + "'");
-        t = *o[0];
-        if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z))
-            throw Error(name + ": NRRD space origin '" + field("space origin") + "' is not finite");
+        for (double c : *o[0])
+            if (!std::isfinite(c))
+                throw Error(name + ": NRRD space origin '" + field("space origin") +
+                            "' is not finite");
+        t = spatial(*o[0], space, name, "space origin");
     }
 
     std::string encoding = toLower(field("encoding"));
     if (encoding.empty()) encoding = "raw";
     const bool gzip = encoding == "gzip" || encoding == "gz";
+    const bool bzip2 = encoding == "bzip2" || encoding == "bz2";
     const bool text = encoding == "text" || encoding == "txt" || encoding == "ascii";
-    if (!gzip && !text && encoding != "raw")
+    const bool hex = encoding == "hex";
+    if (!gzip && !bzip2 && !text && !hex && encoding != "raw")
         throw Error(name + ": unsupported NRRD encoding '" + encoding +
-                    "' (supported: raw, gzip, text)");
+                    "' (the format's five: raw, gzip, bzip2, text, hex)");
     std::string endian = toLower(field("endian"));
     if (!endian.empty() && endian != "big" && endian != "little")
         throw Error(name + ": bad NRRD endian '" + endian + "'");
@@ -239,17 +379,23 @@ Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
     data += skipPos;
     dataSize -= skipPos;
 
-    std::vector<unsigned char> inflated;
-    if (byteSkip > 0) {
+    // byte skip counts bytes of the decompressed stream for gzip and bzip2 (as teem reads
+    // it), of the file otherwise; -1 (data at the end) only with raw.
+    const bool compressed = gzip || bzip2;
+    if (byteSkip > 0 && !compressed) {
         checkDataLength(std::size_t(byteSkip), dataSize, dataName, false);
         data += byteSkip;
         dataSize -= std::size_t(byteSkip);
     }
-    if (gzip) {
-        inflated = inflateAll(data, dataSize, dataName, expected);
-        data = inflated.data();
-        dataSize = inflated.size();
-        checkDataLength(expected, dataSize, dataName, true);
+    std::vector<unsigned char> decoded;
+    if (compressed) {
+        const std::size_t skip = std::size_t(std::max(0LL, byteSkip));
+        const std::size_t limit = checkedAdd(expected, skip, dataName);
+        decoded = gzip ? inflateAll(data, dataSize, dataName, limit)
+                       : bunzip2All(data, dataSize, dataName, limit);
+        checkDataLength(limit, decoded.size(), dataName, true);
+        data = decoded.data() + skip;
+        dataSize = expected;
     } else if (encoding == "raw") {
         if (byteSkip == -1) {
             // "-1": the data is the last `expected` bytes of the file.
@@ -258,6 +404,10 @@ Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
             dataSize = expected;
         }
         checkDataLength(expected, dataSize, dataName, true);
+    } else if (hex) {
+        decoded = decodeHex(data, dataSize, expected, dataName);
+        data = decoded.data();
+        dataSize = decoded.size();
     } else {
         // Text: n numbers take at least 2n - 1 characters (digits and separators).
         const std::size_t count = expected / sampleSize(*type);

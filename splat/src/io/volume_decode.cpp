@@ -206,11 +206,14 @@ void decodeText(const std::string& text, std::size_t count, SampleType t, float*
             throw Error(what + ": text sample " + std::to_string(i) + " ('" +
                         std::string(p, std::size_t(end - p)) + "') is not a " + sampleTypeName(t) +
                         " value");
+        // A float32 number in text is in range when it rounds to a finite float: teem prints
+        // FLT_MAX as 3.4028235e+38, a little above it, which rounds to FLT_MAX.
         if (!range && t == SampleType::F32 && std::isfinite(value) &&
-            std::abs(value) > double(std::numeric_limits<float>::max()))
+            !std::isfinite(std::strtof(p, nullptr)))
             throw Error(what + ": text sample " + std::to_string(i) + " ('" +
                         std::string(p, std::size_t(end - p)) + "') is out of the float32 range");
-        out[i] = static_cast<float>(value);
+        // float32 rounded once, from the text (not through double).
+        out[i] = t == SampleType::F32 ? std::strtof(p, nullptr) : static_cast<float>(value);
         p = end;
     }
 }

@@ -77,6 +77,10 @@ std::vector<unsigned char> readFileRange(const std::filesystem::path& p, std::ui
 /// bytes)" as soon as it passes the limit; corrupt data throws "WHAT: corrupt gzip data".
 std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t size,
                                       const std::string& what, std::size_t limit);
+/// Decompresses bzip2 data (concatenated streams allowed) into at most `limit` bytes, with
+/// inflateAll's messages ("corrupt bzip2 data", "more data than the header declares").
+std::vector<unsigned char> bunzip2All(const unsigned char* data, std::size_t size,
+                                      const std::string& what, std::size_t limit);
 /// The detached data file a header names (NRRD "data file", MetaImage ElementDataFile),
 /// resolved against the header's folder. Unless `allowOutside`, an absolute path or one
 /// whose `..` leaves that folder is refused: "HEADER: data file 'X' is outside the
@@ -90,13 +94,15 @@ std::string trim(const std::string& s);
 
 // ---- orientation -----------------------------------------------------------------
 
-/// Applies a file's index-to-world affine x = t + M p (columns of M = world step of one
-/// index along each file axis) to `v`, whose data and dims are in file index order.
-/// The signed axis permutation closest to M is applied to the data so that world axis
-/// w runs along index axis w in the positive direction; spacing becomes the column
-/// norms in their new places and origin the world position of the new first sample.
-/// A residual rotation larger than ~1e-3 is described in v.note (never dropped
-/// silently). `what` names the matrix's origin ("sform", "space directions").
+/// Applies a file's index-to-world affine x = t + M p (world = RAS; columns of M = world
+/// step of one index along each file axis) to `v`, whose data and dims are in file index
+/// order. The signed axis permutation closest to M is applied to the data so that frame
+/// axis w runs along index axis w in the positive direction; spacing becomes the column
+/// norms in their new places, the rotation left (an oblique file) becomes v.direction
+/// (identity below 1e-6) and v.origin the new first sample's position in the volume's
+/// frame, so that v.worldPosition(p) = t + M p' for every voxel. Non-orthogonal axes are
+/// replaced by the nearest rotation with a warning in v.note. `what` names the matrix's
+/// origin ("sform", "space directions").
 void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t, const std::string& what);
 
 // ---- the loaders (one per file) --------------------------------------------------

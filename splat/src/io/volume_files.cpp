@@ -1,5 +1,6 @@
 // File helpers shared by the loaders and writers: whole-file reads with clear errors,
 // gzip/zlib inflation, atomic writes, extensions and natural sort order.
+#include <bzlib.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -146,6 +147,66 @@ std::vector<unsigned char> inflateAll(const unsigned char* data, std::size_t siz
         throw Error(what + ": compressed data holds more data than the header declares (" +
                     std::to_string(limit) + " bytes)");
     if (ret != Z_STREAM_END) throw Error(what + ": corrupt gzip data (" + reason + ")");
+    out.resize(produced);
+    return out;
+}
+
+std::vector<unsigned char> bunzip2All(const unsigned char* data, std::size_t size,
+                                      const std::string& what, std::size_t limit) {
+    bz_stream bz{};
+    if (BZ2_bzDecompressInit(&bz, 0, 0) != BZ_OK) throw Error(what + ": cannot initialise bzip2");
+    std::vector<unsigned char> out;
+    const std::size_t cap = limit == SIZE_MAX ? limit : limit + 1;
+    out.resize(std::min<std::size_t>(cap, std::max<std::size_t>(size * 4, 1 << 16)));
+    std::size_t inPos = 0, produced = 0;
+    int ret = BZ_OK;
+    bool tooMuch = false;
+    while (true) {
+        if (bz.avail_in == 0 && inPos < size) {
+            const std::size_t chunk = std::min<std::size_t>(size - inPos, 1u << 30);
+            bz.next_in = reinterpret_cast<char*>(const_cast<unsigned char*>(data + inPos));
+            bz.avail_in = unsigned(chunk);
+            inPos += chunk;
+        }
+        if (produced == out.size()) {
+            if (out.size() >= cap) {
+                tooMuch = true;
+                break;
+            }
+            out.resize(std::min(cap, out.size() * 2));
+        }
+        const std::size_t room = std::min<std::size_t>(out.size() - produced, 1u << 30);
+        bz.next_out = reinterpret_cast<char*>(out.data() + produced);
+        bz.avail_out = unsigned(room);
+        ret = BZ2_bzDecompress(&bz);
+        produced += room - bz.avail_out;
+        if (ret == BZ_STREAM_END) {
+            // Concatenated bzip2 streams (pbzip2, teem appending) are legal: the next one.
+            if (bz.avail_in > 0 || inPos < size) {
+                const unsigned left = bz.avail_in;
+                char* next = bz.next_in;
+                BZ2_bzDecompressEnd(&bz);
+                bz = bz_stream{};
+                if (BZ2_bzDecompressInit(&bz, 0, 0) != BZ_OK) break;
+                bz.next_in = next;
+                bz.avail_in = left;
+                continue;
+            }
+            break;
+        }
+        if (ret != BZ_OK) break;
+        // No progress with all the input consumed: the stream ends early.
+        if (bz.avail_in == 0 && inPos >= size && bz.avail_out > 0) break;
+    }
+    BZ2_bzDecompressEnd(&bz);
+    if (tooMuch)
+        throw Error(what + ": compressed data holds more data than the header declares (" +
+                    std::to_string(limit) + " bytes)");
+    if (ret != BZ_STREAM_END)
+        throw Error(what + ": corrupt bzip2 data (" +
+                    (ret == BZ_OK ? std::string("unexpected end of stream")
+                                  : "error " + std::to_string(ret)) +
+                    ")");
     out.resize(produced);
     return out;
 }

@@ -1,11 +1,13 @@
-// Orientation: turning a file's index-to-world affine into the axis-aligned model.
+// Orientation: turning a file's index-to-world affine into the model.
 //
 // Files store samples along their own index axes; the affine x = t + M p says where
-// each index step goes in world space (NIfTI sform/qform in RAS+, NRRD space
-// directions). splat/DESIGN.md's volume has world axes along index axes with positive
-// spacing, so we find the signed permutation closest to M (largest total |cosine|
-// between each file axis and the world axis it is assigned to), reorder and flip the
-// samples accordingly, and report whatever rotation is left.
+// each index step goes in world space (RAS+: NIfTI sform/qform, NRRD space directions and
+// DICOM/MetaImage LPS converted by their loaders). splat/DESIGN.md's volume has its index
+// axes along the axes of its own frame with positive spacing, and a rotation `direction`
+// from that frame to the world. We find the signed permutation closest to M (largest total
+// |cosine| between each file axis and the world axis it is assigned to), reorder and flip
+// the samples accordingly, and keep the rotation that is left in Volume::direction (the
+// nearest rotation when the file's axes are not orthogonal, with a warning).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,6 +17,26 @@
 #include "volume_detail.h"
 
 namespace splat::detail {
+
+namespace {
+
+/// The rotation nearest to A (its polar factor, A (A^T A)^-1/2), by the Newton iteration
+/// X <- (X + X^-T) / 2, quadratically convergent for a non-singular A.
+glm::dmat3 nearestRotation(const glm::dmat3& A) {
+    glm::dmat3 X = A;
+    for (int it = 0; it < 50; ++it) {
+        if (!(std::abs(glm::determinant(X)) > 1e-12)) return X;
+        const glm::dmat3 next = 0.5 * (X + glm::transpose(glm::inverse(X)));
+        double change = 0;
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) change = std::max(change, std::abs(next[c][r] - X[c][r]));
+        X = next;
+        if (change < 1e-15) break;
+    }
+    return X;
+}
+
+}  // namespace
 
 void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
                       const std::string& what) {
@@ -40,11 +62,9 @@ void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
     } while (std::next_permutation(perm.begin(), perm.end()));
 
     int sign[3];
-    double worst = 0;  // largest angle between a file axis and its assigned world axis
     for (int a = 0; a < 3; ++a) {
         double c = u[a][best[a]];
         sign[a] = c < 0 ? -1 : 1;
-        worst = std::max(worst, std::acos(std::min(1.0, std::abs(c))));
     }
 
     const glm::ivec3 fileDims = v.dims;
@@ -88,15 +108,31 @@ void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
     v.spacing = spacing;
     v.origin = origin;
 
-    if (worst > 1e-3) {
+    // The rotation left: the columns of M in their new places, divided by their lengths.
+    glm::dmat3 R;
+    for (int a = 0; a < 3; ++a) R[best[a]] = M[a] * (double(sign[a]) / len[a]);
+    const glm::dmat3 rotation = nearestRotation(R);
+    double shear = 0, offAxis = 0;
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) {
+            shear = std::max(shear, std::abs(rotation[c][r] - R[c][r]));
+            offAxis = std::max(offAxis, std::abs(rotation[c][r] - (c == r ? 1.0 : 0.0)));
+        }
+    if (!(glm::determinant(rotation) > 0.5))
+        throw Error(v.source + ": " + what + " has axes that do not span space");
+    if (shear > 1e-4) {
         char buf[256];
         std::snprintf(buf, sizeof buf,
-                      "oblique orientation: the %s is rotated up to %.2f degrees from the "
-                      "nearest axis-aligned orientation; only axis flips/permutations were "
-                      "applied, the rest of the rotation is not",
-                      what.c_str(), worst * 180.0 / M_PI);
-        if (!v.note.empty()) v.note += "; ";
-        v.note += buf;
+                      "sheared orientation: the %s's axes are not orthogonal (up to %.3g off "
+                      "the nearest rotation); the nearest rotation was used",
+                      what.c_str(), shear);
+        addNote(v, buf);
+    }
+    // Below 1e-6 (a float32 affine's rounding), the volume is axis-aligned.
+    if (offAxis > 1e-6) {
+        v.direction = rotation;
+        // world = t' + R S p = R (origin + S p): the volume-frame origin is R^T t'.
+        v.origin = glm::transpose(rotation) * origin;
     }
 }
 

@@ -59,20 +59,29 @@ void saveNifti(const std::string& path, const Volume& v) {
     nim->dy = nim->pixdim[2] = float(v.spacing.y);
     nim->dz = nim->pixdim[3] = float(v.spacing.z);
     nim->xyz_units = NIFTI_UNITS_MM;
-    // Axis-aligned affine in both forms: qform (identity rotation) and sform.
-    nim->qform_code = NIFTI_XFORM_SCANNER_ANAT;
-    nim->quatern_b = nim->quatern_c = nim->quatern_d = 0;
-    nim->qfac = 1;
-    nim->qoffset_x = float(v.origin.x);
-    nim->qoffset_y = float(v.origin.y);
-    nim->qoffset_z = float(v.origin.z);
-    nim->sform_code = NIFTI_XFORM_SCANNER_ANAT;
+    // The index-to-world affine (world = direction * (origin + S p)) in both forms: the
+    // sform, and the qform from the same rotation (niftilib's matrix-to-quaternion).
+    const glm::dvec3 o = v.direction * v.origin;
     std::memset(&nim->sto_xyz, 0, sizeof nim->sto_xyz);
-    for (int a = 0; a < 3; ++a) {
-        nim->sto_xyz.m[a][a] = float(v.spacing[a]);
-        nim->sto_xyz.m[a][3] = float(v.origin[a]);
+    for (int r = 0; r < 3; ++r) {
+        for (int a = 0; a < 3; ++a) nim->sto_xyz.m[r][a] = float(v.direction[a][r] * v.spacing[a]);
+        nim->sto_xyz.m[r][3] = float(o[r]);
     }
     nim->sto_xyz.m[3][3] = 1;
+    nim->sform_code = NIFTI_XFORM_SCANNER_ANAT;
+    nim->qform_code = NIFTI_XFORM_SCANNER_ANAT;
+    nifti_dmat44 q;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) q.m[r][c] = double(nim->sto_xyz.m[r][c]);
+    double qb, qc, qd, qx, qy, qz, dx, dy, dz, qfac;
+    nifti_dmat44_to_quatern(q, &qb, &qc, &qd, &qx, &qy, &qz, &dx, &dy, &dz, &qfac);
+    nim->quatern_b = qb;
+    nim->quatern_c = qc;
+    nim->quatern_d = qd;
+    nim->qfac = qfac;
+    nim->qoffset_x = qx;
+    nim->qoffset_y = qy;
+    nim->qoffset_z = qz;
     if (nifti_set_filenames(nim, tmp.string().c_str(), 0, 1) != 0) {
         nifti_image_free(nim);
         throw Error(path + ": cannot set NIfTI file name");
@@ -92,14 +101,20 @@ void saveNifti(const std::string& path, const Volume& v) {
 
 void saveNrrd(const std::string& path, const Volume& v) {
     checkWritable(v, path);
+    // World (RAS) axes and origin: direction applied (splat/DESIGN.md "World frame").
+    auto vec = [](const glm::dvec3& a) {
+        std::ostringstream o;
+        o << '(' << fmt(a.x) << ',' << fmt(a.y) << ',' << fmt(a.z) << ')';
+        return o.str();
+    };
+    const glm::dvec3 o = v.direction * v.origin;
     std::ostringstream h;
     h << "NRRD0004\n# written by splat\ntype: float\ndimension: 3\nspace: right-anterior-superior\n"
       << "sizes: " << v.dims.x << ' ' << v.dims.y << ' ' << v.dims.z << '\n'
-      << "space directions: (" << fmt(v.spacing.x) << ",0,0) (0," << fmt(v.spacing.y) << ",0) (0,0,"
-      << fmt(v.spacing.z) << ")\n"
+      << "space directions: " << vec(v.direction[0] * v.spacing.x) << ' '
+      << vec(v.direction[1] * v.spacing.y) << ' ' << vec(v.direction[2] * v.spacing.z) << '\n'
       << "kinds: domain domain domain\nendian: little\nencoding: raw\n"
-      << "space origin: (" << fmt(v.origin.x) << ',' << fmt(v.origin.y) << ',' << fmt(v.origin.z)
-      << ")\n\n";
+      << "space origin: " << vec(o) << "\n\n";
     std::string bytes = h.str() + floatBytes(v);
     writeFileAtomic(path, bytes.data(), bytes.size());
 }
@@ -110,10 +125,16 @@ void saveMetaImage(const std::string& path, const Volume& v) {
     if (ext != ".mha" && ext != ".mhd") throw Error(path + ": MetaImage output needs .mha or .mhd");
     fs::path target(path);
     fs::path rawPath = fs::path(target).replace_extension(".raw");
+    // MetaImage is LPS (ITK's physical space): RAS x and y negated; TransformMatrix row a
+    // is the direction of index axis a.
+    const glm::dvec3 flip(-1.0, -1.0, 1.0);
+    const glm::dvec3 o = flip * (v.direction * v.origin);
     std::ostringstream h;
     h << "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n"
-      << "CompressedData = False\nTransformMatrix = 1 0 0 0 1 0 0 0 1\n"
-      << "Offset = " << fmt(v.origin.x) << ' ' << fmt(v.origin.y) << ' ' << fmt(v.origin.z) << '\n'
+      << "CompressedData = False\nTransformMatrix =";
+    for (int a = 0; a < 3; ++a)
+        for (int r = 0; r < 3; ++r) h << ' ' << fmt(flip[r] * v.direction[a][r]);
+    h << "\nOffset = " << fmt(o.x) << ' ' << fmt(o.y) << ' ' << fmt(o.z) << '\n'
       << "ElementSpacing = " << fmt(v.spacing.x) << ' ' << fmt(v.spacing.y) << ' '
       << fmt(v.spacing.z) << '\n'
       << "DimSize = " << v.dims.x << ' ' << v.dims.y << ' ' << v.dims.z << '\n'

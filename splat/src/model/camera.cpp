@@ -37,13 +37,23 @@ Camera::Camera(const CameraParams& params, const Volume& volume) : params_(param
 
     boundingRadius = 0.5 * glm::length(glm::dvec3(volume.dims) * volume.spacing);
     const double side = double(std::min(params.width, params.height));
+    // The one place where the world frame meets the volume's frame (splat/DESIGN.md "World
+    // frame"): the parameters are world (RAS), the renderers work in the volume's frame,
+    // world = direction * frame, so world points and directions turn by direction^T. For an
+    // oblique volume this is a change of basis of the view, not a resampling of the data.
+    const glm::dmat3 toFrame = glm::transpose(volume.direction);
     if (params.lookAtSet) {
-        lookAtCamera(params, volume, side);
+        CameraParams p = params;
+        p.eye = toFrame * params.eye;
+        p.lookAt = toFrame * params.lookAt;
+        p.upHint = toFrame * params.upHint;
+        lookAtCamera(p, volume, side);
         return;
     }
     const double a = params.azimuthDeg * kPi / 180.0, e = params.elevationDeg * kPi / 180.0;
-    view = glm::dvec3(-std::sin(a) * std::cos(e), std::cos(a) * std::cos(e), -std::sin(e));
-    right = glm::dvec3(std::cos(a), std::sin(a), 0.0);
+    view =
+        toFrame * glm::dvec3(-std::sin(a) * std::cos(e), std::cos(a) * std::cos(e), -std::sin(e));
+    right = toFrame * glm::dvec3(std::cos(a), std::sin(a), 0.0);
     up = glm::cross(right, view);
 
     target = volume.center();

@@ -14,6 +14,7 @@ Volume coarserGrid(const Volume& fine) {
     v.dims = (fine.dims + 1) / 2;
     v.spacing = 2.0 * fine.spacing;
     v.origin = fine.origin + 0.5 * fine.spacing;
+    v.direction = fine.direction;
     v.source = fine.source + " (2x level of detail)";
     v.background = fine.background;
     v.backgroundSource = fine.backgroundSource;

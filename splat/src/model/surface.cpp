@@ -27,8 +27,8 @@ struct SampledField {
     }
     glm::dvec3 index(std::size_t id) const {
         const std::size_t sx = std::size_t(size.x), sy = std::size_t(size.y);
-        return glm::dvec3(lo) + glm::dvec3(double(id % sx), double((id / sx) % sy),
-                                           double(id / (sx * sy)));
+        return glm::dvec3(lo) +
+               glm::dvec3(double(id % sx), double((id / sx) % sy), double(id / (sx * sy)));
     }
 };
 
@@ -97,7 +97,8 @@ class Marcher {
     }
 
     std::uint32_t vertex(std::size_t in, std::size_t out) {
-        const std::uint64_t key = std::uint64_t(std::min(in, out)) * g_.f.size() + std::max(in, out);
+        const std::uint64_t key =
+            std::uint64_t(std::min(in, out)) * g_.f.size() + std::max(in, out);
         auto [it, fresh] = ids_.try_emplace(key, std::uint32_t(edges.size()));
         if (fresh) {
             edges.push_back({in, out});
@@ -171,7 +172,8 @@ Mesh extractIsosurface(const Volume& volume, double level, const SurfaceOptions&
                 t = ta + fa * (tb - ta) / (fa - fb);
             }
             const glm::dvec3 x = a + t * (b - a);
-            mesh.vertices[q] = glm::vec3(x);
+            // The mesh is in the world frame (an oblique volume's rotation applied).
+            mesh.vertices[q] = glm::vec3(volume.direction * x);
             residual[q] = std::abs(field(x) - level);
             glm::dvec3 grad;
             for (int k = 0; k < 3; ++k) {
@@ -180,7 +182,8 @@ Mesh extractIsosurface(const Volume& volume, double level, const SurfaceOptions&
                 grad[k] = (field(x + d) - field(x - d)) / (2 * h);
             }
             const double len = glm::length(grad);
-            mesh.normals[q] = len > 0 ? glm::vec3(-grad / len) : glm::vec3(0.0f);
+            mesh.normals[q] =
+                len > 0 ? glm::vec3(volume.direction * (-grad / len)) : glm::vec3(0.0f);
         });
         for (double r : residual) mesh.maxResidual = std::max(mesh.maxResidual, r);
     };

@@ -201,12 +201,31 @@ std::string describeVolume(const Volume& v) {
     line("dimensions:  %d x %d x %d (%zu voxels)", v.dims.x, v.dims.y, v.dims.z, v.voxelCount());
     line("spacing:     %g x %g x %g mm", v.spacing.x, v.spacing.y, v.spacing.z);
     glm::dvec3 extent = glm::dvec3(v.dims) * v.spacing;
-    glm::dvec3 last = v.world(glm::dvec3(v.dims) - 1.0);
+    // World frame: RAS millimetres (splat/DESIGN.md "World frame").
+    const glm::dvec3 first = v.worldPosition(glm::dvec3(0.0));
+    const glm::dvec3 last = v.worldPosition(glm::dvec3(v.dims) - 1.0);
     line("extent:      %g x %g x %g mm", extent.x, extent.y, extent.z);
-    line("origin:      (%g, %g, %g), last sample at (%g, %g, %g)", v.origin.x, v.origin.y,
-         v.origin.z, last.x, last.y, last.z);
+    line("origin:      (%.9g, %.9g, %.9g), last sample at (%.9g, %.9g, %.9g) (world: RAS mm)",
+         first.x, first.y, first.z, last.x, last.y, last.z);
+    // The world step of one index along each axis: +x is R, +y is A, +z is S.
+    glm::dvec3 axes[3];
+    for (int a = 0; a < 3; ++a) axes[a] = v.direction[a] * v.spacing[a];
+    line("axes:        i (%.9g, %.9g, %.9g), j (%.9g, %.9g, %.9g), k (%.9g, %.9g, %.9g)%s",
+         axes[0].x, axes[0].y, axes[0].z, axes[1].x, axes[1].y, axes[1].z, axes[2].x, axes[2].y,
+         axes[2].z, v.rotated() ? " (oblique)" : "");
     VolumeStats s = volumeStats(v, 16);
     line("values:      %g .. %g, mean %g", double(s.minValue), double(s.maxValue), s.mean);
+    // Where the (first) maximum is: one voxel anyone can find in another viewer.
+    for (std::size_t n = 0; n < v.data.size(); ++n)
+        if (v.data[n] == s.maxValue) {
+            const glm::ivec3 p(int(n % std::size_t(v.dims.x)),
+                               int(n / std::size_t(v.dims.x) % std::size_t(v.dims.y)),
+                               int(n / (std::size_t(v.dims.x) * std::size_t(v.dims.y))));
+            const glm::dvec3 w = v.worldPosition(glm::dvec3(p));
+            line("maximum:     at index (%d, %d, %d), world (%.9g, %.9g, %.9g)", p.x, p.y, p.z, w.x,
+                 w.y, w.z);
+            break;
+        }
     std::size_t peak = 1;
     for (std::size_t c : s.histogram) peak = std::max(peak, c);
     out << "histogram:\n";
