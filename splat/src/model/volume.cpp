@@ -216,8 +216,8 @@ std::string describeVolume(const Volume& v) {
     VolumeStats s = volumeStats(v, 16);
     line("values:      %g .. %g, mean %g", double(s.minValue), double(s.maxValue), s.mean);
     // Where the (first) maximum is: one voxel anyone can find in another viewer.
-    for (std::size_t n = 0; n < v.data.size(); ++n)
-        if (v.data[n] == s.maxValue) {
+    for (std::size_t n = 0; n < v.voxelCount(); ++n)
+        if (v.value(n) == s.maxValue) {
             const glm::ivec3 p(int(n % std::size_t(v.dims.x)),
                                int(n / std::size_t(v.dims.x) % std::size_t(v.dims.y)),
                                int(n / (std::size_t(v.dims.x) * std::size_t(v.dims.y))));
