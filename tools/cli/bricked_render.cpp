@@ -31,6 +31,10 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
         warn(volume.spec +
              ": its samples are not read by byte ranges (compressed, or not a .raw file): every "
              "rank loads the whole volume once and keeps its brick");
+    if (settings.renderer == RendererKind::Sheet)
+        warn(
+            "--renderer sheet in bricks is approximate where its slabs cross a brick face "
+            "(README \"Beyond one machine\"); axis and reference are exact");
     char b[64];
     std::snprintf(b, sizeof b, "%.9g", double(geometry.background));
     runMetadata().push_back(
