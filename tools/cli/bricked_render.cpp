@@ -63,9 +63,9 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
     for (std::size_t r = 0; r < all.size(); ++r)
         std::printf(
             "rank %zu: %d bricks, largest %zu samples (%.1f MiB), %zu splats, load %.1f ms, "
-            "render %.1f ms, exchanged %llu bytes\n",
+            "scene %.1f ms, render %.1f ms, exchanged %llu bytes\n",
             r, all[r].rendered, all[r].samplesLoaded, all[r].samplesLoaded * 4.0 / 1048576.0,
-            all[r].splats, all[r].loadMs, all[r].renderMs,
+            all[r].splats, all[r].loadMs, all[r].sceneMs, all[r].renderMs,
             static_cast<unsigned long long>(all[r].bytesExchanged));
 }
 

@@ -107,7 +107,9 @@ struct BrickStats {
     std::size_t samplesLoaded = 0;  ///< the largest brick this process held, ghost layers included
     std::size_t splats = 0;         ///< splats of the bricks this process rendered
     std::uint64_t bytesExchanged = 0;  ///< sent + received by this process (compositing)
-    double loadMs = 0, renderMs = 0, compositeMs = 0;
+    /// Load the samples, build the bricks' Scenes (classification), render their frames,
+    /// composite (this process's part of the collective).
+    double loadMs = 0, sceneMs = 0, renderMs = 0, compositeMs = 0;
 };
 
 /// The processes that render the bricks of a frame together, and the three things they do

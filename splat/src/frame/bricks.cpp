@@ -258,11 +258,14 @@ Image renderBricked(const Volume& geometry, const std::function<Volume(const Bri
             const Brick& brick = layout.bricks[std::size_t(b)];
             auto v = std::make_shared<const Volume>(kept ? std::move(*kept) : loadBrick(b));
             kept.reset();
-            const auto t = Clock::now();
+            auto t = Clock::now();
             const RenderSettings bs = brickSettings(s, geometry, brick, geometry.dims);
             const Scene scene(v, bs);
+            st.sceneMs += msSince(t);
+            t = Clock::now();
             RenderStats rs;
             partials.emplace_back(b, scene.render(bs, &rs));
+            st.renderMs += msSince(t);
             st.splats += rs.splats;
             st.renderMs += msSince(t);
         }
