@@ -16,13 +16,23 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// `mpirun --oversubscribe -np N splat ARGS`, killed after 120 s (a hang fails the test).
+/// True when `mpirun` is OpenMPI's (it needs --oversubscribe for more ranks than cores;
+/// MPICH's hydra oversubscribes by itself and has no such option).
+bool openMpi() {
+    static const bool yes =
+        runProgram("mpirun", {"--version"}).out.find("Open MPI") != std::string::npos;
+    return yes;
+}
+
+/// `mpirun [--oversubscribe] -np N splat ARGS`, killed after 120 s (a hang fails the test).
 RunResult mpirun(int n, std::vector<std::string> args) {
     ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
     ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
     ::setenv("OMPI_MCA_btl", "self,vader", 0);  // one machine: shared memory, no network probe
-    std::vector<std::string> a = {
-        "-s", "KILL", "120", "mpirun", "--oversubscribe", "-np", std::to_string(n), SPLAT_EXE};
+    std::vector<std::string> a = {"-s", "KILL", "120", "mpirun"};
+    if (openMpi()) a.push_back("--oversubscribe");
+    for (const std::string& s : {std::string("-np"), std::to_string(n), std::string(SPLAT_EXE)})
+        a.push_back(s);
     a.insert(a.end(), args.begin(), args.end());
     return runProgram("timeout", a);
 }
