@@ -87,7 +87,11 @@ TEST_CASE("bricks: the k-d split owns every sample once, uneven for odd sizes an
     // 3 bricks of 17 samples along x: the root splits 1 : 2 (6 and 11 samples).
     const BrickLayout L = splitBricks({17, 9, 5}, 3, 0);
     CHECK(L.bricks[0].hi.x - L.bricks[0].lo.x == 6);
-    CHECK_THROWS_AS(splitBricks({2, 2, 1}, 5, 0), Error);
+    CHECK_THROWS_AS(splitBricks({2, 2, 1}, 5, 0), Error);  // more bricks than samples
+    // Halving the bricks at every level: 3x3x1 splits into 4 bricks, not into 8 (the
+    // children of the first cut would hold 6 and 3 samples for 4 bricks each): refused.
+    CHECK(splitBricks({3, 3, 1}, 4, 1).bricks.size() == 4);
+    CHECK_THROWS_WITH(splitBricks({3, 3, 1}, 8, 1), Catch::Contains("without samples"));
     CHECK(ghostLayers(2.0, glm::dvec3(1.0)) == 3);
 }
 

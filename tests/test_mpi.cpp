@@ -2,6 +2,7 @@
 // sequences equal the one-process run bit for bit, bricked frames equal it within 1e-5 of
 // the peak, a failing rank ends the job with one error. Hidden tag [.mpi]: registered with
 // ctest only when splat is built with MPI (tests/CMakeLists.txt).
+#if SPLAT_TEST_HAVE_MPI  // the whole file: splat built with MPI (SPLAT_MPI)
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <fstream>
@@ -270,3 +271,5 @@ TEST_CASE("mpi: a failing rank ends the job with one error on rank 0, no output,
     CHECK(usage == 1);
     CHECK(!fs::exists(dir / "never"));
 }
+
+#endif  // SPLAT_TEST_HAVE_MPI

@@ -39,15 +39,21 @@ BrickLayout splitBricks(const glm::ivec3& dims, int count, int ghost) {
             L.bricks.push_back(b);
             return node;
         }
-        // The longest axis that can still be cut into k pieces (ties: x, then y, then z).
+        // The longest axis (ties: x, then y, then z), cut so that the children own samples
+        // in the ratio of their bricks, k0 : k - k0, and at least one sample per brick.
         int axis = 0;
         for (int a = 1; a < 3; ++a)
             if (n[a] > n[axis]) axis = a;
         const int k0 = k / 2;
-        // Samples in the ratio k0 : k - k0, at least one per brick on each side... the
-        // children need n0 * (other sides) >= k0 samples; the longest axis always has them.
-        int cut = int(std::lround(double(n[axis]) * k0 / k));
-        cut = std::clamp(cut, 1, n[axis] - 1);
+        const std::int64_t area = std::int64_t(n.x) * n.y * n.z / n[axis];
+        const int least0 = int((k0 + area - 1) / area), least1 = int((k - k0 + area - 1) / area);
+        if (least0 + least1 > n[axis])
+            throw Error("bricks: " + std::to_string(count) +
+                        " bricks leave one without samples in a volume of " +
+                        std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" +
+                        std::to_string(dims.z));
+        const int cut =
+            std::clamp(int(std::lround(double(n[axis]) * k0 / k)), least0, n[axis] - least1);
         glm::ivec3 mid0 = hi, mid1 = lo;
         mid0[axis] = lo[axis] + cut;
         mid1[axis] = lo[axis] + cut;
@@ -59,15 +65,7 @@ BrickLayout splitBricks(const glm::ivec3& dims, int count, int ghost) {
         L.nodes[node].child[1] = c1;
         return node;
     };
-    // A brick needs at least one sample: more bricks than samples along the longest axis
-    // of a node would leave one empty, so K is limited by the samples per axis product.
     split(glm::ivec3(0), dims, count);
-    for (const Brick& b : L.bricks)
-        if (b.hi.x <= b.lo.x || b.hi.y <= b.lo.y || b.hi.z <= b.lo.z)
-            throw Error("bricks: " + std::to_string(count) +
-                        " bricks leave one without samples in a volume of " +
-                        std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" +
-                        std::to_string(dims.z));
     return L;
 }
 
