@@ -30,6 +30,8 @@ RunResult mpirun(int n, std::vector<std::string> args) {
     ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
     ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
     ::setenv("OMPI_MCA_btl", "self,vader", 0);  // one machine: shared memory, no network probe
+    // Containers often forbid the cross-memory attach of OpenMPI's shared-memory transport.
+    ::setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
     std::vector<std::string> a = {"-s", "KILL", "120", "mpirun"};
     if (openMpi()) a.push_back("--oversubscribe");
     for (const std::string& s : {std::string("-np"), std::to_string(n), std::string(SPLAT_EXE)})

@@ -18,7 +18,7 @@ import subprocess
 import sys
 
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-           OMPI_MCA_btl="self,vader")
+           OMPI_MCA_btl="self,vader", OMPI_MCA_btl_vader_single_copy_mechanism="none")
 # Only the skull is opaque (the phantom's 2.0 shell): few splats, so that the volume's
 # samples dominate the memory.
 SKULL_TF = {"domain": "normalized", "unit_distance": 1.0,

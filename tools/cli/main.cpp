@@ -113,7 +113,7 @@ int runCommand(int argc, char** argv) {
 
 int main(int argc, char** argv) {
     using namespace splat::cli;
-    // Under mpirun the ranks > 0 take part in rotate and popping only (parallel.h).
+    // Under mpirun the ranks > 0 take part in render, rotate and popping only (parallel.h).
     ParallelRun parallel(&argc, &argv);
     if (!parallel.refusal().empty()) {
         std::fprintf(stderr, "splat: error: %s\n", parallel.refusal().c_str());
