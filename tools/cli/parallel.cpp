@@ -1,6 +1,7 @@
 // The `splat` program under mpirun (parallel.h).
 #include "parallel.h"
 
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -77,6 +78,10 @@ void printError(const std::string& line) {
 
 void serveFrames(const std::function<Scene()>& build) {
 #if SPLAT_HAVE_MPI
+    // A launcher that forwards Ctrl-C to every rank (OpenMPI's mpirun kills the job instead):
+    // rank 0 stops the sequence and ends the job, so a worker ignores it and finishes the
+    // frames it holds.
+    std::signal(SIGINT, SIG_IGN);
     if (gSession && !gSession->leader()) mpi::serveFrames(*gSession, build);
 #else
     (void)build;
