@@ -125,27 +125,18 @@ RenderSettings brickSettings(const RenderSettings& frame, const Volume& whole, c
     s.camera.pixelSize = cam.pixelSize;
     s.background = glm::vec4(0.0f);
     s.quality.earlyTermination = 0;
-    // The owned box, half a sample beyond the owned samples; open on the volume's faces
-    // (the field reaches past them by the kernel's support).
-    const double far = 1e30;
-    glm::dvec3 lo, hi;
+    // The owned box, half a sample beyond the owned samples, as one clip plane per inner
+    // face (open on the volume's faces: the field reaches past them by the kernel's
+    // support). Planes, not a world-aligned crop box, so that any grid orientation works.
+    const glm::dvec3 o = whole.world(glm::dvec3(0.0));
     for (int a = 0; a < 3; ++a) {
-        lo[a] = brick.lo[a] == 0 ? -far : 0.0;
-        hi[a] = brick.hi[a] == dims[a] ? far : 0.0;
-    }
-    const glm::dvec3 wlo = whole.world(glm::dvec3(brick.lo) - 0.5),
-                     whi = whole.world(glm::dvec3(brick.hi) - 0.5);
-    for (int a = 0; a < 3; ++a) {
-        if (lo[a] == 0.0) lo[a] = std::min(wlo[a], whi[a]);
-        if (hi[a] == 0.0) hi[a] = std::max(wlo[a], whi[a]);
-    }
-    if (s.clipping.cropBox) {
-        s.clipping.boxMin = glm::max(s.clipping.boxMin, lo);
-        s.clipping.boxMax = glm::min(s.clipping.boxMax, hi);
-    } else {
-        s.clipping.cropBox = true;
-        s.clipping.boxMin = lo;
-        s.clipping.boxMax = hi;
+        glm::dvec3 e(0.0);
+        e[a] = 1.0;
+        const glm::dvec3 axis = glm::normalize(whole.world(e) - o);  // increasing index
+        glm::dvec3 face = glm::dvec3(brick.lo) - 0.5;
+        if (brick.lo[a] > 0) s.clipping.planes.push_back({whole.world(face), -axis});
+        face = glm::dvec3(brick.hi) - 0.5;
+        if (brick.hi[a] < dims[a]) s.clipping.planes.push_back({whole.world(face), axis});
     }
     return s;
 }
