@@ -52,16 +52,17 @@ inline std::string readTextFile(const std::filesystem::path& p) {
     return s.str();
 }
 
-/// Runs SPLAT_EXE with `args`; stdout and stderr are captured through files in the
-/// scratch folder (unique per call, removed afterwards).
-inline RunResult runSplat(const std::vector<std::string>& args) {
+/// Runs the program `exe` (a path, or a name looked up in PATH) with `args`; stdout and
+/// stderr are captured through files in the scratch folder (unique per call, removed
+/// afterwards).
+inline RunResult runProgram(const std::string& exe, const std::vector<std::string>& args) {
     static std::atomic<int> counter{0};
     std::filesystem::path dir = testTmpDir();
     std::string tag = std::to_string(::getpid()) + "_" + std::to_string(counter++);
     std::filesystem::path outPath = dir / (".run_" + tag + ".out");
     std::filesystem::path errPath = dir / (".run_" + tag + ".err");
 
-    std::vector<std::string> argv_s{SPLAT_EXE};
+    std::vector<std::string> argv_s{exe};
     argv_s.insert(argv_s.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (auto& a : argv_s) argv.push_back(a.data());
@@ -75,10 +76,10 @@ inline RunResult runSplat(const std::vector<std::string>& args) {
                                      0644);
     RunResult r;
     pid_t pid = 0;
-    int rc = posix_spawn(&pid, SPLAT_EXE, &actions, nullptr, argv.data(), environ);
+    int rc = posix_spawnp(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
     if (rc != 0) {
-        r.err = "posix_spawn failed for " + std::string(SPLAT_EXE);
+        r.err = "posix_spawn failed for " + exe;
         return r;
     }
     int wstatus = 0;
@@ -94,6 +95,11 @@ inline RunResult runSplat(const std::vector<std::string>& args) {
     std::filesystem::remove(outPath, ec);
     std::filesystem::remove(errPath, ec);
     return r;
+}
+
+/// Runs SPLAT_EXE with `args` (runProgram).
+inline RunResult runSplat(const std::vector<std::string>& args) {
+    return runProgram(SPLAT_EXE, args);
 }
 
 }  // namespace splat::test

@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "diagnostics.h"
+#include "parallel.h"
 #include "progress.h"
 #include "render_options.h"
 #include "resume_journal.h"
@@ -120,6 +121,11 @@ void registerPopping(CLI::App& app) {
         o.flip = !a->noFlip;
         // The Scene is validated against its first renderer (iso: the reference alone).
         settings.renderer = o.renderers.front();
+        if (workerProcess())  // under mpirun: render the frames rank 0 asks for (parallel.h)
+            return serveFrames([&] {
+                auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
+                return Scene(v, withDataDefaults(a->render, settings, *v));
+            });
         beginRun(*cmd);
         // The frames rendered so far are journaled, so that --resume after an interruption
         // renders only the rest; the journal goes once the report is written.

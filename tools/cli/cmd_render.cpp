@@ -2,8 +2,10 @@
 #include <cstdio>
 #include <memory>
 
+#include "bricked_render.h"
 #include "commands.h"
 #include "diagnostics.h"
+#include "parallel.h"
 #include "render_options.h"
 #include "scene_file.h"
 #include "splat/atomic_file.h"
@@ -18,6 +20,7 @@ struct RenderCommand {
     VolumeArgs volume;
     RenderArgs render;
     std::string output;
+    int bricks = 0;
 };
 }  // namespace
 
@@ -29,6 +32,10 @@ void registerRender(CLI::App& app) {
     addOption(*cmd, "-o,--output", args->output,
               "output image: .png (8-bit display), .exr or .tif (float, values as computed)",
               "Output", PathKind::Output);
+    addOption(*cmd, "--bricks", args->bricks,
+              "sort-last: cut the volume into K bricks, each loaded alone, rendered and "
+              "composited (0: off; under mpirun one per process)",
+              "Output");
     cmd->footer(
         "Examples:\n"
         "  splat render ch2.nii.gz --tf mri-head --azimuth 30 -o head.png\n"
@@ -42,6 +49,15 @@ void registerRender(CLI::App& app) {
         use.imageExt = lowerExtension(args->output);
         RenderSettings settings = settingsFromArgs(args->render, use);
         loadOptionsFromArgs(args->volume);  // malformed volume options: usage errors, now
+        if (args->bricks < 0 || args->bricks > 4096)
+            throw UsageError("--bricks must be between 0 and 4096");
+        if (args->bricks > 0 || processCount() > 1) {  // README "Beyond one machine"
+            if (!workerProcess()) beginRun(*cmd);
+            renderBrickedToFile(args->volume, args->render, settings,
+                                args->bricks > 0 ? args->bricks : processCount(), args->output);
+            if (!workerProcess()) finishRun(*cmd);
+            return;
+        }
         beginRun(*cmd);
         const Volume volume = loadVolumeFromArgs(args->volume);
         settings = withDataDefaults(args->render, settings, volume);

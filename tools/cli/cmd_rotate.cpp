@@ -21,6 +21,7 @@
 
 #include "commands.h"
 #include "diagnostics.h"
+#include "parallel.h"
 #include "progress.h"
 #include "render_options.h"
 #include "scene_file.h"
@@ -326,6 +327,11 @@ void registerRotate(CLI::App& app) {
         use.imageExt = "." + a->format;
         RenderSettings settings = settingsFromArgs(a->render, use);
         loadOptionsFromArgs(a->volume);
+        if (workerProcess())  // under mpirun: render the frames rank 0 asks for (parallel.h)
+            return serveFrames([&] {
+                auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
+                return Scene(v, withDataDefaults(a->render, settings, *v));
+            });
         std::string ffmpeg;
         if (!a->mp4.empty()) {
             ffmpeg = findProgram("ffmpeg");

@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "diagnostics.h"
+#include "parallel.h"
 
 namespace {
 
@@ -45,9 +46,7 @@ std::string usageText(const CLI::App& app) {
     return s;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int runCommand(int argc, char** argv) {
     using namespace splat::cli;
     CLI::App app{
         "splat: splatting volume renderer (axis-aligned and image-aligned sheet "
@@ -98,14 +97,28 @@ int main(int argc, char** argv) {
         for (const CLI::App* c : app.get_subcommands()) where += " " + c->get_name();
         std::string what = e.what();
         std::replace(what.begin(), what.end(), '\n', ' ');
-        std::fprintf(stderr, "splat: error: %s (see '%s --help')\n", what.c_str(), where.c_str());
+        printError(what + " (see '" + where + " --help')");
         return kExitUsage;
     } catch (const UsageError& e) {
-        std::fprintf(stderr, "splat: error: %s\n", e.what());
+        printError(e.what());
         return kExitUsage;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "splat: error: %s\n", e.what());
+        printError(e.what());
         return kExitFailure;
     }
     return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    using namespace splat::cli;
+    // Under mpirun the ranks > 0 take part in render, rotate and popping only (parallel.h).
+    ParallelRun parallel(&argc, &argv);
+    if (!parallel.refusal().empty()) {
+        std::fprintf(stderr, "splat: error: %s\n", parallel.refusal().c_str());
+        return kExitUsage;
+    }
+    if (workerProcess() && (argc < 2 || !workersTakePart(argv[1]))) return parallel.finish(0);
+    return parallel.finish(runCommand(argc, argv));
 }

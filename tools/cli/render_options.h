@@ -50,6 +50,8 @@ RenderSettings settingsFromArgs(RenderArgs& args, const RenderUse& use);
 /// Defaults that depend on the data: with no --tf (nor an inline one), dvr of a volume that
 /// looksLikeHounsfield renders with the preset ct-hu; says so on stderr.
 RenderSettings withDataDefaults(const RenderArgs& a, RenderSettings s, const Volume& volume);
+/// A free camera's look-at point left unset (NaN) becomes the volume's centre.
+RenderSettings withFreeCameraTarget(RenderSettings s, const Volume& volume);
 
 WriteOptions displayOptions(const RenderArgs& args, const RenderSettings& s, const Image& image);
 

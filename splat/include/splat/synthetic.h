@@ -29,6 +29,10 @@ int syntheticDefaultSize(const std::string& name);
 ///   [-1, 1]^3, values in [0, 1].
 /// Throws splat::Error for an unknown name or N outside [1, 2048].
 Volume makeSynthetic(const std::string& name, int n);
+/// The samples [lo, hi) of makeSynthetic(name, n) alone (a brick, splat/bricks.h), origin
+/// lo: only they are computed and held.
+Volume makeSyntheticBrick(const std::string& name, int n, const glm::ivec3& lo,
+                          const glm::ivec3& hi);
 
 /// Radius in voxels of the `sphere` volume, 0.375 N.
 inline double syntheticSphereRadius(int n) { return 0.375 * n; }

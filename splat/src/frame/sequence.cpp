@@ -11,8 +11,15 @@
 #include <nlohmann/json.hpp>
 
 #include "splat/error.h"
+#include "splat/frame_farm.h"
 
 namespace splat {
+
+// frame_farm.cpp: the views rendered by an installed FrameFarm (splat/frame_farm.h).
+void renderSequenceOnFarm(FrameFarm& farm, const Scene& scene,
+                          const std::vector<RendererKind>& renderers, const CameraPath& path,
+                          const std::vector<std::size_t>& views, const SequenceOptions& options,
+                          const std::function<void(SequenceFrame&&)>& sink);
 
 namespace {
 constexpr int kMaxFrames = 100000;
@@ -34,8 +41,9 @@ CameraPath CameraPath::turn(const CameraParams& base, Angle angle, double from, 
         throw Error("a sequence needs 1 to " + std::to_string(kMaxFrames) + " frames");
     if (!std::isfinite(from) || !std::isfinite(to)) throw Error("--from/--to must be finite");
     if (base.lookAtSet)
-        throw Error("a turn orbits the volume centre by azimuth or elevation; a free camera "
-                    "(--eye/--look-at) does not turn: give its views as a camera path");
+        throw Error(
+            "a turn orbits the volume centre by azimuth or elevation; a free camera "
+            "(--eye/--look-at) does not turn: give its views as a camera path");
     CameraPath p;
     for (int f = 0; f < frames; ++f) {
         const double t =
@@ -104,6 +112,8 @@ void renderSequence(const Scene& scene, const std::vector<RendererKind>& rendere
     std::vector<std::size_t> views;
     for (std::size_t v = 0; v < path.views.size(); ++v)
         if (!options.skip || !options.skip(v)) views.push_back(v);
+    if (FrameFarm* farm = installedFrameFarm())
+        return renderSequenceOnFarm(*farm, scene, renderers, path, views, options, sink);
     const std::size_t total = views.size() * renderers.size();
     std::size_t done = 0;
     std::mutex progressMutex;

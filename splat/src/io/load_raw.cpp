@@ -11,10 +11,8 @@ namespace fs = std::filesystem;
 
 namespace splat::detail {
 
-Volume loadRaw(const fs::path& p, const RawOptions& options) {
+RawLayout rawLayout(const fs::path& p, const RawOptions& options) {
     const std::string name = displayName(p);
-    const std::uint64_t fileSize = regularFileSize(p);
-    const bool gz = lowerExtension(p) == ".raw.gz";
 
     std::optional<glm::ivec3> dims = options.dims;
     std::string typeName = options.type;
@@ -44,6 +42,18 @@ Volume loadRaw(const fs::path& p, const RawOptions& options) {
     if (!type)
         throw Error(name + ": unsupported sample type '" + typeName +
                     "' (uint8, int8, uint16, int16, uint32, int32, float32, float64)");
+    (void)volumeBytes(*dims, *type, name);  // dimensions and count checked
+    return {*dims, *type, options.headerBytes};
+}
+
+Volume loadRaw(const fs::path& p, const RawOptions& options) {
+    const std::string name = displayName(p);
+    const std::uint64_t fileSize = regularFileSize(p);
+    const bool gz = lowerExtension(p) == ".raw.gz";
+    const RawLayout L = rawLayout(p, options);
+    const std::optional<glm::ivec3> dims = L.dims;
+    const std::optional<SampleType> type = L.type;
+    const std::string file = p.filename().string();
     const std::size_t dataBytes = volumeBytes(*dims, *type, name);
     const std::uint64_t expected = checkedAdd(options.headerBytes, dataBytes, name);
     std::vector<unsigned char> bytes;

@@ -52,12 +52,13 @@ double marschnerLobb(double x, double y, double z) {
     return (1 - std::sin(M_PI * z / 2) + alpha * (1 + rr)) / (2 * (1 + alpha));
 }
 
+/// Fills `v`, the box of samples from `lo` on, with f(i, j, k) of the whole volume's indices.
 template <typename F>
-void fill(Volume& v, F f) {
-    const int n = v.dims.x;
-    for (int k = 0; k < n; ++k)
-        for (int j = 0; j < n; ++j)
-            for (int i = 0; i < n; ++i) v.at(i, j, k) = float(f(i, j, k));
+void fill(Volume& v, const glm::ivec3& lo, F f) {
+    for (int k = 0; k < v.dims.z; ++k)
+        for (int j = 0; j < v.dims.y; ++j)
+            for (int i = 0; i < v.dims.x; ++i)
+                v.at(i, j, k) = float(f(lo.x + i, lo.y + j, lo.z + k));
 }
 
 }  // namespace
@@ -71,6 +72,11 @@ int syntheticDefaultSize(const std::string& name) {
 }
 
 Volume makeSynthetic(const std::string& name, int n) {
+    return makeSyntheticBrick(name, n, glm::ivec3(0), glm::ivec3(std::clamp(n, 1, 2048)));
+}
+
+Volume makeSyntheticBrick(const std::string& name, int n, const glm::ivec3& lo,
+                          const glm::ivec3& hi) {
     bool known = false;
     for (const auto& s : syntheticNames()) known = known || s == name;
     if (!known) {
@@ -81,37 +87,41 @@ Volume makeSynthetic(const std::string& name, int n) {
     if (n < 1 || n > 2048)
         throw Error("synthetic:" + name + ":" + std::to_string(n) +
                     ": size must be between 1 and 2048");
-    Volume v = makeVolume({n, n, n}, glm::dvec3(1.0), "synthetic:" + name);
+    if (glm::any(glm::lessThan(lo, glm::ivec3(0))) ||
+        glm::any(glm::greaterThan(hi, glm::ivec3(n))) || glm::any(glm::lessThanEqual(hi, lo)))
+        throw Error("synthetic:" + name + ":" + std::to_string(n) + ": empty or outside brick");
+    Volume v = makeVolume(hi - lo, glm::dvec3(1.0), "synthetic:" + name);
+    v.origin = glm::dvec3(lo);
     const double c = (n - 1) * 0.5;
     if (name == "phantom" || name == "ct-phantom") {
         // Index -> phantom coordinates: the cube [-1, 1]^3 spans the N samples. The
         // phantom's longest axis (y, semi-axis 0.92) becomes world +z so the head is
         // upright; phantom z becomes world -y (keeps the frame right-handed).
         const double s = 2.0 / n;
-        fill(v, [&](int i, int j, int k) {
+        fill(v, lo, [&](int i, int j, int k) {
             return phantomAt((i - c) * s, (k - c) * s, -(j - c) * s);
         });
     } else if (name == "blob") {
         const double sigma = syntheticBlobSigma(n);
-        fill(v, [&](int i, int j, int k) {
+        fill(v, lo, [&](int i, int j, int k) {
             double r2 = (i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c);
             return std::exp(-r2 / (2 * sigma * sigma));
         });
     } else if (name == "cube") {
         const double h = n / 4.0;
-        fill(v, [&](int i, int j, int k) {
+        fill(v, lo, [&](int i, int j, int k) {
             return std::abs(i - c) < h && std::abs(j - c) < h && std::abs(k - c) < h ? 1.0 : 0.0;
         });
     } else if (name == "sphere") {
         const double r = syntheticSphereRadius(n), w = syntheticSphereEdge();
-        fill(v, [&](int i, int j, int k) {
+        fill(v, lo, [&](int i, int j, int k) {
             const double d = std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c));
             const double t = std::clamp((r + w - d) / (2.0 * w), 0.0, 1.0);
             return t * t * t * (10.0 + t * (6.0 * t - 15.0));  // smootherstep
         });
     } else {  // marschner-lobb over [-1, 1]^3, sample 0 at -1 and sample N-1 at +1
         const double s = n > 1 ? 2.0 / (n - 1) : 0.0;
-        fill(v, [&](int i, int j, int k) {
+        fill(v, lo, [&](int i, int j, int k) {
             return marschnerLobb(-1 + i * s, -1 + j * s, -1 + k * s);
         });
     }

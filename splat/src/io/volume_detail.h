@@ -111,6 +111,16 @@ Volume loadNifti(const std::filesystem::path& p);
 Volume loadNrrd(const std::filesystem::path& p, const LoadOptions& options);
 Volume loadMetaImage(const std::filesystem::path& p, const LoadOptions& options);
 Volume loadRaw(const std::filesystem::path& p, const RawOptions& options);
+/// Where a headerless .raw file's samples are: its dims, type and first byte (the name
+/// convention or RawOptions); dimensions and sample count checked, the file size not.
+struct RawLayout {
+    glm::ivec3 dims{0};
+    SampleType type = SampleType::U8;
+    std::uint64_t offset = 0;
+};
+RawLayout rawLayout(const std::filesystem::path& p, const RawOptions& options);
+/// "synthetic:NAME[:N]" as its name and size (the default size when N is not given).
+std::pair<std::string, int> syntheticSpec(const std::string& spec);
 Volume loadSliceFolder(const std::filesystem::path& dir, const LoadOptions& options);
 /// DICOM files through GDCM (load_dicom.cpp): one series, sorted along the slice normal.
 Volume loadDicomFiles(const std::string& name, const std::vector<std::filesystem::path>& files,

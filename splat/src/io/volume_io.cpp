@@ -16,22 +16,7 @@ namespace splat {
 namespace {
 
 Volume loadSynthetic(const std::string& spec) {
-    // synthetic:NAME[:N]
-    std::string rest = spec.substr(std::strlen("synthetic:"));
-    std::string name = rest;
-    int n = 0;
-    std::size_t colon = rest.find(':');
-    if (colon != std::string::npos) {
-        name = rest.substr(0, colon);
-        std::string num = rest.substr(colon + 1);
-        char* end = nullptr;
-        long value = std::strtol(num.c_str(), &end, 10);
-        if (num.empty() || *end || value < 1 || value > 2048)
-            throw Error(spec + ": size must be an integer between 1 and 2048");
-        n = int(value);
-    } else {
-        n = syntheticDefaultSize(name);
-    }
+    const auto [name, n] = detail::syntheticSpec(spec);
     return makeSynthetic(name, n);
 }
 
@@ -84,6 +69,26 @@ Volume loadByType(const fs::path& p, const std::string& ext, const LoadOptions& 
 }
 
 }  // namespace
+
+std::pair<std::string, int> detail::syntheticSpec(const std::string& spec) {
+    // synthetic:NAME[:N]
+    std::string rest = spec.substr(std::strlen("synthetic:"));
+    std::string name = rest;
+    int n = 0;
+    std::size_t colon = rest.find(':');
+    if (colon != std::string::npos) {
+        name = rest.substr(0, colon);
+        std::string num = rest.substr(colon + 1);
+        char* end = nullptr;
+        long value = std::strtol(num.c_str(), &end, 10);
+        if (num.empty() || *end || value < 1 || value > 2048)
+            throw Error(spec + ": size must be an integer between 1 and 2048");
+        n = int(value);
+    } else {
+        n = syntheticDefaultSize(name);
+    }
+    return {name, n};
+}
 
 Volume loadVolume(const std::string& spec, const LoadOptions& options) {
     Volume v;

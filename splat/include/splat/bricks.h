@@ -1,0 +1,162 @@
+#pragma once
+// Sort-last bricked rendering (issue 26, splat/DESIGN.md "Beyond one machine"), the parts
+// that do not need MPI: the volume is cut into K bricks by a k-d tree (uneven splits for odd
+// dimensions and K not a power of 2), each brick loaded with ghost layers as wide as the
+// kernel's support; a brick is rendered by the unchanged renderers with the whole volume's
+// rays (a free camera) clipped to the box the brick owns, and the partial images are
+// composited in visibility order (front first): dvr and iso over, mip max, xray sum.
+//
+// Exact: every ray is cut into the convex pieces the bricks own, and within its own box a
+// brick's field equals the whole volume's (its ghost layers hold every sample whose kernel
+// reaches the box). The reference ray caster integrates each piece with the same error
+// control, so bricked frames match one-process frames within the reference tolerance (tests:
+// test_bricks.cpp); the splatters cut their sheet pixels' paths at the brick faces
+// (frame/clip_cut.h) and their seam error is measured there.
+#include <functional>
+#include <glm/glm.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "splat/image.h"
+#include "splat/settings.h"
+#include "splat/volume.h"
+
+namespace splat {
+
+struct Brick {
+    glm::ivec3 lo{0}, hi{0};          ///< the samples the brick owns, [lo, hi)
+    glm::ivec3 loadLo{0}, loadHi{0};  ///< with the ghost layers, clamped to the volume
+    std::size_t loadedSamples() const {
+        const glm::ivec3 n = loadHi - loadLo;
+        return std::size_t(n.x) * std::size_t(n.y) * std::size_t(n.z);
+    }
+};
+
+/// The k-d tree of the bricks: node 0 is the root; a leaf holds a brick.
+struct BrickLayout {
+    glm::ivec3 dims{0};
+    int ghost = 0;
+    std::vector<Brick> bricks;
+    struct Node {
+        int axis = -1;  ///< -1: a leaf
+        int split = 0;  ///< children own [.., split) and [split, ..) along axis
+        int child[2] = {-1, -1};
+        int brick = -1;
+    };
+    std::vector<Node> nodes;
+};
+
+/// Cuts `dims` into `count` bricks (1 <= count <= the number of samples): the longest axis
+/// of a node is split so that its two children, of floor(k/2) and ceil(k/2) bricks, own
+/// samples in that ratio. Ghost layers: `ghost` samples on every inner face.
+BrickLayout splitBricks(const glm::ivec3& dims, int count, int ghost);
+
+/// Ghost layers a kernel of support radius `radius` (in units of the smallest spacing)
+/// needs on a grid of `spacing`: every sample whose kernel reaches the owned box, plus one
+/// layer for the central-difference gradients.
+int ghostLayers(double radius, const glm::dvec3& spacing);
+
+/// The bricks of `layout` front to back as seen by `camera` of a volume of geometry `whole`
+/// (dims, spacing, origin; samples not needed): a k-d tree traversal, near child first.
+std::vector<int> visibilityOrder(const BrickLayout& layout, const Volume& whole,
+                                 const CameraParams& camera);
+
+/// The geometry of `brick` (its loaded box) in the volume `whole`: dims, spacing, origin,
+/// background and source; no samples.
+Volume brickGeometry(const Volume& whole, const Brick& brick);
+
+/// The settings that render `brick` as its part of `frame` of the volume `whole`: the whole
+/// volume's rays (a free camera with its eye, target, up and pixel size), clipped to the box
+/// the brick owns (open where it is the volume's face), a transparent background, no early
+/// termination (a ray's opacity is not known within one brick).
+RenderSettings brickSettings(const RenderSettings& frame, const Volume& whole, const Brick& brick,
+                             const glm::ivec3& dims);
+
+/// Composites the partial images of one frame, front first, as `mode` combines pieces of a
+/// ray (dvr, iso: over; mip: max; xray: sum), then lays `background` behind (dvr, iso).
+Image compositeBricks(const std::vector<const Image*>& frontToBack, RenderMode mode,
+                      const glm::vec4& background);
+
+}  // namespace splat
+
+namespace splat {
+
+struct LoadOptions;
+
+/// The geometry of the volume `spec` names (dims, spacing, origin, background and its
+/// source, the source's description; no samples). `alone` says whether loadVolumeBrick
+/// reads a brick's samples alone: synthetic volumes (only the brick is computed) and
+/// uncompressed .raw files (byte ranges, one read per row of the brick). Any other file
+/// (compressed, or a format whose samples are not read by range yet) is loaded whole here
+/// and by loadVolumeBrick, which keeps the brick.
+Volume volumeGeometry(const std::string& spec, const LoadOptions& options, bool* alone);
+
+/// The samples [lo, hi) of the volume `spec` names, origin at sample lo; a brick beyond the
+/// end of a truncated file throws splat::Error naming the file and the bytes missing.
+Volume loadVolumeBrick(const std::string& spec, const LoadOptions& options, const glm::ivec3& lo,
+                       const glm::ivec3& hi);
+
+}  // namespace splat
+
+namespace splat {
+
+struct BrickStats {
+    int bricks = 0;                 ///< in the frame
+    int rendered = 0;               ///< by this process
+    std::size_t samplesLoaded = 0;  ///< the largest brick this process held, ghost layers included
+    std::size_t splats = 0;         ///< splats of the bricks this process rendered
+    std::uint64_t bytesExchanged = 0;  ///< sent + received by this process (compositing)
+    /// Load the samples, build the bricks' Scenes (classification), render their frames,
+    /// composite (this process's part of the collective).
+    double loadMs = 0, sceneMs = 0, renderMs = 0, compositeMs = 0;
+};
+
+/// The processes that render the bricks of a frame together, and the three things they do
+/// together (the seam of the MPI module: splat::mpi implements it over MPI; LocalBrickGroup
+/// is one process holding every brick). Process r renders the bricks b with b % size == r.
+class BrickGroup {
+  public:
+    virtual ~BrickGroup() = default;
+    virtual int rank() const = 0;
+    virtual int size() const = 0;
+    /// Every process says whether its part succeeded (`error` empty); when one failed, every
+    /// process throws splat::Error with the first failed one's message.
+    virtual void agree(const std::string& error) = 0;
+    /// The smallest lo and largest hi over the processes.
+    virtual void range(float& lo, float& hi) = 0;
+    /// Composites the partial images (brick index, image) of all processes in the order
+    /// `frontToBack` (compositeBricks) and returns the frame on process 0 (others: empty).
+    /// Adds the bytes this process sent and received to `bytes`.
+    virtual Image composite(std::vector<std::pair<int, Image>>& partials,
+                            const std::vector<int>& frontToBack, int width, int height,
+                            RenderMode mode, const glm::vec4& background, std::uint64_t* bytes) = 0;
+    /// Every process's stats, on process 0 (rank order; others: empty).
+    virtual std::vector<BrickStats> gather(const BrickStats& mine) = 0;
+};
+
+/// One process, every brick: what `splat render --bricks K` does without mpirun (each
+/// brick is loaded, rendered and freed in turn, so memory follows the largest brick).
+class LocalBrickGroup : public BrickGroup {
+  public:
+    int rank() const override { return 0; }
+    int size() const override { return 1; }
+    void agree(const std::string& error) override;
+    void range(float&, float&) override {}
+    Image composite(std::vector<std::pair<int, Image>>& partials,
+                    const std::vector<int>& frontToBack, int width, int height, RenderMode mode,
+                    const glm::vec4& background, std::uint64_t* bytes) override;
+    std::vector<BrickStats> gather(const BrickStats& mine) override { return {mine}; }
+};
+
+/// Renders `frame` of the volume of geometry `geometry` cut into `bricks` bricks: this
+/// process loads (`load`: the samples of a brick's loaded box, background as `geometry`'s)
+/// and renders its bricks, and the group composites the frame. The transfer function and a
+/// normalised iso level are resolved against the whole volume's range (the group's). Edge
+/// enhancement (its scale is the whole volume's largest gradient) and labels are refused.
+/// Returns the frame on process 0.
+Image renderBricked(const Volume& geometry, const std::function<Volume(const Brick&)>& load,
+                    const RenderSettings& frame, int bricks, BrickGroup& group,
+                    BrickStats* stats = nullptr);
+
+}  // namespace splat

@@ -1,0 +1,138 @@
+// Sort-last bricks over MPI (splat/mpi/brick_group.h).
+#include "splat/mpi/brick_group.h"
+
+#include <mpi.h>
+
+#include <cstring>
+#include <type_traits>
+
+#include "splat/error.h"
+
+namespace splat::mpi {
+
+namespace {
+
+constexpr int kMessage = 512;  // characters of an error message sent in agree()
+
+/// Rows [first, end) of the image strip owned by rank r of p.
+int stripBegin(int height, int r, int p) { return int(std::int64_t(height) * r / p); }
+
+class MpiBrickGroup : public BrickGroup {
+  public:
+    explicit MpiBrickGroup(Session& s) : s_(s) {}
+    int rank() const override { return s_.rank(); }
+    int size() const override { return s_.size(); }
+
+    void agree(const std::string& error) override {
+        int ok = error.empty() ? 1 : 0, all = 0;
+        MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+        if (all) return;
+        // Every rank learns the first failed rank's message.
+        std::vector<char> mine(kMessage, '\0'), every(std::size_t(kMessage) * size());
+        std::strncpy(mine.data(), error.c_str(), kMessage - 1);
+        MPI_Allgather(mine.data(), kMessage, MPI_CHAR, every.data(), kMessage, MPI_CHAR,
+                      MPI_COMM_WORLD);
+        for (int r = 0; r < size(); ++r) {
+            const char* m = every.data() + std::size_t(r) * kMessage;
+            if (*m)
+                throw Error("rank " + std::to_string(r) + " of " + std::to_string(size()) + ": " +
+                            std::string(m, strnlen(m, kMessage)));
+        }
+        throw Error("a rank failed");
+    }
+
+    void range(float& lo, float& hi) override {
+        float in[2] = {lo, -hi}, out[2];
+        MPI_Allreduce(in, out, 2, MPI_FLOAT, MPI_MIN, MPI_COMM_WORLD);
+        lo = out[0];
+        hi = -out[1];
+    }
+
+    Image composite(std::vector<std::pair<int, Image>>& partials,
+                    const std::vector<int>& frontToBack, int width, int height, RenderMode mode,
+                    const glm::vec4& background, std::uint64_t* bytes) override {
+        const int p = size();
+        const int bricks = int(frontToBack.size());
+        const std::size_t rowFloats = std::size_t(width) * 4;
+        // Send: for each destination rank, the destination's strip of each of my partials
+        // (in my brick order).
+        std::vector<int> sendCounts(p, 0), sendOffsets(p, 0), recvCounts(p, 0), recvOffsets(p, 0);
+        std::vector<float> send;
+        for (int d = 0; d < p; ++d) {
+            sendOffsets[d] = int(send.size());
+            const int r0 = stripBegin(height, d, p), r1 = stripBegin(height, d + 1, p);
+            for (const auto& [b, image] : partials) {
+                const float* from = &image.pixels[std::size_t(r0) * width].x;
+                send.insert(send.end(), from, from + std::size_t(r1 - r0) * rowFloats);
+            }
+            sendCounts[d] = int(send.size()) - sendOffsets[d];
+        }
+        // Receive: from each source rank, my strip of each of its bricks (b % p == source).
+        const int m0 = stripBegin(height, rank(), p), m1 = stripBegin(height, rank() + 1, p);
+        const std::size_t stripFloats = std::size_t(m1 - m0) * rowFloats;
+        int total = 0;
+        for (int q = 0; q < p; ++q) {
+            int count = 0;
+            for (int b = q; b < bricks; b += p) ++count;
+            recvOffsets[q] = total;
+            recvCounts[q] = int(std::size_t(count) * stripFloats);
+            total += recvCounts[q];
+        }
+        std::vector<float> recv(static_cast<std::size_t>(total));
+        MPI_Alltoallv(send.data(), sendCounts.data(), sendOffsets.data(), MPI_FLOAT, recv.data(),
+                      recvCounts.data(), recvOffsets.data(), MPI_FLOAT, MPI_COMM_WORLD);
+        std::uint64_t moved = 0;
+        for (int q = 0; q < p; ++q)
+            if (q != rank()) moved += 4ull * (std::uint64_t(sendCounts[q]) + recvCounts[q]);
+        partials.clear();  // the partial images are no longer needed
+        std::vector<Image> strips(static_cast<std::size_t>(bricks));
+        for (int q = 0; q < p; ++q) {
+            std::size_t at = std::size_t(recvOffsets[q]);
+            for (int b = q; b < bricks; b += p, at += stripFloats) {
+                strips[std::size_t(b)] = Image(width, m1 - m0);
+                std::memcpy(strips[std::size_t(b)].pixels.data(), recv.data() + at,
+                            stripFloats * sizeof(float));
+            }
+        }
+        recv.clear();
+        std::vector<const Image*> ordered;
+        for (int b : frontToBack) ordered.push_back(&strips[std::size_t(b)]);
+        const Image strip = m1 > m0 ? compositeBricks(ordered, mode, background) : Image();
+        // Gather the strips on rank 0.
+        std::vector<int> counts(p), offsets(p);
+        for (int q = 0; q < p; ++q) {
+            offsets[q] = int(std::size_t(stripBegin(height, q, p)) * rowFloats);
+            counts[q] = int(std::size_t(stripBegin(height, q + 1, p) - stripBegin(height, q, p)) *
+                            rowFloats);
+        }
+        Image out = rank() == 0 ? Image(width, height) : Image();
+        MPI_Gatherv(strip.pixels.empty() ? nullptr : &strip.pixels[0].x, counts[rank()], MPI_FLOAT,
+                    rank() == 0 ? &out.pixels[0].x : nullptr, counts.data(), offsets.data(),
+                    MPI_FLOAT, 0, MPI_COMM_WORLD);
+        if (rank() == 0)
+            for (int q = 1; q < p; ++q) moved += 4ull * std::uint64_t(counts[q]);
+        else
+            moved += 4ull * std::uint64_t(counts[rank()]);
+        if (bytes) *bytes += moved;
+        return out;
+    }
+
+    std::vector<BrickStats> gather(const BrickStats& mine) override {
+        static_assert(std::is_trivially_copyable_v<BrickStats>);
+        std::vector<BrickStats> all(rank() == 0 ? std::size_t(size()) : 0);
+        MPI_Gather(&mine, int(sizeof mine), MPI_BYTE, all.data(), int(sizeof mine), MPI_BYTE, 0,
+                   MPI_COMM_WORLD);
+        return all;
+    }
+
+  private:
+    Session& s_;
+};
+
+}  // namespace
+
+std::unique_ptr<BrickGroup> makeBrickGroup(Session& session) {
+    return std::make_unique<MpiBrickGroup>(session);
+}
+
+}  // namespace splat::mpi

@@ -1,0 +1,274 @@
+// Sort-last bricks (splat/bricks.h).
+#include "splat/bricks.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include "footprint/kernel.h"
+#include "splat/camera.h"
+#include "splat/error.h"
+#include "splat/scene.h"
+
+namespace splat {
+
+BrickLayout splitBricks(const glm::ivec3& dims, int count, int ghost) {
+    const std::size_t samples = std::size_t(dims.x) * std::size_t(dims.y) * std::size_t(dims.z);
+    if (count < 1 || std::size_t(count) > samples)
+        throw Error("bricks: " + std::to_string(count) + " bricks of a volume of " +
+                    std::to_string(samples) + " samples");
+    if (ghost < 0) throw Error("bricks: ghost layers must be >= 0");
+    BrickLayout L;
+    L.dims = dims;
+    L.ghost = ghost;
+    std::function<int(glm::ivec3, glm::ivec3, int)> split = [&](glm::ivec3 lo, glm::ivec3 hi,
+                                                                int k) {
+        const int node = int(L.nodes.size());
+        L.nodes.emplace_back();
+        const glm::ivec3 n = hi - lo;
+        if (k == 1) {
+            Brick b;
+            b.lo = lo;
+            b.hi = hi;
+            b.loadLo = glm::max(lo - ghost, glm::ivec3(0));
+            b.loadHi = glm::min(hi + ghost, dims);
+            L.nodes[node].brick = int(L.bricks.size());
+            L.bricks.push_back(b);
+            return node;
+        }
+        // The longest axis (ties: x, then y, then z), cut so that the children own samples
+        // in the ratio of their bricks, k0 : k - k0, and at least one sample per brick.
+        int axis = 0;
+        for (int a = 1; a < 3; ++a)
+            if (n[a] > n[axis]) axis = a;
+        const int k0 = k / 2;
+        const std::int64_t area = std::int64_t(n.x) * n.y * n.z / n[axis];
+        const int least0 = int((k0 + area - 1) / area), least1 = int((k - k0 + area - 1) / area);
+        if (least0 + least1 > n[axis])
+            throw Error("bricks: " + std::to_string(count) +
+                        " bricks leave one without samples in a volume of " +
+                        std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" +
+                        std::to_string(dims.z));
+        const int cut =
+            std::clamp(int(std::lround(double(n[axis]) * k0 / k)), least0, n[axis] - least1);
+        glm::ivec3 mid0 = hi, mid1 = lo;
+        mid0[axis] = lo[axis] + cut;
+        mid1[axis] = lo[axis] + cut;
+        L.nodes[node].axis = axis;
+        L.nodes[node].split = lo[axis] + cut;
+        const int c0 = split(lo, mid0, k0);
+        const int c1 = split(mid1, hi, k - k0);
+        L.nodes[node].child[0] = c0;
+        L.nodes[node].child[1] = c1;
+        return node;
+    };
+    split(glm::ivec3(0), dims, count);
+    return L;
+}
+
+int ghostLayers(double radius, const glm::dvec3& spacing) {
+    // radius is in units of the smallest spacing, so no axis has more than ceil(radius)
+    // samples within it of the owned box.
+    (void)spacing;
+    return int(std::ceil(radius)) + 1;
+}
+
+std::vector<int> visibilityOrder(const BrickLayout& layout, const Volume& whole,
+                                 const CameraParams& params) {
+    const Camera cam(params, whole);
+    std::vector<int> order;
+    std::function<void(int)> visit = [&](int node) {
+        const BrickLayout::Node& n = layout.nodes[std::size_t(node)];
+        if (n.axis < 0) {
+            order.push_back(n.brick);
+            return;
+        }
+        glm::dvec3 p(0.0), q(0.0);
+        p[n.axis] = n.split - 0.5;
+        q[n.axis] = n.split + 0.5;
+        const glm::dvec3 a = whole.world(p), b = whole.world(q);  // the plane between them
+        const glm::dvec3 normal = b - a, point = 0.5 * (a + b);
+        // Near child: the one on the eye's side (perspective) or the one the rays cross
+        // first (orthographic: rays run along view).
+        const double side =
+            cam.perspective() ? glm::dot(cam.eye - point, normal) : -glm::dot(cam.view, normal);
+        const int nearChild = side < 0 ? 0 : 1;
+        visit(n.child[nearChild]);
+        visit(n.child[1 - nearChild]);
+    };
+    visit(0);
+    return order;
+}
+
+Volume brickGeometry(const Volume& whole, const Brick& brick) {
+    Volume v;
+    v.dims = brick.loadHi - brick.loadLo;
+    v.spacing = whole.spacing;
+    v.origin = whole.world(glm::dvec3(brick.loadLo));
+    v.background = whole.background;
+    v.backgroundSource = whole.backgroundSource;
+    v.source = whole.source;
+    return v;
+}
+
+RenderSettings brickSettings(const RenderSettings& frame, const Volume& whole, const Brick& brick,
+                             const glm::ivec3& dims) {
+    RenderSettings s = frame;
+    const Camera cam(frame.camera, whole);
+    s.camera.lookAtSet = true;
+    s.camera.lookAt = cam.target;
+    s.camera.eye = cam.eye;
+    s.camera.upHint = cam.up;
+    s.camera.pixelSize = cam.pixelSize;
+    s.background = glm::vec4(0.0f);
+    s.quality.earlyTermination = 0;
+    // The owned box, half a sample beyond the owned samples, as one clip plane per inner
+    // face (open on the volume's faces: the field reaches past them by the kernel's
+    // support). Planes, not a world-aligned crop box, so that any grid orientation works.
+    const glm::dvec3 o = whole.world(glm::dvec3(0.0));
+    for (int a = 0; a < 3; ++a) {
+        glm::dvec3 e(0.0);
+        e[a] = 1.0;
+        const glm::dvec3 axis = glm::normalize(whole.world(e) - o);  // increasing index
+        glm::dvec3 face = glm::dvec3(brick.lo) - 0.5;
+        if (brick.lo[a] > 0) s.clipping.planes.push_back({whole.world(face), -axis});
+        face = glm::dvec3(brick.hi) - 0.5;
+        if (brick.hi[a] < dims[a]) s.clipping.planes.push_back({whole.world(face), axis});
+    }
+    return s;
+}
+
+Image compositeBricks(const std::vector<const Image*>& frontToBack, RenderMode mode,
+                      const glm::vec4& background) {
+    if (frontToBack.empty()) throw Error("bricks: no partial image to composite");
+    Image out = *frontToBack.front();
+    for (std::size_t b = 1; b < frontToBack.size(); ++b) {
+        const Image& im = *frontToBack[b];
+        if (im.width != out.width || im.height != out.height)
+            throw Error("bricks: partial images differ in size");
+        for (std::size_t p = 0; p < out.pixels.size(); ++p) {
+            glm::vec4& o = out.pixels[p];
+            const glm::vec4& c = im.pixels[p];
+            if (mode == RenderMode::Mip)
+                o = glm::max(o, c);
+            else if (mode == RenderMode::Xray)
+                o = glm::vec4(glm::vec3(o) + glm::vec3(c), 1.0f);
+            else
+                o += (1.0f - o.a) * c;
+        }
+    }
+    if (mode == RenderMode::Dvr || mode == RenderMode::Iso)
+        for (glm::vec4& o : out.pixels) o += (1.0f - o.a) * background;
+    return out;
+}
+
+}  // namespace splat
+
+namespace splat {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+}  // namespace
+
+void LocalBrickGroup::agree(const std::string& error) {
+    if (!error.empty()) throw Error(error);
+}
+
+Image LocalBrickGroup::composite(std::vector<std::pair<int, Image>>& partials,
+                                 const std::vector<int>& frontToBack, int, int, RenderMode mode,
+                                 const glm::vec4& background, std::uint64_t*) {
+    std::vector<const Image*> ordered;
+    for (int b : frontToBack)
+        for (const auto& [brick, image] : partials)
+            if (brick == b) ordered.push_back(&image);
+    return compositeBricks(ordered, mode, background);
+}
+
+Image renderBricked(const Volume& geometry, const std::function<Volume(const Brick&)>& load,
+                    const RenderSettings& frame, int bricks, BrickGroup& group, BrickStats* stats) {
+    if (frame.edges.enabled())
+        throw Error(
+            "--bricks: edge enhancement scales by the whole volume's largest gradient; "
+            "render it without bricks");
+    if (frame.labels.enabled) throw Error("--bricks: labels are rendered without bricks");
+    const footprint::Kernel kernel =
+        footprint::Kernel::fromName(frame.kernel, frame.kernelSigma, frame.kernelRadius);
+    const BrickLayout layout =
+        splitBricks(geometry.dims, bricks, ghostLayers(kernel.radius(), geometry.spacing));
+    BrickStats st;
+    st.bricks = bricks;
+    std::vector<int> mine;
+    for (int b = group.rank(); b < bricks; b += group.size()) mine.push_back(b);
+    st.rendered = int(mine.size());
+
+    // The whole volume's range, when the settings are relative to it: one pass that loads
+    // each brick, unless this process holds a single brick (kept for rendering).
+    const bool relative = frame.transfer.normalized || frame.isoNormalized;
+    std::optional<Volume> kept;
+    std::string error;
+    float lo = INFINITY, hi = -INFINITY;
+    auto loadBrick = [&](int b) {
+        const auto t = Clock::now();
+        Volume v = load(layout.bricks[std::size_t(b)]);
+        v.background = geometry.background;
+        st.samplesLoaded = std::max(st.samplesLoaded, v.data.size());
+        st.loadMs += msSince(t);
+        return v;
+    };
+    try {
+        if (relative || mine.size() == 1)
+            for (int b : mine) {
+                Volume v = loadBrick(b);
+                for (float d : v.data) lo = std::min(lo, d), hi = std::max(hi, d);
+                if (mine.size() == 1) kept = std::move(v);
+            }
+    } catch (const std::exception& e) {
+        error = e.what();
+    }
+    group.agree(error);
+    RenderSettings s = frame;
+    if (relative) {
+        group.range(lo, hi);
+        s.transfer = s.transfer.resolved(lo, hi);
+        if (s.isoNormalized) {
+            s.isoLevel = lo + s.isoLevel * (hi - lo);
+            s.isoNormalized = false;
+        }
+    }
+    std::vector<std::pair<int, Image>> partials;
+    try {
+        for (int b : mine) {
+            const Brick& brick = layout.bricks[std::size_t(b)];
+            auto v = std::make_shared<const Volume>(kept ? std::move(*kept) : loadBrick(b));
+            kept.reset();
+            auto t = Clock::now();
+            const RenderSettings bs = brickSettings(s, geometry, brick, geometry.dims);
+            const Scene scene(v, bs);
+            st.sceneMs += msSince(t);
+            t = Clock::now();
+            RenderStats rs;
+            partials.emplace_back(b, scene.render(bs, &rs));
+            st.renderMs += msSince(t);
+            st.splats += rs.splats;
+            st.renderMs += msSince(t);
+        }
+    } catch (const std::exception& e) {
+        error = e.what();
+    }
+    group.agree(error);
+    const auto t = Clock::now();
+    const std::vector<int> order = visibilityOrder(layout, geometry, frame.camera);
+    Image out = group.composite(partials, order, frame.camera.width, frame.camera.height,
+                                frame.mode, frame.background, &st.bytesExchanged);
+    st.compositeMs = msSince(t);
+    if (stats) *stats = st;
+    return out;
+}
+
+}  // namespace splat
