@@ -108,6 +108,7 @@ Volume brickGeometry(const Volume& whole, const Brick& brick) {
     v.dims = brick.loadHi - brick.loadLo;
     v.spacing = whole.spacing;
     v.origin = whole.world(glm::dvec3(brick.loadLo));
+    v.direction = whole.direction;
     v.background = whole.background;
     v.backgroundSource = whole.backgroundSource;
     v.source = whole.source;
@@ -118,10 +119,11 @@ RenderSettings brickSettings(const RenderSettings& frame, const Volume& whole, c
                              const glm::ivec3& dims) {
     RenderSettings s = frame;
     const Camera cam(frame.camera, whole);
+    // The Camera's points are in the volume's frame; CameraParams are world (RAS).
     s.camera.lookAtSet = true;
-    s.camera.lookAt = cam.target;
-    s.camera.eye = cam.eye;
-    s.camera.upHint = cam.up;
+    s.camera.lookAt = whole.direction * cam.target;
+    s.camera.eye = whole.direction * cam.eye;
+    s.camera.upHint = whole.direction * cam.up;
     s.camera.pixelSize = cam.pixelSize;
     s.background = glm::vec4(0.0f);
     s.quality.earlyTermination = 0;
@@ -217,7 +219,7 @@ Image renderBricked(const Volume& geometry, const std::function<Volume(const Bri
         const auto t = Clock::now();
         Volume v = load(layout.bricks[std::size_t(b)]);
         v.background = geometry.background;
-        st.samplesLoaded = std::max(st.samplesLoaded, v.data.size());
+        st.samplesLoaded = std::max(st.samplesLoaded, v.voxelCount());
         st.loadMs += msSince(t);
         return v;
     };
@@ -225,7 +227,8 @@ Image renderBricked(const Volume& geometry, const std::function<Volume(const Bri
         if (relative || mine.size() == 1)
             for (int b : mine) {
                 Volume v = loadBrick(b);
-                for (float d : v.data) lo = std::min(lo, d), hi = std::max(hi, d);
+                for (std::size_t n = 0; n < v.voxelCount(); ++n)
+                    lo = std::min(lo, v.value(n)), hi = std::max(hi, v.value(n));
                 if (mine.size() == 1) kept = std::move(v);
             }
     } catch (const std::exception& e) {

@@ -28,14 +28,15 @@ bool isPlainRaw(const std::string& spec) {
 Volume crop(const Volume& whole, const glm::ivec3& lo, const glm::ivec3& hi) {
     Volume v = makeVolume(hi - lo, whole.spacing, whole.source);
     v.origin = whole.world(glm::dvec3(lo));
+    v.direction = whole.direction;
     v.background = whole.background;
     v.backgroundSource = whole.backgroundSource;
     v.source = whole.source;
     v.note = whole.note;
     for (int k = 0; k < v.dims.z; ++k)
         for (int j = 0; j < v.dims.y; ++j)
-            std::memcpy(&v.at(0, j, k), &whole.data[whole.index(lo.x, lo.y + j, lo.z + k)],
-                        std::size_t(v.dims.x) * sizeof(float));
+            whole.values(whole.index(lo.x, lo.y + j, lo.z + k), std::size_t(v.dims.x),
+                         &v.at(0, j, k));
     return v;
 }
 
