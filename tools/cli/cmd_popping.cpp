@@ -25,7 +25,8 @@ namespace {
 struct PoppingCommand {
     VolumeArgs volume;
     RenderArgs render;
-    std::string report, sweep = "azimuth", renderers = "axis,sheet,reference";
+    std::string report, sweep = "azimuth", renderers = "axis,sheet,reference", path;
+    int frames = 21;
     double from = 40, to = 50, step = 0.5, k = 5, floor = 2, ppd = 67;
     int refine = 10;
     bool noFlip = false, quiet = false, resume = false;
@@ -49,13 +50,23 @@ void printSummary(const PoppingResult& r) {
         std::printf("%-10s %12.2f %12.3g %10.2f %8d %12.1f\n", toString(s.renderer), s.spikeRatio,
                     s.medianT, s.flickerRatio, events, s.msPerFrame);
     }
-    for (double a : r.predictedSwitches) std::printf("predicted sheet switch at %.6f degrees\n", a);
+    for (const RendererSeries& s : r.series) {
+        std::size_t exact = 0;
+        for (std::size_t p : s.exactPixels) exact += p > 0;
+        if (exact > 0)
+            warn(std::string(toString(s.renderer)) + ": " + std::to_string(exact) + " of " +
+                 std::to_string(s.exactPixels.size()) +
+                 " views handed to the exact path (the reference's pixels): " + s.exactReason);
+    }
+    // Positions: degrees of a sweep, or view positions of a camera path.
+    const char* unit = r.pathViews > 0 ? " (path position)" : " degrees";
+    for (double a : r.predictedSwitches) std::printf("predicted sheet switch at %.6f%s\n", a, unit);
     for (const PoppingEvent& e : r.events)
         std::printf(
-            "event (%s) %.4g..%.4g: signal %.3g; refined to %.3g degrees at %.6f: jump "
+            "event (%s) %.4g..%.4g: signal %.3g; refined to %.3g%s at %.6f: jump "
             "%.3g, slope %.2f (%s); sheet axis %d -> %d%s\n",
-            toString(e.renderer), e.angleFrom, e.angleTo, e.signal, e.refinedWidth, e.refinedAngle,
-            e.refinedJump, e.refinedSlope,
+            toString(e.renderer), e.angleFrom, e.angleTo, e.signal, e.refinedWidth, unit,
+            e.refinedAngle, e.refinedJump, e.refinedSlope,
             std::abs(e.refinedSlope) < 0.25 ? "a discontinuity" : "continuous change",
             e.sheetAxisBefore, e.sheetAxisAfter, e.predicted ? ", predicted" : "");
 }
@@ -72,6 +83,11 @@ void registerPopping(CLI::App& app) {
     addOption(*cmd, "--to", a->to, "last angle of the sweep (inclusive), degrees", sw);
     addOption(*cmd, "--step", a->step, "angle step, degrees", sw);
     addOption(*cmd, "--sweep", a->sweep, "the angle swept: azimuth or elevation", sw);
+    addOption(*cmd, "--path", a->path,
+              "analyse a camera path instead of a sweep: JSON {\"keys\": [...]} as for rotate, "
+              "interpolated over --frames views",
+              sw, PathKind::Input);
+    addOption(*cmd, "--frames", a->frames, "views of --path (at least 3)", sw);
     addOption(*cmd, "--renderers", a->renderers, "renderers to compare (reference: ground truth)",
               sw);
     addOption(*cmd, "--refine", a->refine, "bisection levels around each event (0: none)", sw);
@@ -105,7 +121,16 @@ void registerPopping(CLI::App& app) {
             sweep.to = a->to;
             sweep.step = a->step;
             sweep.base = settings.camera;
-            (void)sweep.angles();  // refuse a bad sweep before loading anything
+            if (!a->path.empty()) {
+                for (const char* k : {"from", "to", "step", "sweep"})
+                    if (given(*cmd, k))
+                        throw Error(std::string("--") + k + " does not apply with --path");
+                if (a->frames < 3 || a->frames > 100000)
+                    throw Error("--frames must be between 3 and 100000");
+            } else {
+                if (given(*cmd, "frames")) throw Error("--frames applies only with --path");
+                (void)sweep.angles();  // refuse a bad sweep before loading anything
+            }
             o.renderers = parseRenderers(a->renderers);
             if (a->refine < 0 || a->refine > 60) throw Error("--refine must be between 0 and 60");
             for (double v : {a->k, a->floor, a->ppd})
@@ -142,7 +167,12 @@ void registerPopping(CLI::App& app) {
         };
         PoppingResult result;
         try {
-            result = analyzePopping(scene, sweep, o);
+            result =
+                a->path.empty()
+                    ? analyzePopping(scene, sweep, o)
+                    : analyzePopping(
+                          scene, CameraPath::fromJson(a->path, scene.settings().camera, a->frames),
+                          o);
         } catch (const Cancelled&) {
             progress.finish();
             throw Error(
