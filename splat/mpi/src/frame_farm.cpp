@@ -16,7 +16,29 @@ namespace splat::mpi {
 namespace {
 
 static_assert(std::is_trivially_copyable_v<CameraParams>);
-static_assert(std::is_trivially_copyable_v<RenderStats>);
+
+// RenderStats on the wire: its numbers field by field, then the exact-path reason.
+#define SPLAT_STATS_FIELDS(X)                                                                  \
+    X(milliseconds) X(splats) X(voxels) X(footprintPixels) X(sheets) X(culledSplats)          \
+    X(referenceStep) X(sheetAxis) X(sheetSign) X(slabs) X(shadeMs) X(projectMs) X(orderMs)   \
+    X(binMs) X(tilesMs) X(perspective) X(normals) X(pathScalePixels) X(exactPixels)          \
+    X(lodLevel) X(lodSplats)
+
+void putStats(Writer& w, const RenderStats& s) {
+#define SPLAT_PUT(f) w.put(s.f);
+    SPLAT_STATS_FIELDS(SPLAT_PUT)
+#undef SPLAT_PUT
+    w.putString(s.exactReason);
+}
+
+RenderStats getStats(Reader& r) {
+    RenderStats s;
+#define SPLAT_GET(f) s.f = r.get<decltype(s.f)>();
+    SPLAT_STATS_FIELDS(SPLAT_GET)
+#undef SPLAT_GET
+    s.exactReason = r.getString();
+    return s;
+}
 
 // A job: [u64 job][u64 view][CameraParams][u32 n][i32 renderer] * n
 std::vector<char> encodeJob(std::uint64_t index, const FrameJob& job,
@@ -42,7 +64,7 @@ std::vector<char> encodeResult(std::uint64_t index, const SequenceFrame* f,
         for (std::size_t k = 0; k < f->images.size(); ++k) {
             w.put(std::int32_t(f->images[k].width));
             w.put(std::int32_t(f->images[k].height));
-            w.put(f->stats[k]);
+            putStats(w, f->stats[k]);
             w.putArray(f->images[k].pixels.data(), f->images[k].pixels.size());
         }
     } else {
@@ -114,7 +136,7 @@ class MpiFrameFarm : public FrameFarm {
         f.stats.resize(n);
         for (std::uint32_t k = 0; k < n; ++k) {
             const int w = r.get<std::int32_t>(), h = r.get<std::int32_t>();
-            f.stats[k] = r.get<RenderStats>();
+            f.stats[k] = getStats(r);
             f.images[k] = Image(w, h);
             r.getArray(f.images[k].pixels.data(), f.images[k].pixels.size());
         }
