@@ -182,6 +182,13 @@ TEST_CASE("NRRD hex and bzip2: damaged data is one clear error", "[volume][nrrd]
         error(write("sp2.nrrd", spaced + "space: RAST\n"
                                          "space directions: (1,0,0,0) (0,1,0,0) (0,0,1,1)\n\nab")),
         Catch::Contains("time component"));
+    // Axes 5.7 degrees from orthogonal: the nearest rotation, with a warning.
+    const Volume sheared =
+        loadVolume(write("shear.nrrd", spaced + "space: RAS\nspace directions: "
+                                                "(1,0,0) (0.1,1,0) (0,0,1)\n\nab"));
+    CHECK_THAT(sheared.note, Catch::Contains("sheared orientation: the axes of the space "
+                                             "directions are not orthogonal"));
+    CHECK(sheared.rotated());
     CHECK_THAT(error(write("sp3.nrrd", spaced + "space: LPS\n"
                                                 "space directions: (1,0,0) (0,1,0) (0,0)\n\nab")),
                Catch::Contains("has 2 components, the space has 3"));

@@ -189,3 +189,16 @@ TEST_CASE("oblique: a NIfTI sform rotation is kept as the volume's direction", "
         CHECK(back.data == v.data);
     }
 }
+
+TEST_CASE("oblique: a direction that is not a rotation is refused at the boundary", "[oblique]") {
+    Volume v = makeSynthetic("blob", 8);
+    RenderSettings s;
+    for (const glm::dmat3& bad :
+         {glm::dmat3(2.0),
+          glm::dmat3(glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 1))}) {
+        v.direction = bad;
+        CHECK_THROWS_WITH(Scene(v, s), Catch::Contains("volume direction must be a rotation"));
+    }
+    v.direction = glm::dmat3(std::nan(""));
+    CHECK_THROWS_WITH(Scene(v, s), Catch::Contains("volume direction must be a rotation"));
+}

@@ -1,6 +1,7 @@
 // Writes the seed corpora of the fuzz targets: `splat_fuzz_seeds OUTDIR` fills
 // OUTDIR/<target>/ with small valid (and a few nearly valid) inputs of every shape each
 // target understands, made by the library's own writers, GDCM's writer and by hand.
+#include <bzlib.h>
 #include <zlib.h>
 
 #include <cstdio>
@@ -110,6 +111,34 @@ int main(int argc, char** argv) {
              "space directions: (0.5,0,0) (0,-1,0) (0,0,2)\nspace origin: (1,2,3)\n"
              "byte skip: 0\n\n" +
              be);
+    // The other encodings (issue 22): bzip2, hex; a time space and a left-handed one.
+    {
+        const std::string raw = ramp<std::int16_t>(24);
+        const std::string skipped = "sk" + raw;  // byte skip 2 counts decompressed bytes
+        std::vector<char> packed(raw.size() * 2 + 600);
+        unsigned int packedSize = unsigned(packed.size());
+        if (BZ2_bzBuffToBuffCompress(packed.data(), &packedSize, const_cast<char*>(skipped.data()),
+                                     unsigned(skipped.size()), 9, 0, 0) == BZ_OK)
+            seed("nrrd", "bzip2.nrrd",
+                 nrrdHead + "endian: little\nencoding: bzip2\nbyte skip: 2\n\n" +
+                     std::string(packed.data(), packedSize));
+        static const char digits[] = "0123456789abcdef";
+        std::string hex;
+        for (std::size_t i = 0; i < raw.size(); ++i)
+            hex += std::string{digits[(unsigned char)raw[i] >> 4], digits[raw[i] & 15],
+                               i % 8 == 7 ? '\n' : ' '};
+        seed("nrrd", "hex.nrrd",
+             nrrdHead +
+                 "endian: little\nencoding: hex\nspace: RAST\n"
+                 "space directions: (0.5,0,0,0) (0,0.6,0.1,0) (0,0,2,0)\n"
+                 "space origin: (1,2,3,0)\n\n" +
+                 hex);
+        seed("nrrd", "lefthanded.nrrd",
+             nrrdHead +
+                 "endian: little\nencoding: raw\nspace: 3D-left-handed\n"
+                 "space directions: (0.9,0.1,0) (-0.1,0.9,0) (0,0,1)\n\n" +
+                 raw);
+    }
     seed("nrrd", "detached.nhdr",
          nrrdHead +
              "endian: little\nencoding: raw\nline skip: 1\nbyte skip: 2\n"

@@ -42,7 +42,7 @@ struct Volume {
     std::vector<float> data;
     std::string source;  ///< how it was obtained, e.g. "NIfTI-1 int16 (ch2.nii.gz)"
     /// Warnings about the input, "; " separated: anything accepted with an assumption or
-    /// an ignored field (oblique rotation dropped, 4D file's first volume, DICOM gantry
+    /// an ignored field (sheared axes made a rotation, 4D file's first volume, DICOM gantry
     /// tilt, NaNs replaced, ...). Every command prints it (README "Input files and bad
     /// input" lists the cases).
     std::string note;

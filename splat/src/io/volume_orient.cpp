@@ -123,8 +123,8 @@ void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
     if (shear > 1e-4) {
         char buf[256];
         std::snprintf(buf, sizeof buf,
-                      "sheared orientation: the %s's axes are not orthogonal (up to %.3g off "
-                      "the nearest rotation); the nearest rotation was used",
+                      "sheared orientation: the axes of the %s are not orthogonal (up to %.3g "
+                      "off the nearest rotation), the nearest rotation was used",
                       what.c_str(), shear);
         addNote(v, buf);
     }

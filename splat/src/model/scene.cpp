@@ -50,6 +50,14 @@ void validateGeometry(const Volume& v) {
         throw Error(
             "volume origin is NaN or Inf (check the file's sform/qform, space origin or "
             "Offset)");
+    // The Camera turns world into the volume's frame by direction^T: a rotation only.
+    const glm::dmat3 dd = glm::transpose(v.direction) * v.direction;
+    double offOrthonormal = 0;
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r)
+            offOrthonormal = std::max(offOrthonormal, std::abs(dd[c][r] - (c == r ? 1.0 : 0.0)));
+    if (!(offOrthonormal < 1e-6) || !(glm::determinant(v.direction) > 0))
+        throw Error("volume direction must be a rotation (orthonormal, determinant +1)");
     const double hi = std::max(v.spacing.x, std::max(v.spacing.y, v.spacing.z));
     if (hi / v.minSpacing() > kMaxSpacingRatio)
         throw Error("volume spacing " + std::to_string(v.spacing.x) + ", " +
