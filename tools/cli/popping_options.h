@@ -1,0 +1,31 @@
+#pragma once
+// The sweep options of `splat popping` (--from, --to, --step, --sweep, --renderers, --refine,
+// --threshold-k, --threshold-floor, --ppd, --no-flip), shared with the Python module's
+// splat.popping (splat/python), whose keywords are these options.
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "splat/popping.h"
+
+namespace splat::cli {
+
+struct PoppingArgs {
+    std::string sweep = "azimuth", renderers = "axis,sheet,reference";
+    double from = 40, to = 50, step = 0.5, k = 5, floor = 2, ppd = 67;
+    int refine = 10;
+    bool noFlip = false;
+};
+
+/// Adds the options to the group "Sweep".
+void addPoppingOptions(CLI::App& cmd, PoppingArgs& args);
+
+/// The sweep (base camera from `settings`) and options; refuses a bad sweep or value with a
+/// UsageError before anything is loaded. Leaves progress and the frame journal unset.
+void poppingFromArgs(const PoppingArgs& args, const RenderSettings& settings, Sweep& sweep,
+                     PoppingOptions& options);
+
+/// "axis,sheet" -> {Axis, Sheet}; throws splat::Error on an unknown or empty list.
+std::vector<RendererKind> parseRenderers(const std::string& text);
+
+}  // namespace splat::cli
