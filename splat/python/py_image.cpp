@@ -100,7 +100,7 @@ void bindImage(py::module_& m) {
         py::arg("image"), "The display window the CLI uses for mip/xray 8-bit output.");
     m.def(
         "_compare",
-        [](const py::array& test, const py::array& reference, bool flip, double ppd) {
+        [](const py::array& test, const py::array& reference, bool flip, double ppd, bool srgb) {
             const Image a = fromArray(test, "compare"), b = fromArray(reference, "compare");
             ImageMetrics mt;
             double f = NAN;
@@ -108,13 +108,14 @@ void bindImage(py::module_& m) {
             {
                 py::gil_scoped_release release;
                 mt = compareImages(a, b);
-                if (flip) f = flipMean(a, b, flipOptions(ppd));
+                if (flip)
+                    f = srgb ? flipMeanSrgb(a, b, flipOptions(ppd)) : flipMean(a, b, flipOptions(ppd));
             }
             py::dict d = metricsDict(mt);
             d["flip"] = f;
             return d;
         },
-        py::arg("test"), py::arg("reference"), py::arg("flip"), py::arg("ppd"));
+        py::arg("test"), py::arg("reference"), py::arg("flip"), py::arg("ppd"), py::arg("srgb"));
     m.def(
         "flip_map",
         [](const py::array& test, const py::array& reference, double ppd) {

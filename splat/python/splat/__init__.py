@@ -58,10 +58,9 @@ def _text(key: str, value) -> str:
     if isinstance(value, (numbers.Real, np.generic)) and not isinstance(value, (bool, np.bool_)):
         return _number(value)
     if isinstance(value, (list, tuple, np.ndarray)):
-        sep = "x" if key in _X_JOINED else ","
         if key in _X_JOINED:
-            return sep.join(str(int(v)) for v in value)
-        return sep.join(_number(v) for v in value)
+            return "x".join(str(int(v)) for v in value)
+        return ",".join(v if isinstance(v, str) else _number(v) for v in value)
     raise InputError(f"{key}=: unsupported value {value!r}")
 
 
@@ -82,9 +81,9 @@ def _argv(options: dict) -> tuple[list[str], str]:
             if value:
                 argv.append(flag)
             continue
-        if (isinstance(value, (list, tuple)) and value
+        if (key == "clip_plane" and isinstance(value, (list, tuple)) and value
                 and all(isinstance(v, (list, tuple, np.ndarray, str)) for v in value)):
-            for v in value:  # a repeatable option: clip_plane=[(x, y, z, nx, ny, nz), ...]
+            for v in value:  # repeatable: clip_plane=[(x, y, z, nx, ny, nz), ...]
                 argv += [flag, _text(key, v)]
             continue
         argv += [flag, _text(key, value)]
@@ -231,11 +230,14 @@ def compare(test, reference, *, flip: bool = True, ppd: float = 67.0206432765822
     arrays, or image file names): rmse, psnr, max_abs, mean_abs_foreground,
     foreground_pixels and flip (mean LDR-FLIP at `ppd` pixels per degree; NaN when
     flip=False)."""
+    display = (".png", ".jpg", ".jpeg", ".gif")
+    # Display files hold sRGB values: FLIP decodes them first, as the CLI does.
+    srgb = all(isinstance(x, str) and x.lower().endswith(display) for x in (test, reference))
     if isinstance(test, str):
         test = read_image(test)
     if isinstance(reference, str):
         reference = read_image(reference)
-    return _splat._compare(test, reference, flip, ppd)
+    return _splat._compare(test, reference, flip, ppd, srgb)
 
 
 def popping(volume: Volume, *, progress=None, **options) -> PoppingResult:
