@@ -1,9 +1,12 @@
 #pragma once
 // A scalar volume: samples d_i at integer index positions p = (i, j, k), world position
-// x = origin + S p with S = diag(spacing). Samples are float, x fastest, then y, then z.
+// x = origin + S p with S = diag(spacing). Samples are x fastest, then y, then z; stored as
+// float in `data` (owned), or in the caller's memory or a file's type (u8/i16/u16/f32,
+// read as raw * scale + offset) without a float copy: Volume::borrow.
 #include <cstddef>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,12 +16,23 @@ namespace splat {
 /// are refused with a clear error rather than attempted.
 inline constexpr std::uint64_t kMaxVoxels = std::uint64_t(1) << 32;
 
+/// How samples are stored. Every reader converts through Volume::value (float), so a
+/// renderer never makes a float copy of a borrowed or typed volume.
+enum class SampleType : std::uint8_t { Float32, UInt8, Int16, UInt16 };
+/// Bytes per sample of `type` (4, 1, 2, 2).
+std::size_t sampleTypeBytes(SampleType type);
+/// "float32", "uint8", "int16", "uint16".
+const char* sampleTypeName(SampleType type);
+
 struct Volume {
     glm::ivec3 dims{0};       ///< samples along x, y, z (all >= 1 for a valid volume)
     glm::dvec3 spacing{1.0};  ///< world units (usually mm) between samples per axis
     glm::dvec3 origin{0.0};   ///< world position of sample (0, 0, 0)
-    std::vector<float> data;  ///< dims.x * dims.y * dims.z samples, x fastest
-    std::string source;       ///< how it was obtained, e.g. "NIfTI-1 int16 (ch2.nii.gz)"
+    /// The samples of an owned float volume: dims.x * dims.y * dims.z, x fastest (the
+    /// loaders fill it). Empty for a borrowed or typed volume (sampleData() is then the
+    /// storage); read samples with at() or value(), which work for every storage.
+    std::vector<float> data;
+    std::string source;  ///< how it was obtained, e.g. "NIfTI-1 int16 (ch2.nii.gz)"
     /// Warnings about the input, "; " separated: anything accepted with an assumption or
     /// an ignored field (oblique rotation dropped, 4D file's first volume, DICOM gantry
     /// tilt, NaNs replaced, ...). Every command prints it (README "Input files and bad
@@ -40,7 +54,55 @@ struct Volume {
         return (std::size_t(k) * std::size_t(dims.y) + std::size_t(j)) * std::size_t(dims.x) +
                std::size_t(i);
     }
-    float at(int i, int j, int k) const { return data[index(i, j, k)]; }
+    /// A volume over samples the caller owns (no copy): dims.x*dims.y*dims.z samples of `type`,
+    /// x fastest, read as value = raw * scale + offset. `keepAlive` (may be null) is held by the
+    /// Volume and by every Scene/Renderer built from it; with a null keepAlive the caller
+    /// guarantees the memory outlives them. Throws splat::Error on bad sizes/spacing/null data.
+    static Volume borrow(const void* samples, SampleType type, const glm::ivec3& dims,
+                         const glm::dvec3& spacing, const glm::dvec3& origin,
+                         std::shared_ptr<const void> keepAlive = nullptr, double scale = 1.0,
+                         double offset = 0.0);
+    /// As borrow, over storage the volume owns through `storage` (a loader keeping a file's
+    /// 8/16-bit samples): borrowed() is false.
+    static Volume typed(std::shared_ptr<const void> storage, const void* samples, SampleType type,
+                        const glm::ivec3& dims, const glm::dvec3& spacing, const glm::dvec3& origin,
+                        double scale = 1.0, double offset = 0.0);
+
+    SampleType sampleType() const { return external_ ? type_ : SampleType::Float32; }
+    /// The first sample, whatever the storage (data.data() for an owned float volume).
+    const void* sampleData() const { return external_ ? external_ : data.data(); }
+    /// True for a volume made by borrow (its samples live in the caller's memory).
+    bool borrowed() const { return borrowed_; }
+    double sampleScale() const { return external_ ? scale_ : 1.0; }
+    double sampleOffset() const { return external_ ? offset_ : 0.0; }
+    /// True when the storage holds voxelCount() >= 1 samples.
+    bool hasSamples() const {
+        return voxelCount() > 0 && (external_ != nullptr || data.size() == voxelCount());
+    }
+    /// Sample n (index order) as float: raw * scale + offset, computed in double.
+    float value(std::size_t n) const {
+        if (!external_) return data[n];
+        switch (type_) {
+            case SampleType::Float32: {
+                const float raw = static_cast<const float*>(external_)[n];
+                return identity_ ? raw : float(double(raw) * scale_ + offset_);
+            }
+            case SampleType::UInt8:
+                return float(double(static_cast<const std::uint8_t*>(external_)[n]) * scale_ +
+                             offset_);
+            case SampleType::Int16:
+                return float(double(static_cast<const std::int16_t*>(external_)[n]) * scale_ +
+                             offset_);
+            case SampleType::UInt16:
+                return float(double(static_cast<const std::uint16_t*>(external_)[n]) * scale_ +
+                             offset_);
+        }
+        return 0.0f;
+    }
+    /// Samples [first, first + count) as float into `out` (one row at a time, say).
+    void values(std::size_t first, std::size_t count, float* out) const;
+    float at(int i, int j, int k) const { return value(index(i, j, k)); }
+    /// Writable sample of an owned float volume (`data`); not for borrowed or typed storage.
     float& at(int i, int j, int k) { return data[index(i, j, k)]; }
     /// World position of a (possibly fractional) index position.
     glm::dvec3 world(const glm::dvec3& p) const { return origin + spacing * p; }
@@ -48,8 +110,18 @@ struct Volume {
     glm::dvec3 center() const { return world((glm::dvec3(dims) - 1.0) * 0.5); }
     /// Smallest spacing: the world length of "one voxel" in splat/DESIGN.md.
     double minSpacing() const { return glm::min(spacing.x, glm::min(spacing.y, spacing.z)); }
-    /// Memory held by the samples, in bytes.
-    std::size_t bytes() const { return data.size() * sizeof(float); }
+    /// Memory the samples take, in bytes (the caller's, for a borrowed volume).
+    std::size_t bytes() const {
+        return external_ ? voxelCount() * sampleTypeBytes(type_) : data.size() * sizeof(float);
+    }
+
+  private:
+    const void* external_ = nullptr;         ///< borrowed or typed samples; null: `data`
+    std::shared_ptr<const void> keepAlive_;  ///< owner of external_ (may be null if borrowed)
+    SampleType type_ = SampleType::Float32;
+    bool borrowed_ = false;
+    bool identity_ = true;  ///< scale 1, offset 0
+    double scale_ = 1.0, offset_ = 0.0;
 };
 
 /// The voxel count of `dims` after checking every dimension >= 1 and the count within

@@ -103,7 +103,7 @@ Volume loadVolume(const std::string& spec, const LoadOptions& options) {
             // .hdr.gz / .img.gz pairs: the extension before .gz decides.
             if (ext == ".gz") ext = lowerExtension(p.stem());
             v = loadByType(p, ext, options);
-            if (v.data.empty()) {
+            if (!v.hasSamples()) {
                 std::string guess = sniff(p);
                 if (guess.empty() || guess == ext)
                     throw Error(spec + ": unknown file type '" + p.extension().string() +

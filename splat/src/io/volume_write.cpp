@@ -20,8 +20,7 @@ using detail::displayName;
 namespace {
 
 void checkWritable(const Volume& v, const std::string& path) {
-    if (v.data.size() != v.voxelCount() || v.data.empty())
-        throw Error(path + ": volume has no data or inconsistent dimensions");
+    if (!v.hasSamples()) throw Error(path + ": volume has no data or inconsistent dimensions");
 }
 
 std::string fmt(double d) {
@@ -30,9 +29,12 @@ std::string fmt(double d) {
     return buf;
 }
 
-// Host-order float32 bytes; the header declares little endian (see volume_decode.cpp).
+// Host-order float32 bytes of the sample values (any storage); the header declares little
+// endian (see volume_decode.cpp).
 std::string floatBytes(const Volume& v) {
-    return std::string(reinterpret_cast<const char*>(v.data.data()), v.bytes());
+    std::string out(v.voxelCount() * sizeof(float), '\0');
+    v.values(0, v.voxelCount(), reinterpret_cast<float*>(out.data()));
+    return out;
 }
 
 }  // namespace
@@ -51,7 +53,8 @@ void saveNifti(const std::string& path, const Volume& v) {
     nifti_set_debug_level(0);
     nifti_image* nim = nifti_make_new_nim(dims, DT_FLOAT32, 1);
     if (!nim) throw Error(path + ": cannot create NIfTI image");
-    std::memcpy(nim->data, v.data.data(), v.bytes());
+    const std::size_t floatSize = v.voxelCount() * sizeof(float);
+    v.values(0, v.voxelCount(), static_cast<float*>(nim->data));
     nim->dx = nim->pixdim[1] = float(v.spacing.x);
     nim->dy = nim->pixdim[2] = float(v.spacing.y);
     nim->dz = nim->pixdim[3] = float(v.spacing.z);
@@ -79,8 +82,9 @@ void saveNifti(const std::string& path, const Volume& v) {
     // niftilib does not report a failed write (a full disk): the file is read back whole
     // and compared before it replaces anything (issue 23).
     nifti_image* back = nifti_image_read(tmp.string().c_str(), 1);
-    const bool whole = back && back->data && std::size_t(back->nvox) * back->nbyper == v.bytes() &&
-                       std::memcmp(back->data, v.data.data(), v.bytes()) == 0;
+    const std::string expected = floatBytes(v);
+    const bool whole = back && back->data && std::size_t(back->nvox) * back->nbyper == floatSize &&
+                       std::memcmp(back->data, expected.data(), floatSize) == 0;
     if (back) nifti_image_free(back);
     if (!whole) throw Error(path + ": cannot write NIfTI file (the file written is incomplete)");
     out.commit();
@@ -121,7 +125,8 @@ void saveMetaImage(const std::string& path, const Volume& v) {
         writeFileAtomic(path, bytes.data(), bytes.size());
     } else {
         // Data first, so the header never points at a missing file.
-        writeFileAtomic(rawPath, v.data.data(), v.bytes());
+        const std::string bytes = floatBytes(v);
+        writeFileAtomic(rawPath, bytes.data(), bytes.size());
         std::string header = h.str();
         writeFileAtomic(path, header.data(), header.size());
     }

@@ -97,11 +97,11 @@ void shadeEmission(const SplatList& s, const Shading& sh, const glm::dvec3& view
 
 std::vector<std::uint16_t> shownLabels(const Volume& volume, const Labels& labels) {
     const Volume& lv = labels.volume ? *labels.volume : volume;
-    if (lv.dims != volume.dims)
+    if (lv.dims != volume.dims || !lv.hasSamples())
         throw Error("the label volume's dimensions differ from the volume's");
     std::vector<std::uint16_t> out(lv.voxelCount(), 0);
     for (std::size_t n = 0; n < out.size(); ++n) {
-        const float d = lv.data[n];
+        const float d = lv.value(n);
         const int label = d >= 0.0f && d < 65536.0f ? int(std::lround(d)) : 0;
         if (labels.shown(label).a > 0.0f) out[n] = std::uint16_t(label);
     }
@@ -229,7 +229,8 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
             if (!intensity) return false;
         }
         if (pre) return tf.extinction(value) > 0.0f && (!edges || edgeOf(i, j, k) > 0.0f);
-        if (value == volume.background && !(gradients && glm::length(gradientAt(volume, i, j, k)) > 0.0))
+        if (value == volume.background &&
+            !(gradients && glm::length(gradientAt(volume, i, j, k)) > 0.0))
             return false;
         if (need.empty()) return true;
         return need[(std::size_t(k / kBrick) * bricks.y + j / kBrick) * bricks.x + i / kBrick] != 0;
@@ -296,7 +297,11 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
         for (float& v : s.paletteDensity) v -= b;
         s.emissionIndex.resize(n);
     } else {
-        for (auto* a : {&s.density, &s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
+        s.density.resize(n);
+        // Only what the mode needs (issue 24): mip, x-ray and iso read the density alone, so
+        // their splats carry no emission (16 bytes a splat less).
+        if (usesTf)
+            for (auto* a : {&s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
     }
     for (auto* a : {&s.i, &s.j, &s.k}) a->resize(n);
     if (normals)
@@ -319,7 +324,7 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                     s.emissionIndex[o] =
                         std::uint16_t(std::lower_bound(distinct.begin(), distinct.end(), value) -
                                       distinct.begin());
-                } else {
+                } else if (usesTf) {
                     glm::vec4 e = emissionOf(value);
                     if (edges && e.x != 0.0f) {
                         const float f = edgeOf(i, j, k);

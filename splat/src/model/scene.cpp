@@ -1,5 +1,7 @@
 // splat::Scene (the view-independent state, built once), splat::Renderer and render().
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -64,13 +66,19 @@ void validateGeometry(const Volume& v) {
 }
 
 void validateScene(const Volume& v, const RenderSettings& s) {
-    if (v.voxelCount() == 0 || v.data.size() != v.voxelCount())
+    if (!v.hasSamples())
         throw Error("volume is empty or its sample count does not match its dimensions");
     validateGeometry(v);
     // The loaders' NaN policy at the library boundary (issue 24): an in-memory volume with
     // NaN/Inf samples is refused, not rendered differently by each renderer.
-    const std::size_t bad = std::size_t(std::count_if(
-        v.data.begin(), v.data.end(), [](float d) { return !std::isfinite(d); }));
+    // The values are scanned, whatever the storage (a scale can overflow float).
+    const std::size_t bad = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, v.voxelCount(), 1 << 16), std::size_t(0),
+        [&](const tbb::blocked_range<std::size_t>& r, std::size_t n) {
+            for (std::size_t q = r.begin(); q != r.end(); ++q) n += !std::isfinite(v.value(q));
+            return n;
+        },
+        [](std::size_t a, std::size_t b) { return a + b; });
     if (bad > 0)
         throw Error("volume has " + std::to_string(bad) +
                     " NaN/Inf samples; replace them (the loaders' --nan-policy zero does)");
@@ -106,7 +114,9 @@ bool sameClipping(const Clipping& a, const Clipping& b) {
 /// given and the ones it resolved (a frame may pass either), or "" when none does.
 std::string changedSceneField(const RenderSettings& frame, const RenderSettings& given,
                               const RenderSettings& resolved) {
-    auto differs = [&](auto get) { return !(get(frame) == get(given)) && !(get(frame) == get(resolved)); };
+    auto differs = [&](auto get) {
+        return !(get(frame) == get(given)) && !(get(frame) == get(resolved));
+    };
     if (differs([](const RenderSettings& s) { return s.mode; })) return "mode";
     if (differs([](const RenderSettings& s) { return s.classification; })) return "classification";
     if (differs([](const RenderSettings& s) { return s.kernel; })) return "kernel";
@@ -121,7 +131,8 @@ std::string changedSceneField(const RenderSettings& frame, const RenderSettings&
                                h.headlight, h.light);
     };
     if (differs(shading)) return "shading";
-    if (differs([](const RenderSettings& s) { return std::make_pair(s.edges.gain, s.edges.exponent); }))
+    if (differs(
+            [](const RenderSettings& s) { return std::make_pair(s.edges.gain, s.edges.exponent); }))
         return "edges";
     if (!sameClipping(frame.clipping, given.clipping)) return "clipping";
     const auto labels = [](const RenderSettings& s) {
@@ -131,8 +142,8 @@ std::string changedSceneField(const RenderSettings& frame, const RenderSettings&
     if (differs(labels)) return "labels";
     const auto tables = [](const RenderSettings& s) {
         const Quality& q = s.quality;
-        return std::make_tuple(q.footprintResolution, q.slabRadialResolution,
-                               q.slabDepthResolution, q.polynomialTolerance);
+        return std::make_tuple(q.footprintResolution, q.slabRadialResolution, q.slabDepthResolution,
+                               q.polynomialTolerance);
     };
     if (differs(tables)) return "quality (footprint/slab table resolutions, polynomial tolerance)";
     return "";
@@ -222,8 +233,7 @@ const Scene::Impl* Scene::Impl::coarser() const {
     // Isolated: while this thread waits inside the merge's parallel loop it must not pick up
     // another frame's task that would ask for this lock again.
     if (!coarser_)
-        tbb::this_task_arena::isolate(
-            [&] { coarser_ = std::make_unique<Impl>(*this, Coarser{}); });
+        tbb::this_task_arena::isolate([&] { coarser_ = std::make_unique<Impl>(*this, Coarser{}); });
     return coarser_.get();
 }
 
@@ -331,8 +341,17 @@ Scene::Scene(std::shared_ptr<const Volume> volume, const RenderSettings& setting
     impl_->given = settings;
 }
 
+namespace {
+// A borrowed volume is copied (its metadata only: the copy shares the caller's samples and
+// holds the keepAlive); an owned one is referenced, and must outlive the Scene.
+std::shared_ptr<const Volume> sceneVolume(const Volume& volume) {
+    if (volume.borrowed() || volume.data.empty()) return std::make_shared<const Volume>(volume);
+    return std::shared_ptr<const Volume>(&volume, [](const Volume*) {});
+}
+}  // namespace
+
 Scene::Scene(const Volume& volume, const RenderSettings& settings)
-    : Scene(std::shared_ptr<const Volume>(&volume, [](const Volume*) {}), settings) {}
+    : Scene(sceneVolume(volume), settings) {}
 
 Scene::Scene(Volume&& volume, const RenderSettings& settings)
     : Scene(std::make_shared<const Volume>(std::move(volume)), settings) {}

@@ -30,9 +30,36 @@ std::uint64_t checkedVoxelCount(const glm::ivec3& dims, const std::string& what)
     return count;
 }
 
-Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::string& what) {
+std::size_t sampleTypeBytes(SampleType type) {
+    switch (type) {
+        case SampleType::Float32:
+            return 4;
+        case SampleType::UInt8:
+            return 1;
+        case SampleType::Int16:
+        case SampleType::UInt16:
+            return 2;
+    }
+    return 4;
+}
+
+const char* sampleTypeName(SampleType type) {
+    switch (type) {
+        case SampleType::Float32:
+            return "float32";
+        case SampleType::UInt8:
+            return "uint8";
+        case SampleType::Int16:
+            return "int16";
+        case SampleType::UInt16:
+            return "uint16";
+    }
+    return "?";
+}
+
+namespace {
+void checkSpacing(const glm::dvec3& spacing, const std::string& what) {
     const char* axis = "xyz";
-    const std::uint64_t count = checkedVoxelCount(dims, what);
     for (int a = 0; a < 3; ++a)
         if (!std::isfinite(spacing[a]) || spacing[a] <= 0) {
             std::ostringstream s;
@@ -40,6 +67,58 @@ Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::
               << " (" << axis[a] << " must be finite and > 0)";
             throw Error(s.str());
         }
+}
+}  // namespace
+
+Volume Volume::borrow(const void* samples, SampleType type, const glm::ivec3& dims,
+                      const glm::dvec3& spacing, const glm::dvec3& origin,
+                      std::shared_ptr<const void> keepAlive, double scale, double offset) {
+    Volume v = typed(std::move(keepAlive), samples, type, dims, spacing, origin, scale, offset);
+    v.borrowed_ = true;
+    v.source = std::string("borrowed ") + sampleTypeName(type) + " samples";
+    return v;
+}
+
+Volume Volume::typed(std::shared_ptr<const void> storage, const void* samples, SampleType type,
+                     const glm::ivec3& dims, const glm::dvec3& spacing, const glm::dvec3& origin,
+                     double scale, double offset) {
+    const std::string what = "volume";
+    if (!samples) throw Error(what + ": no sample data (null pointer)");
+    if (type != SampleType::Float32 && type != SampleType::UInt8 && type != SampleType::Int16 &&
+        type != SampleType::UInt16)
+        throw Error(what + ": unknown sample type " + std::to_string(int(type)));
+    checkedVoxelCount(dims, what);
+    checkSpacing(spacing, what);
+    if (!std::isfinite(origin.x) || !std::isfinite(origin.y) || !std::isfinite(origin.z))
+        throw Error(what + ": origin is NaN or Inf");
+    if (!std::isfinite(scale) || !std::isfinite(offset))
+        throw Error(what + ": sample scale and offset must be finite");
+    Volume v;
+    v.dims = dims;
+    v.spacing = spacing;
+    v.origin = origin;
+    v.external_ = samples;
+    v.keepAlive_ = std::move(storage);
+    v.type_ = type;
+    v.scale_ = scale;
+    v.offset_ = offset;
+    v.identity_ = scale == 1.0 && offset == 0.0;
+    v.source = std::string(sampleTypeName(type)) + " samples";
+    return v;
+}
+
+void Volume::values(std::size_t first, std::size_t count, float* out) const {
+    if (!external_) {
+        std::copy(data.begin() + std::ptrdiff_t(first),
+                  data.begin() + std::ptrdiff_t(first + count), out);
+        return;
+    }
+    for (std::size_t n = 0; n < count; ++n) out[n] = value(first + n);
+}
+
+Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::string& what) {
+    const std::uint64_t count = checkedVoxelCount(dims, what);
+    checkSpacing(spacing, what);
     Volume v;
     v.dims = dims;
     v.spacing = spacing;
@@ -53,7 +132,7 @@ Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::
 }
 
 float backgroundFromFaces(const Volume& v) {
-    if (v.data.empty()) return 0.0f;
+    if (!v.hasSamples()) return 0.0f;
     std::vector<float> face;
     const glm::ivec3 d = v.dims;
     auto take = [&](int i, int j, int k) {
@@ -63,11 +142,12 @@ float backgroundFromFaces(const Volume& v) {
     for (int k = 0; k < d.z; ++k)
         for (int j = 0; j < d.y; ++j)
             for (int i = 0; i < d.x; ++i) {
-                const bool outer = i == 0 || j == 0 || k == 0 || i == d.x - 1 || j == d.y - 1 ||
-                                   k == d.z - 1;
+                const bool outer =
+                    i == 0 || j == 0 || k == 0 || i == d.x - 1 || j == d.y - 1 || k == d.z - 1;
                 if (outer) take(i, j, k);
                 // Inner rows of an inner slice: jump to the row's last sample.
-                else if (i == 1) i = d.x - 2;
+                else if (i == 1)
+                    i = d.x - 2;
             }
     if (face.empty()) return 0.0f;
     auto mid = face.begin() + std::ptrdiff_t(face.size() / 2);
@@ -83,11 +163,13 @@ VolumeStats volumeStats(const Volume& v, int bins) {
     VolumeStats s;
     bins = std::max(bins, 1);
     s.histogram.assign(std::size_t(bins), 0);
-    if (v.data.empty()) return s;
+    if (!v.hasSamples()) return s;
     float lo = std::numeric_limits<float>::infinity(), hi = -lo;
     double sum = 0;
     std::size_t finite = 0;
-    for (float d : v.data) {
+    const std::size_t count = v.voxelCount();
+    for (std::size_t n = 0; n < count; ++n) {
+        const float d = v.value(n);
         if (!std::isfinite(d)) continue;
         lo = std::min(lo, d);
         hi = std::max(hi, d);
@@ -99,7 +181,8 @@ VolumeStats volumeStats(const Volume& v, int bins) {
     s.maxValue = hi;
     s.mean = sum / double(finite);
     double range = double(hi) - double(lo);
-    for (float d : v.data) {
+    for (std::size_t n = 0; n < count; ++n) {
+        const float d = v.value(n);
         if (!std::isfinite(d)) continue;
         int b = range > 0 ? int((double(d) - lo) / range * bins) : 0;
         s.histogram[std::size_t(std::clamp(b, 0, bins - 1))]++;
@@ -139,7 +222,10 @@ std::string describeVolume(const Volume& v) {
                       width, std::string(std::size_t(n), '#').c_str(), c);
         out << buf << '\n';
     }
-    line("memory:      %.1f MiB", double(v.bytes()) / (1024.0 * 1024.0));
+    line("memory:      %.1f MiB (%s samples%s)", double(v.bytes()) / (1024.0 * 1024.0),
+         sampleTypeName(v.sampleType()), v.borrowed() ? ", borrowed" : "");
+    if (v.sampleScale() != 1.0 || v.sampleOffset() != 0.0)
+        line("scaling:     value = raw * %g + %g", v.sampleScale(), v.sampleOffset());
     line("background:  %g (%s)", double(v.background), v.backgroundSource.c_str());
     if (!v.note.empty()) out << "note:        " << v.note << '\n';
     return out.str();

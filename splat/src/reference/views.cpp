@@ -47,7 +47,7 @@ void forRows(const FieldView& field, int height, F&& body) {
 
 FieldView::FieldView(const Volume& volume, const std::string& kernel, double sigma, double radius,
                      int threads) {
-    if (volume.voxelCount() == 0 || volume.data.size() != volume.voxelCount())
+    if (!volume.hasSamples())
         throw Error("volume is empty or its sample count does not match its dimensions");
     impl_ = std::make_unique<Impl>(volume, viewKernel(kernel, sigma, radius), threads);
     validateReferenceKernel(impl_->kernel);
