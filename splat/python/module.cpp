@@ -10,17 +10,17 @@
 namespace splat::python {
 
 namespace {
-PyObject* errorType = nullptr;      // splat.Error
+PyObject* errorType = nullptr;       // splat.Error
 PyObject* inputErrorType = nullptr;  // splat.InputError (ValueError)
 PyObject* fileErrorType = nullptr;   // splat.FileError (OSError)
-PyObject* cancelledType = nullptr;  // splat.Cancelled
+PyObject* cancelledType = nullptr;   // splat.Cancelled
 }  // namespace
 
 void rethrowFileError(const Error& e, const std::string& path, bool reading) {
     const std::string m = e.what();
     std::error_code ec;
-    const bool missing = reading && path.rfind("synthetic:", 0) != 0 &&
-                         !std::filesystem::exists(path, ec);
+    const bool missing =
+        reading && path.rfind("synthetic:", 0) != 0 && !std::filesystem::exists(path, ec);
     bool osError = missing;
     for (const char* s : {"cannot open", "cannot read", "cannot write", "cannot create",
                           "No such file", "Permission denied", "Is a directory", "not a folder",
@@ -118,14 +118,12 @@ PYBIND11_MODULE(_splat, m) {
         base.ptr(), nullptr);
     py::tuple inputBases = py::make_tuple(py::handle(errorType), py::handle(PyExc_ValueError));
     inputErrorType = PyErr_NewExceptionWithDoc(
-        "splat.InputError",
-        "A bad argument, option, array or file contents (also a ValueError).", inputBases.ptr(),
-        nullptr);
+        "splat.InputError", "A bad argument, option, array or file contents (also a ValueError).",
+        inputBases.ptr(), nullptr);
     py::tuple fileBases = py::make_tuple(py::handle(errorType), py::handle(PyExc_OSError));
     fileErrorType = PyErr_NewExceptionWithDoc(
-        "splat.FileError",
-        "A file that cannot be found, read or written (also an OSError).", fileBases.ptr(),
-        nullptr);
+        "splat.FileError", "A file that cannot be found, read or written (also an OSError).",
+        fileBases.ptr(), nullptr);
     cancelledType = PyErr_NewExceptionWithDoc(
         "splat.Cancelled", "A progress callable returned False: the call stopped cleanly.",
         errorType, nullptr);

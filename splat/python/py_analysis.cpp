@@ -112,8 +112,9 @@ void bindAnalysis(py::module_& m) {
     py::class_<PoppingResult>(m, "PoppingResult",
                               "The result of splat.popping: per-renderer series (NumPy arrays) "
                               "and events (dicts); write_report(folder) writes the CLI's report.")
-        .def_property_readonly("angles", [](const PoppingResult& r) { return doubles(r.angles); },
-                               "The sweep's view angles, degrees.")
+        .def_property_readonly(
+            "angles", [](const PoppingResult& r) { return doubles(r.angles); },
+            "The sweep's view angles, degrees.")
         .def_property_readonly(
             "renderers",
             [](const PoppingResult& r) {
@@ -132,9 +133,9 @@ void bindAnalysis(py::module_& m) {
             "{renderer: {'T', 'J', 'flip_T' (per interval), 'e', 'flip_ref', 'sheet_axis', "
             "'sheet_sign' (per view), 'signal', and the numbers 'threshold', 'spike_ratio', "
             "'median_T', 'flicker_ratio', 'ms_per_frame', ...}}")
-        .def_property_readonly("cross_jump",
-                               [](const PoppingResult& r) { return doubles(r.crossJump); },
-                               "C per interval (axis and sheet both present).")
+        .def_property_readonly(
+            "cross_jump", [](const PoppingResult& r) { return doubles(r.crossJump); },
+            "C per interval (axis and sheet both present).")
         .def_property_readonly(
             "predicted_switches",
             [](const PoppingResult& r) { return doubles(r.predictedSwitches); },
@@ -162,9 +163,9 @@ void bindAnalysis(py::module_& m) {
         [](const PyVolume& v, const std::vector<std::string>& argv, const std::string& tfJson,
            const py::object& progress) {
             cli::PoppingArgs pa;
-            RenderSettings settings = parseRenderSettings(
-                argv, tfJson, v.volume.get(), false,
-                [&pa](CLI::App& app) { cli::addPoppingOptions(app, pa); });
+            RenderSettings settings =
+                parseRenderSettings(argv, tfJson, v.volume.get(), false,
+                                    [&pa](CLI::App& app) { cli::addPoppingOptions(app, pa); });
             Sweep sweep;
             PoppingOptions o;
             cli::poppingFromArgs(pa, settings, sweep, o);
@@ -227,9 +228,10 @@ void bindAnalysis(py::module_& m) {
     m.def(
         "_study",
         [](const PyVolume& v, const std::vector<std::string>& argv, const std::string& tfJson,
-           const std::vector<std::string>& sweeps, const std::vector<std::pair<double, double>>& views,
-           int repeats, int warmup, double truthStep, double truthTolerance, double ppd,
-           bool convergence, const std::string& cacheDir, const py::object& progress) {
+           const std::vector<std::string>& sweeps,
+           const std::vector<std::pair<double, double>>& views, int repeats, int warmup,
+           double truthStep, double truthTolerance, double ppd, bool convergence,
+           const std::string& cacheDir, const py::object& progress) {
             RenderSettings settings = parseRenderSettings(argv, tfJson, v.volume.get(), false);
             StudyOptions o;
             for (const std::string& s : sweeps) o.sweeps.push_back(parseKnob(s));
@@ -261,10 +263,9 @@ void bindAnalysis(py::module_& m) {
                 return r;
             });
         },
-        py::arg("volume"), py::arg("argv"), py::arg("tf_json"), py::arg("sweeps"),
-        py::arg("views"), py::arg("repeats"), py::arg("warmup"), py::arg("truth_step"),
-        py::arg("truth_tolerance"), py::arg("ppd"), py::arg("convergence"),
-        py::arg("cache_dir"), py::arg("progress"));
+        py::arg("volume"), py::arg("argv"), py::arg("tf_json"), py::arg("sweeps"), py::arg("views"),
+        py::arg("repeats"), py::arg("warmup"), py::arg("truth_step"), py::arg("truth_tolerance"),
+        py::arg("ppd"), py::arg("convergence"), py::arg("cache_dir"), py::arg("progress"));
     m.def("study_knobs", &studyKnobNames, "Knob names splat.study sweeps.");
 
     py::class_<Mesh>(m, "Mesh", "A triangle mesh in world coordinates (splat.iso_surface).")
@@ -301,8 +302,8 @@ void bindAnalysis(py::module_& m) {
             py::arg("path"), "Writes .ply, .obj or .stl atomically.");
     m.def(
         "iso_surface",
-        [](const PyVolume& v, double level, const std::string& kernel, double sigma,
-           double radius, int threads) {
+        [](const PyVolume& v, double level, const std::string& kernel, double sigma, double radius,
+           int threads) {
             SurfaceOptions o;
             o.kernel = kernel;
             o.kernelSigma = sigma;

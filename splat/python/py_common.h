@@ -49,10 +49,10 @@ class FileFailure : public Error {
 struct Interrupt {
     explicit Interrupt(py::object progress = py::none());
     std::atomic<bool> stop{false};
-    PyObject* callback = nullptr;       ///< null: none
-    bool byCallback = false;            ///< the callable returned False
-    std::exception_ptr callbackError;   ///< the callable raised
-    std::exception_ptr signalError;     ///< KeyboardInterrupt (or another signal handler's)
+    PyObject* callback = nullptr;      ///< null: none
+    bool byCallback = false;           ///< the callable returned False
+    std::exception_ptr callbackError;  ///< the callable raised
+    std::exception_ptr signalError;    ///< KeyboardInterrupt (or another signal handler's)
     /// A ProgressFn for the library: calls the Python callable (GIL taken) and returns false
     /// once the call is to stop. Holds a reference to *this: use it within the call.
     ProgressFn progress();
@@ -79,7 +79,8 @@ auto interruptible(Interrupt& in, F&& work, SceneCancel* scene = nullptr) -> dec
         runInterruptible(in, work, scene);
     } else {
         std::optional<R> result;
-        runInterruptible(in, [&] { result.emplace(work()); }, scene);
+        runInterruptible(
+            in, [&] { result.emplace(work()); }, scene);
         return std::move(*result);
     }
 }

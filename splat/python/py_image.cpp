@@ -64,8 +64,8 @@ void bindImage(py::module_& m) {
         "(missing alpha: 1), values as stored.");
     m.def(
         "write_image",
-        [](const std::string& path, const py::array& image, const py::object& window,
-           int bitDepth, bool alpha) {
+        [](const std::string& path, const py::array& image, const py::object& window, int bitDepth,
+           bool alpha) {
             const Image im = fromArray(image, "write_image");
             WriteOptions o;
             if (!window.is_none()) {
@@ -109,7 +109,8 @@ void bindImage(py::module_& m) {
                 py::gil_scoped_release release;
                 mt = compareImages(a, b);
                 if (flip)
-                    f = srgb ? flipMeanSrgb(a, b, flipOptions(ppd)) : flipMean(a, b, flipOptions(ppd));
+                    f = srgb ? flipMeanSrgb(a, b, flipOptions(ppd))
+                             : flipMean(a, b, flipOptions(ppd));
             }
             py::dict d = metricsDict(mt);
             d["flip"] = f;
@@ -129,7 +130,8 @@ void bindImage(py::module_& m) {
             std::copy(map.begin(), map.end(), out.mutable_data());
             return out;
         },
-        py::arg("test"), py::arg("reference"), py::arg("ppd") = flipPixelsPerDegree(0.7, 0.7, 3840.0),
+        py::arg("test"), py::arg("reference"),
+        py::arg("ppd") = flipPixelsPerDegree(0.7, 0.7, 3840.0),
         "Per-pixel LDR-FLIP (Andersson et al. 2020) between two linear RGB images, H x W.");
     m.def(
         "write_heatmap",

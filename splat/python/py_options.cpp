@@ -35,7 +35,8 @@ std::string keywordMessage(const CLI::ParseError& e) {
     std::string m = e.what();
     for (std::size_t at = 0; (at = m.find("--", at)) != std::string::npos;) {
         std::size_t end = at + 2;
-        while (end < m.size() && (std::isalnum(static_cast<unsigned char>(m[end])) || m[end] == '-'))
+        while (end < m.size() &&
+               (std::isalnum(static_cast<unsigned char>(m[end])) || m[end] == '-'))
             ++end;
         const std::string k = keywordOf(m.substr(at + 2, end - at - 2));
         m.replace(at, end - at, k + "=");
@@ -67,8 +68,7 @@ std::vector<std::tuple<std::string, std::string, std::string, std::string>> tabl
         if (o->get_lnames().empty()) continue;
         const std::string name = o->get_lnames().front();
         if (name == "help" || name == "write-scene") continue;
-        out.emplace_back(keywordOf(name), "--" + name, o->get_description(),
-                         o->get_default_str());
+        out.emplace_back(keywordOf(name), "--" + name, o->get_description(), o->get_default_str());
     }
     return out;
 }

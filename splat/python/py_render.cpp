@@ -98,8 +98,7 @@ void bindRender(py::module_& m) {
             "render",
             [](const PyScene& p, const std::vector<std::string>& argv, const std::string& tfJson,
                const py::object& progress, bool withStats, bool depth) {
-                RenderSettings s =
-                    parseRenderSettings(argv, tfJson, &p.scene->volume(), true);
+                RenderSettings s = parseRenderSettings(argv, tfJson, &p.scene->volume(), true);
                 Interrupt in(progress);
                 s.progress = frameProgress(in, p.cancel);
                 RenderStats stats;
@@ -150,9 +149,8 @@ void bindRender(py::module_& m) {
                 for (Image& im : images) out.append(toArray(std::move(im)));
                 return out;
             },
-            py::arg("sweep"), py::arg("from_"), py::arg("to"), py::arg("frames"),
-            py::arg("path"), py::arg("parallel_frames"), py::arg("first"), py::arg("count"),
-            py::arg("progress"))
+            py::arg("sweep"), py::arg("from_"), py::arg("to"), py::arg("frames"), py::arg("path"),
+            py::arg("parallel_frames"), py::arg("first"), py::arg("count"), py::arg("progress"))
         .def_property_readonly("splat_count",
                                [](const PyScene& p) { return p.scene->splats().size(); })
         .def_property_readonly("splat_bytes",

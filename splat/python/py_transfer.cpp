@@ -27,7 +27,8 @@ TransferFunction fromPoints(const py::object& pointsObj, bool normalized, double
     auto a = p.unchecked<2>();
     for (py::ssize_t i = 0; i < a.shape(0); ++i)
         tf.points.push_back(TransferPoint{
-            float(a(i, 0)), glm::vec4(float(a(i, 1)), float(a(i, 2)), float(a(i, 3)), float(a(i, 4)))});
+            float(a(i, 0)),
+            glm::vec4(float(a(i, 1)), float(a(i, 2)), float(a(i, 3)), float(a(i, 4)))});
     tf.validate("TransferFunction");
     return tf;
 }
@@ -74,9 +75,9 @@ points: N x 5 array of [value, r, g, b, a] rows, values non-decreasing, colour a
 Also TransferFunction.preset(name), .from_json(path) (the project's or ParaView's JSON,
 'path#Name' picks one ParaView preset) and .load(preset name or path), as --tf takes them.
 )doc")
-        .def(py::init(&fromPoints), py::arg("points"), py::kw_only(),
-             py::arg("normalized") = false, py::arg("unit_distance") = 1.0,
-             py::arg("mode") = py::none(), py::arg("name") = "custom")
+        .def(py::init(&fromPoints), py::arg("points"), py::kw_only(), py::arg("normalized") = false,
+             py::arg("unit_distance") = 1.0, py::arg("mode") = py::none(),
+             py::arg("name") = "custom")
         .def_static("preset", &TransferFunction::preset, py::arg("name"), presetDoc.c_str())
         .def_static("presets", &TransferFunction::presetNames, "The preset names.")
         .def_static(
@@ -124,7 +125,8 @@ Also TransferFunction.preset(name), .from_json(path) (the project's or ParaView'
                 const float* in = d.data();
                 float* o = out.mutable_data();
                 const py::ssize_t n = d.size();
-                auto flat = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(d);
+                auto flat =
+                    py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(d);
                 in = flat.data();
                 for (py::ssize_t i = 0; i < n; ++i) {
                     const glm::vec4 c = tf.sample(in[i]);
@@ -141,7 +143,8 @@ Also TransferFunction.preset(name), .from_json(path) (the project's or ParaView'
              "Normalized control points mapped onto [low, high].")
         .def("rescaled_to_data", &TransferFunction::rescaledToData,
              "The same function on the normalized domain (--tf-rescale).")
-        .def("to_json", &transferJson, "The project's JSON text (TransferFunction.from_json reads it).")
+        .def("to_json", &transferJson,
+             "The project's JSON text (TransferFunction.from_json reads it).")
         .def("__repr__", [](const TransferFunction& tf) {
             return "splat.TransferFunction('" + tf.name + "', " + std::to_string(tf.points.size()) +
                    " points, " + (tf.normalized ? "normalized" : "absolute") + ")";

@@ -3,6 +3,7 @@
 // reads; splat.from_nibabel's affine step. README "Python" states the conversions.
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <sstream>
 
 #include "py_common.h"
@@ -51,16 +52,21 @@ py::array_t<float, py::array::c_style> zyxFloat(const py::array& a, const std::s
     return py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(view);
 }
 
-/// Refuses NaN/Inf samples (policy "error", as the loaders' --nan-policy) or replaces them by
-/// 0 (policy "zero"; the count goes to the note). Runs without the GIL.
-void applyNanPolicy(Volume& v, const std::string& policy) {
+/// The first non-finite sample and their count (0: none), read through Volume::value
+/// whatever the storage. Runs without the GIL.
+std::pair<std::size_t, std::size_t> nonFinite(const Volume& v) {
     std::size_t count = 0, first = 0;
-    for (std::size_t n = 0; n < v.data.size(); ++n)
-        if (!std::isfinite(v.data[n])) {
+    for (std::size_t n = 0, total = v.voxelCount(); n < total; ++n)
+        if (!std::isfinite(v.value(n))) {
             if (!count) first = n;
             ++count;
-            if (policy == "zero") v.data[n] = 0.0f;
         }
+    return {count, first};
+}
+
+/// Refuses NaN/Inf samples (policy "error", as the loaders' --nan-policy) or, in an owned
+/// float volume, replaces them by 0 (policy "zero"; the count goes to the note).
+void applyNanPolicy(Volume& v, const std::string& policy, std::size_t count, std::size_t first) {
     if (!count) return;
     const std::size_t nx = std::size_t(v.dims.x), ny = std::size_t(v.dims.y);
     char where[96];
@@ -69,8 +75,33 @@ void applyNanPolicy(Volume& v, const std::string& policy) {
     if (policy != "zero")
         throw Error("splat.Volume: " + std::to_string(count) + " NaN/Inf samples (" + where +
                     "); nan_policy='zero' replaces them by 0");
+    for (float& d : v.data)
+        if (!std::isfinite(d)) d = 0.0f;
     if (!v.note.empty()) v.note += "; ";
     v.note += std::to_string(count) + " NaN/Inf samples replaced by 0 (" + where + ")";
+}
+
+/// The sample types a volume can borrow; nullopt for the others.
+std::optional<SampleType> borrowableType(const py::array& a) {
+    const py::dtype d = a.dtype();
+    if (!d.attr("isnative").cast<bool>()) return std::nullopt;  // byte-swapped: converted
+    const char kind = d.kind();
+    const py::ssize_t size = d.itemsize();
+    if (kind == 'f' && size == 4) return SampleType::Float32;
+    if (kind == 'u' && size == 1) return SampleType::UInt8;
+    if (kind == 'i' && size == 2) return SampleType::Int16;
+    if (kind == 'u' && size == 2) return SampleType::UInt16;
+    return std::nullopt;
+}
+
+/// Holds a Python object for the library (Volume keepAlive): released with the GIL taken,
+/// whichever thread drops the last reference.
+std::shared_ptr<const void> keepAlive(py::object o) {
+    PyObject* p = o.release().ptr();
+    return std::shared_ptr<const void>(p, [](const void* q) {
+        py::gil_scoped_acquire gil;
+        Py_DECREF(static_cast<PyObject*>(const_cast<void*>(q)));
+    });
 }
 
 void checkPolicy(const std::string& policy, const std::string& order) {
@@ -102,23 +133,44 @@ glm::ivec3 dimsOf(const py::array& a, const std::string& order) {
     return d;
 }
 
+/// The volume of a 3-D array: borrowed (no copy) when its [z, y, x] view is float32,
+/// uint8, int16 or uint16, C-contiguous and aligned (and `allowBorrow`), else a float32 copy.
 Volume volumeFromArray(const py::array& input, const glm::dvec3& spacing, const glm::dvec3& origin,
-                       const std::string& order, const std::string& nanPolicy) {
+                       const std::string& order, const std::string& nanPolicy,
+                       bool allowBorrow = true) {
     checkPolicy(nanPolicy, order);
     const glm::ivec3 dims = dimsOf(input, order);
     for (int a = 0; a < 3; ++a)
         if (!(spacing[a] > 0) || spacing[a] > 1e12)
             throw Error("splat.Volume: spacing must be finite and > 0 on every axis");
+    const std::string source = "NumPy array " + std::string(py::str(input.dtype())) + " " +
+                               shapeText(input) + (order == "xyz" ? " [x, y, z]" : " [z, y, x]");
+    py::array zyx = order == "zyx" ? input : py::array(input.attr("transpose")());
+    const auto type = borrowableType(zyx);
+    const bool contiguous = (zyx.flags() & py::array::c_style) &&
+                            (zyx.flags() & py::detail::npy_api::NPY_ARRAY_ALIGNED_);
+    if (allowBorrow && type && contiguous) {
+        Volume v = Volume::borrow(zyx.data(), *type, dims, spacing, origin, keepAlive(zyx));
+        v.source = source;
+        std::pair<std::size_t, std::size_t> bad;
+        {
+            py::gil_scoped_release release;
+            bad = nonFinite(v);
+        }
+        if (bad.first == 0) return v;
+        if (nanPolicy != "zero") applyNanPolicy(v, nanPolicy, bad.first, bad.second);
+        // nan_policy='zero' never writes into the caller's array: a float copy instead.
+    }
     py::array_t<float, py::array::c_style> samples = zyxFloat(input, order);
     Volume v = makeVolume(dims, spacing, "splat.Volume array");
     v.origin = origin;
-    v.source = "NumPy array " + std::string(py::str(input.dtype())) + " " + shapeText(input) +
-               (order == "xyz" ? " [x, y, z]" : " [z, y, x]");
+    v.source = source;
     const float* src = samples.data();
     {
         py::gil_scoped_release release;
         std::memcpy(v.data.data(), src, v.data.size() * sizeof(float));
-        applyNanPolicy(v, nanPolicy);
+        const auto [count, first] = nonFinite(v);
+        applyNanPolicy(v, nanPolicy, count, first);
     }
     return v;
 }
@@ -174,8 +226,8 @@ background_value: the field's value where nothing is (default: the median of the
                          const py::object& background, const std::string& nanPolicy) {
                  py::array a = py::array::ensure(array);
                  if (!a) throw Error("splat.Volume: the array is not convertible to a NumPy array");
-                 Volume v = volumeFromArray(a, vec3Of(spacing, "spacing"),
-                                            vec3Of(origin, "origin"), order, nanPolicy);
+                 Volume v = volumeFromArray(a, vec3Of(spacing, "spacing"), vec3Of(origin, "origin"),
+                                            order, nanPolicy);
                  setBackground(v, background);
                  return share(std::move(v));
              }),
@@ -187,13 +239,15 @@ background_value: the field's value where nothing is (default: the median of the
             "array",
             [](const py::object& self) {
                 const Volume& v = *self.cast<const PyVolume&>().volume;
-                py::array_t<float> a({py::ssize_t(v.dims.z), py::ssize_t(v.dims.y),
-                                      py::ssize_t(v.dims.x)},
-                                     v.data.data(), self);
+                py::dtype type = py::dtype(sampleTypeName(v.sampleType()));
+                py::array a(type,
+                            {py::ssize_t(v.dims.z), py::ssize_t(v.dims.y), py::ssize_t(v.dims.x)},
+                            v.sampleData(), self);
                 a.attr("flags").attr("writeable") = false;
                 return a;
             },
-            "The samples as a read-only NumPy view [z, y, x] (no copy).")
+            "The samples as a read-only NumPy view [z, y, x] (no copy): the wrapped array's "
+            "memory for a borrowed volume, with its dtype.")
         .def_property_readonly(
             "shape",
             [](const PyVolume& p) {
@@ -266,8 +320,12 @@ background_value: the field's value where nothing is (default: the median of the
             "notes", [](const PyVolume& p) { return notesOf(*p.volume); },
             "What the loader assumed or changed, one line each.")
         .def_property_readonly(
-            "dtype", [](const PyVolume&) { return std::string("float32"); },
-            "The sample type as stored.")
+            "dtype",
+            [](const PyVolume& p) { return std::string(sampleTypeName(p.volume->sampleType())); },
+            "The sample type as stored: float32, or uint8/int16/uint16 for wrapped arrays.")
+        .def_property_readonly(
+            "borrowed", [](const PyVolume& p) { return p.volume->borrowed(); },
+            "True when the samples are the wrapped NumPy array's memory (no copy).")
         .def_property_readonly(
             "nbytes", [](const PyVolume& p) { return p.volume->bytes(); },
             "Bytes the samples take.")
@@ -287,8 +345,9 @@ background_value: the field's value where nothing is (default: the median of the
                     else if (path.ends_with(".mha") || path.ends_with(".mhd"))
                         saveMetaImage(path, *p.volume);
                     else
-                        throw Error(path + ": unsupported volume type (use .nii, .nii.gz, .nrrd, "
-                                           ".mha or .mhd)");
+                        throw Error(path +
+                                    ": unsupported volume type (use .nii, .nii.gz, .nrrd, "
+                                    ".mha or .mhd)");
                 } catch (const FileFailure&) {
                     throw;
                 } catch (const Error& e) {
@@ -331,9 +390,14 @@ background_value: the field's value where nothing is (default: the median of the
                 for (int c = 0; c < 4; ++c)
                     if (!std::isfinite(A(r, c)))
                         throw Error("from_nibabel: the affine holds NaN or Inf");
-            Volume v = volumeFromArray(a, glm::dvec3(1.0), glm::dvec3(0.0), "xyz", nanPolicy);
+            Volume v;
+            if (isAxisAligned(M)) {  // spacing and origin only: the array as it is
+                v = volumeFromArray(a, glm::dvec3(M[0][0], M[1][1], M[2][2]), t, "xyz", nanPolicy);
+            } else {  // samples move: a float copy, oriented like the loaders do
+                v = volumeFromArray(a, glm::dvec3(1.0), glm::dvec3(0.0), "xyz", nanPolicy, false);
+                orientVolume(v, M, t, "affine");
+            }
             v.source = source;
-            orientVolume(v, M, t, "affine");
             setBackground(v, background);
             return share(std::move(v));
         },

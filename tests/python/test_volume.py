@@ -48,7 +48,10 @@ def test_changing_the_array_and_rewrapping_changes_the_image():
     a[4:12, 4:12, 4:12] = 0.5  # the volume sees the caller's memory
     assert v.array.max() == 0.5
     after = splat.render(splat.Volume(a), size=(24, 24), mode="mip")
-    assert after.max() == pytest.approx(before.max() / 2, rel=1e-6)
+    assert not same_bits(before, after)
+    # the same pixels as a converted copy of the changed data
+    assert same_bits(after, splat.render(splat.Volume(a.astype(np.float64)), size=(24, 24),
+                                         mode="mip"))
 
 
 @pytest.mark.parametrize("make", [
@@ -142,6 +145,16 @@ def test_nibabel_array_with_its_affine_equals_splat_load():
     assert a.background_value == b.background_value
     # zero-copy: nibabel's [x, y, z] uint8 array in Fortran order is [z, y, x] in C order
     assert a.borrowed
+
+
+def test_byte_swapped_and_nan_zeroed_arrays_are_copies():
+    a = np.arange(24, dtype=">f4").reshape(2, 3, 4)
+    v = splat.Volume(a)
+    assert not v.borrowed and v.dtype == "float32" and np.array_equal(v.array, a)
+    b = np.ones((2, 2, 2), np.float32)
+    b[0, 0, 0] = np.nan
+    w = splat.Volume(b, nan_policy="zero")
+    assert not w.borrowed and np.isnan(b[0, 0, 0])  # the caller's array is untouched
 
 
 def test_flipped_and_permuted_affine_equals_splat_load(tmp):
