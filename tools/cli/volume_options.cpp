@@ -7,9 +7,9 @@
 #include <sstream>
 
 #include "diagnostics.h"
+#include "technique_options.h"
 #include "scene_file.h"
 #include "splat/error.h"
-#include "technique_options.h"
 
 namespace splat::cli {
 namespace {
@@ -53,11 +53,10 @@ glm::dvec3 parseSpacing(const std::string& s) {
 
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
     const std::string g = "Volume";
-    addOption(
-        cmd, "VOLUME", args.spec,
-        "volume file (.nii .nii.gz .nrrd .nhdr .mhd .mha .raw), folder of slices or DICOM "
-        "files, or synthetic:NAME[:N] (phantom, ct-phantom, blob, cube, sphere, marschner-lobb)",
-        g, PathKind::Input);
+    addOption(cmd, "VOLUME", args.spec,
+              "volume file (.nii .nii.gz .nrrd .nhdr .mhd .mha .raw), folder of slices or DICOM "
+              "files, or synthetic:NAME[:N] (phantom, ct-phantom, blob, cube, sphere, marschner-lobb)",
+              g, PathKind::Input);
     addOption(cmd, "--dims", args.dims, "raw data: dimensions XxYxZ, e.g. 256x256x128", g);
     addOption(cmd, "--type", args.type,
               "raw data: sample type (uint8 int8 uint16 int16 uint32 int32 float32 float64)", g);
@@ -127,8 +126,7 @@ Volume loadVolumeFromArgs(const VolumeArgs& args) {
     // Recorded in every image the run writes, so that a scene reproduces.
     char b[64];
     std::snprintf(b, sizeof b, "%.9g", double(v.background));
-    runMetadata().push_back(
-        {"splat:background_value", std::string(b) + " (" + v.backgroundSource + ")"});
+    runMetadata().push_back({"splat:background_value", std::string(b) + " (" + v.backgroundSource + ")"});
     // Every command that loads a volume says what the loader had to assume or change.
     std::string note = v.note;
     for (std::size_t at; (at = note.find("; ")) != std::string::npos;) note.replace(at, 2, "\n");
