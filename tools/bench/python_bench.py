@@ -6,7 +6,11 @@
 #     settings (classification included) timed by the library.
 #  2. Throughput of 2 Python threads (1 render thread each) against 1 thread, same frames.
 #  3. Peak memory of wrapping a 512^3 float32 array (VmHWM before and after).
+#  4. Ctrl-C latency: SIGINT during a long reference render (ch2 512x512) and during a popping
+#     sweep, time until KeyboardInterrupt reaches Python.
 # Usage: PYTHONPATH=build/python /usr/bin/python3 tools/bench/python_bench.py [FRAMES]
+import os
+import signal
 import statistics
 import sys
 import threading
@@ -53,18 +57,20 @@ def threads(volume):
         for a in azimuths:
             scene.render(renderer="axis", azimuth=a, threads=1)
 
-    t = time.perf_counter()
+    t, c = time.perf_counter(), time.process_time()
     run(work)
-    one = time.perf_counter() - t
-    t = time.perf_counter()
+    one, cpu1 = time.perf_counter() - t, time.process_time() - c
+    t, c = time.perf_counter(), time.process_time()
     ts = [threading.Thread(target=run, args=(work[i::2],)) for i in range(2)]
     for th in ts:
         th.start()
     for th in ts:
         th.join()
-    two = time.perf_counter() - t
-    print(f"threads: {len(work)} frames 256x256 axis threads=1: 1 Python thread {one:.2f} s, "
-          f"2 Python threads {two:.2f} s: throughput x{one / two:.2f}")
+    two, cpu2 = time.perf_counter() - t, time.process_time() - c
+    # CPU seconds per wall second: 1 and 2 when the machine gives the process the cores.
+    print(f"threads: {len(work)} frames 256x256 axis threads=1: 1 Python thread {one:.2f} s "
+          f"(cpu/wall {cpu1 / one:.2f}), 2 Python threads {two:.2f} s (cpu/wall {cpu2 / two:.2f}): "
+          f"throughput x{one / two:.2f}; load average {os.getloadavg()[0]:.1f}")
 
 
 def wrap():
@@ -77,8 +83,29 @@ def wrap():
           f"({100 * grown * 1024 / a.nbytes:.2f}% of the array), borrowed={v.borrowed}")
 
 
+def interrupt(label, call):
+    """SIGINT once the call has run 1 s; the time until KeyboardInterrupt is caught."""
+    fired = []
+
+    def fire():
+        time.sleep(1.0)
+        fired.append(time.perf_counter())
+        os.kill(os.getpid(), signal.SIGINT)
+
+    threading.Thread(target=fire, daemon=True).start()
+    try:
+        call()
+        print(f"ctrl-c {label}: finished before the signal")
+    except KeyboardInterrupt:
+        print(f"ctrl-c {label}: KeyboardInterrupt {1e3 * (time.perf_counter() - fired[0]):.0f} ms "
+              f"after SIGINT")
+
+
 if __name__ == "__main__":
     ch2 = splat.load(CH2)
     overhead(ch2)
     threads(ch2)
     wrap()
+    interrupt("render", lambda: splat.render(ch2, tf="mri-head", size=(512, 512),
+                                             renderer="reference"))
+    interrupt("popping", lambda: splat.popping(ch2, tf="mri-head", size=(256, 256)))
