@@ -96,7 +96,7 @@ TEST_CASE("free camera: bad vectors are refused in one line", "[camera]") {
     c.upHint = glm::dvec3(std::nan(""), 0, 1);
     CHECK_THROWS_WITH(Camera(c, v), Catch::Contains("finite"));
     c.upHint = glm::dvec3(0, 1, 0);
-    CHECK_THROWS_WITH(CameraPath::turn(c, CameraPath::Angle::Azimuth, 0, 90, 4, false),
+    CHECK_THROWS_WITH(CameraPath::turn(c, CameraPath::Angle::Azimuth, 0, 90, 4),
                       Catch::Contains("free camera"));
 
     using splat::test::runSplat;

@@ -9,12 +9,16 @@ trap 'rm -rf "$tmp"' EXIT
 cmake --install build --prefix "$tmp/prefix" > "$tmp/install.log"
 cmake -S tools/consumer -B "$tmp/build" -DCMAKE_PREFIX_PATH="$tmp/prefix" -DCMAKE_BUILD_TYPE=Release \
     > "$tmp/configure.log" 2>&1 || { cat "$tmp/configure.log"; exit 1; }
-cmake --build "$tmp/build" -j"$(nproc)" > "$tmp/build.log" 2>&1 || { cat "$tmp/build.log"; exit 1; }
+# A consumer configures without warning blocks from splat's or its dependencies' CMake files.
+if grep -q "CMake Warning\|CMake Deprecation Warning" "$tmp/configure.log"; then
+    echo "test_install: configuring the consumer printed warnings:"; cat "$tmp/configure.log"; exit 1
+fi
+cmake --build "$tmp/build" -j2 > "$tmp/build.log" 2>&1 || { cat "$tmp/build.log"; exit 1; }
 "$tmp/build/splat_consumer" "$tmp"
-# pkg-config sees the same package.
+# pkg-config: relocatable (the prefix comes from the .pc file's folder), and the static
+# libraries' dependencies are in Libs, so a plain --libs links (with or without --static).
 pc=$(find "$tmp/prefix" -name splat.pc | head -1)
 [ -n "$pc" ] || { echo "test_install: no splat.pc installed"; exit 1; }
-PKG_CONFIG_PATH=$(dirname "$pc") pkg-config --cflags --libs splat > /dev/null
 # The Python package (SPLAT_PYTHON): imported from the prefix's site folder, one render.
 if grep -q "^SPLAT_PYTHON:BOOL=ON" build/CMakeCache.txt; then
     python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' build/CMakeCache.txt)
@@ -24,4 +28,18 @@ if grep -q "^SPLAT_PYTHON:BOOL=ON" build/CMakeCache.txt; then
         "import splat; assert splat.render(splat.synthetic('blob', 16), size=(8, 8)).shape == (8, 8, 4)")
     echo "install: Python package splat imports from $(dirname "$site")"
 fi
-echo "install: ok (find_package(splat) and pkg-config splat from a temporary prefix)"
+mv "$tmp/prefix" "$tmp/moved"  # any prefix: the installed tree moved after installing
+pcdir=$(dirname "${pc/$tmp\/prefix/$tmp/moved}")
+flags=$(PKG_CONFIG_PATH=$pcdir pkg-config --cflags --libs splat)
+inc=$(PKG_CONFIG_PATH=$pcdir pkg-config --variable=includedir splat)
+[ "$(realpath "$inc")" = "$(realpath "$tmp/moved/include")" ] ||
+    { echo "test_install: pkg-config's includedir $inc is not the prefix's"; exit 1; }
+for mode in plain static; do
+    extra=$([ $mode = static ] && PKG_CONFIG_PATH=$pcdir pkg-config --static --libs splat || true)
+    # shellcheck disable=SC2086
+    c++ -O1 -o "$tmp/pc_consumer_$mode" tools/consumer/main.cpp $flags $extra \
+        > "$tmp/pc_$mode.log" 2>&1 || { echo "test_install: pkg-config ($mode) link failed:"; \
+        tail -20 "$tmp/pc_$mode.log"; exit 1; }
+    "$tmp/pc_consumer_$mode" "$tmp"
+done
+echo "install: ok (find_package(splat) without warnings; pkg-config splat from a moved prefix, plain and --static)"

@@ -129,7 +129,7 @@ void bindRender(py::module_& m) {
                         ? CameraPath::turn(base.camera,
                                            sweep == "azimuth" ? CameraPath::Angle::Azimuth
                                                               : CameraPath::Angle::Elevation,
-                                           from, to, frames, true)
+                                           from, to, frames)
                         : CameraPath::fromJson(pathFile, base.camera, frames);
                 Interrupt in(progress);
                 SequenceOptions o;

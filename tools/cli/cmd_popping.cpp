@@ -39,6 +39,14 @@ void printSummary(const PoppingResult& r) {
         std::printf("%-10s %12.2f %12.3g %10.2f %8d %12.1f\n", toString(s.renderer), s.spikeRatio,
                     s.medianT, s.flickerRatio, events, s.msPerFrame);
     }
+    for (const RendererSeries& s : r.series) {
+        std::size_t exact = 0;
+        for (std::size_t p : s.exactPixels) exact += p > 0;
+        if (exact > 0)
+            warn(std::string(toString(s.renderer)) + ": " + std::to_string(exact) + " of " +
+                 std::to_string(s.exactPixels.size()) +
+                 " views handed to the exact path (the reference's pixels): " + s.exactReason);
+    }
     for (double a : r.predictedSwitches) std::printf("predicted sheet switch at %.6f degrees\n", a);
     for (const PoppingEvent& e : r.events)
         std::printf(

@@ -66,6 +66,10 @@ void registerRender(CLI::App& app) {
             stats.perspective ? "perspective" : "orthographic",
             stats.exactPixels ? " (eye near the volume: exact path for every pixel)" : "",
             stats.culledSplats, stats.footprintPixels);
+        if (stats.exactPixels > 0)
+            warn(std::to_string(stats.exactPixels) + " of " +
+                 std::to_string(std::size_t(image.width) * std::size_t(image.height)) +
+                 " pixels handed to the exact path: " + stats.exactReason);
         if (stats.lodLevel > 0)
             std::printf("level of detail %d: %zu splats of %dx%dx%d voxels each (--lod %g)\n",
                         stats.lodLevel, stats.lodSplats, 1 << stats.lodLevel, 1 << stats.lodLevel,

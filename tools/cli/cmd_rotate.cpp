@@ -257,8 +257,8 @@ void registerRotate(CLI::App& app) {
     addOption(*cmd, "--frames", a->frames, "number of frames", seq);
     addOption(*cmd, "--from", a->from, "first angle, degrees", seq);
     addOption(*cmd, "--to", a->to,
-              "end of the turn, degrees: frames are spaced evenly over [from, to), so the last "
-              "frame is one step before it and 0..360 loops without repeating a view",
+              "last angle, degrees (inclusive: the last frame is at --to). Default: a full "
+              "turn that loops without repeating a view, from + 360 (frames - 1) / frames",
               seq);
     addOption(*cmd, "--sweep", a->sweep, "the angle turned: azimuth or elevation", seq);
     addOption(*cmd, "--path", a->path,
@@ -344,11 +344,15 @@ void registerRotate(CLI::App& app) {
                         a->render.size +
                         " would not fit in memory; use fewer frames or a smaller --size");
         const CameraPath path =
-            a->path.empty() ? CameraPath::turn(settings.camera,
-                                               a->sweep == "azimuth" ? CameraPath::Angle::Azimuth
-                                                                     : CameraPath::Angle::Elevation,
-                                               a->from, a->to, a->frames, true)
-                            : CameraPath::fromJson(a->path, settings.camera, a->frames);
+            a->path.empty()
+                ? CameraPath::turn(
+                      settings.camera,
+                      a->sweep == "azimuth" ? CameraPath::Angle::Azimuth
+                                            : CameraPath::Angle::Elevation,
+                      a->from,
+                      given(*cmd, "to") ? a->to : a->from + 360.0 * (a->frames - 1) / a->frames,
+                      a->frames)
+                : CameraPath::fromJson(a->path, settings.camera, a->frames);
         nlohmann::json manifest = manifestOf(*a, settings);
         const std::vector<bool> keep =
             prepareFolder(*a, manifest, settings.camera.width, settings.camera.height);

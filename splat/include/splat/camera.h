@@ -34,6 +34,14 @@ struct CameraParams {
     glm::dvec3 eye{0.0}, lookAt{0.0}, upHint{0.0, 0.0, 1.0};
 };
 
+/// The camera a fraction t in [0, 1] of the way from a to b (the popping analyzer's
+/// refinement between two views of a camera path): every number interpolated linearly —
+/// azimuth, elevation, distance, pixel size and field of view, and for a free camera eye,
+/// look-at point and up vector — as CameraPath::fromJson interpolates between its keys.
+/// t = 0 gives a, t = 1 gives b exactly. Throws splat::Error when a and b differ in what
+/// cannot be interpolated: image size, projection, or orbit against free camera.
+CameraParams interpolateCamera(const CameraParams& a, const CameraParams& b, double t);
+
 struct Ray {
     glm::dvec3 origin, dir;  ///< dir is unit length
 };

@@ -29,7 +29,8 @@
 
 namespace splat {
 
-/// The views of a sweep: the base camera turned about one angle.
+/// The views of a sweep: the base camera turned about one angle. End points follow the one
+/// convention of splat/DESIGN.md ("Sequences"): `to` is inclusive, the last view.
 struct Sweep {
     enum class Angle { Azimuth, Elevation };
     Angle angle = Angle::Azimuth;
@@ -99,7 +100,12 @@ struct RendererSeries {
     /// Per view n (angles.size() entries): error against the reference and its mean FLIP.
     std::vector<double> e, flipRef;
     std::vector<int> sheetAxis, sheetSign;  ///< per view (axis-aligned; else -1, 0)
-    std::vector<double> signal;             ///< the detection signal per interval
+    /// Per view: pixels the splatter handed to the reference (RenderStats::exactPixels; 0
+    /// for the reference itself). A view with exact pixels compares the reference with
+    /// itself there; the report marks it.
+    std::vector<std::size_t> exactPixels;
+    std::string exactReason;     ///< the first such view's RenderStats::exactReason
+    std::vector<double> signal;  ///< the detection signal per interval
     double threshold = 0, medianSignal = 0, spikeRatio = 0;  ///< max signal / median
     double medianT = 0, flickerRatio = 0;  ///< median T / reference's median T (0 without)
     double msPerFrame = 0, totalMs = 0;    ///< median frame time, total render time
@@ -107,7 +113,13 @@ struct RendererSeries {
 };
 
 struct PoppingResult {
+    /// The sweep analysed; for a camera path (pathViews > 0) unused.
     Sweep sweep;
+    /// Views of the camera path analysed; 0 for a sweep. For a path, `angles` and every
+    /// angle of the result (events, refinement, predicted switches) are path positions u:
+    /// view n at u = n, a fractional u the camera interpolated between views floor(u) and
+    /// floor(u) + 1 (interpolateCamera).
+    std::size_t pathViews = 0;
     PoppingOptions options;   ///< as used (progress omitted)
     RenderSettings settings;  ///< the scene's settings
     std::vector<RendererKind> renderers;
@@ -122,11 +134,25 @@ struct PoppingResult {
 
 /// Renders the sweep with every renderer of `options` from `scene`, measures, detects and
 /// refines events. Throws splat::Error on bad sweeps, splat::Cancelled when cancelled.
+/// Progress: `total` is the sweep's frames (views x renderers) until the events are found,
+/// then grows once, by the refinement's frames (events x (refine + 2) x renderers), and
+/// stays; `done` never exceeds it. Cancel reaches inside the frame in flight.
 PoppingResult analyzePopping(const Scene& scene, const Sweep& sweep, const PoppingOptions& options);
+/// The same over any camera path (at least 3 views; every view of the same image size and
+/// projection, all orbit or all free cameras): interval n lies between views n and n + 1,
+/// thresholds and report as for a sweep; refinement bisects an interval in path position,
+/// rendering the camera interpolated between its two views (interpolateCamera).
+PoppingResult analyzePopping(const Scene& scene, const CameraPath& path,
+                             const PoppingOptions& options);
+/// The same over explicit cameras.
+PoppingResult analyzePopping(const Scene& scene, const std::vector<CameraParams>& views,
+                             const PoppingOptions& options);
 
 /// The angles in (from, to) where the axis-aligned splatter's sheet axis (the major axis of
 /// S^-1 view) changes along the sweep, to 1e-9 degrees.
 std::vector<double> predictSheetSwitches(const Sweep& sweep, const Volume& volume);
+/// The path positions u where the sheet axis changes along a camera path (views at u = n).
+std::vector<double> predictSheetSwitches(const CameraPath& path, const Volume& volume);
 
 /// Writes `dir`/report.html (self-contained: inline SVG plots, embedded images and
 /// animation), metrics.csv (one row per renderer and interval) and summary.json (schema in

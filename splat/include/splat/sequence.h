@@ -22,11 +22,12 @@ struct CameraPath {
     std::vector<CameraParams> views;
 
     enum class Angle { Azimuth, Elevation };
-    /// `frames` views turning `angle` evenly from `from` towards `to`: with `closed` the last
-    /// view is one step before `to` (from 0 to 360 loops without repeating a view), else
-    /// the last view is `to`.
+    /// `frames` views turning `angle` evenly from `from` to `to`, both inclusive (the one
+    /// end-point convention of splat/DESIGN.md "Sequences": the last view is `to`; one frame
+    /// is `from`). A loop that does not repeat its first view ends one step short of a full
+    /// turn: to = from + 360 (frames - 1) / frames (the `splat rotate` default).
     static CameraPath turn(const CameraParams& base, Angle angle, double from, double to,
-                           int frames, bool closed);
+                           int frames);
     /// A JSON camera path: {"keys": [{"azimuth": 0, "elevation": 10, "distance": 400}, ...]}
     /// (each key's missing fields keep the base camera's), `frames` views interpolated
     /// linearly along the keys by their index (at least 2 keys; `frames` >= 2).
@@ -38,7 +39,11 @@ struct SequenceOptions {
     /// 256 x 256 pixels and scenes of up to 1M splats, else one frame at a time on
     /// every thread.
     int parallelFrames = 0;
-    ProgressFn progress;  ///< called after every frame (serialised)
+    /// Called (serialised) after every frame with done frames of `total` = views x
+    /// renderers, fixed up front; and inside each frame after every tile or row with the
+    /// same done and total (`what` names the frame and its tiles/rows), so that returning
+    /// false cancels the frame in flight too.
+    ProgressFn progress;
     /// Views to leave out (e.g. frames already on disk); null: none.
     std::function<bool(std::size_t view)> skip;
 };

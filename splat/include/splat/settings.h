@@ -3,9 +3,9 @@
 // kernel, shading), how (renderer, compositing order, camera) and the Quality knobs that
 // trade speed for accuracy. Every such knob lives in Quality, so that a speed/accuracy
 // study can move any of them; defaults are the figures the README's tables are made with.
-#include <glm/glm.hpp>
 #include <cstddef>
 #include <functional>
+#include <glm/glm.hpp>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -27,7 +27,6 @@ class Cancelled : public Error {
   public:
     Cancelled() : Error("cancelled") {}
 };
-
 
 enum class RendererKind { Axis, Sheet, Reference };
 enum class RenderMode { Dvr, Mip, Xray, Iso };
@@ -170,6 +169,10 @@ struct RenderStats {
     /// a kernel straddles or lies behind the perspective near plane (eye inside or within
     /// two kernel radii of the volume's kernels), where a local-affine footprint is invalid.
     std::size_t exactPixels = 0;
+    /// Why pixels went to the exact path (empty when none did): a splatter's frame with
+    /// exactPixels > 0 is the reference's, and comparing it with the reference says nothing.
+    /// The command line prints it as a warning; popping and study reports mark such frames.
+    std::string exactReason;
     /// Level of detail the splatters used (Quality::lod): 0 the full-resolution list, L the
     /// list of 2^L x 2^L x 2^L voxels merged per splat, holding lodSplats splats (= splats at
     /// level 0; 0 for frames of the reference ray caster).

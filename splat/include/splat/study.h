@@ -73,6 +73,9 @@ struct StudyPoint {
     double rmse = 0, psnr = 0, maxAbs = 0;
     double flip = NAN;  ///< mean LDR-FLIP (NaN when splat/flip.h is not built in)
     bool pareto = false;
+    /// Frames (views x repeats) whose pixels the splatter handed to the reference
+    /// (RenderStats::exactPixels > 0): their error says nothing about the splatter.
+    std::size_t exactFrames = 0;
     std::string label() const;  ///< "renderer=sheet slab=0.5"
 };
 

@@ -192,12 +192,15 @@ class Scene:
         depth[image[..., 3] == 0] = np.nan
         return depth
 
-    def rotate(self, frames: int = 36, *, from_: float = 0.0, to: float = 360.0,
+    def rotate(self, frames: int = 36, *, from_: float = 0.0, to: float | None = None,
                sweep: str = "azimuth", path: str | None = None, parallel_frames: int = 0,
                progress=None, batch: int = 8):
         """Frames of a turn about the volume (as `splat rotate`): `frames` views spaced
-        evenly over [from_, to) in azimuth or elevation, or along a camera path JSON file;
-        yields the images in order, rendered `batch` views at a time."""
+        evenly from from_ to `to`, both included (default: a loop, from_ + 360 (frames - 1) /
+        frames), in azimuth or elevation, or along a camera path JSON file; yields the images
+        in order, rendered `batch` views at a time."""
+        if to is None:
+            to = from_ + 360.0 * (int(frames) - 1) / max(1, int(frames))
         for first in range(0, int(frames), max(1, int(batch))):
             yield from self._scene.sequence(sweep, float(from_), float(to), int(frames),
                                             path or "", int(parallel_frames), first,
@@ -217,7 +220,7 @@ class Scene:
 Scene.__init__.__doc__ = "Scene(volume, **options); options as splat.render's:\n" + _RENDER_DOC
 
 
-def rotate(volume: Volume, frames: int = 36, *, from_: float = 0.0, to: float = 360.0,
+def rotate(volume: Volume, frames: int = 36, *, from_: float = 0.0, to: float | None = None,
            sweep: str = "azimuth", path: str | None = None, parallel_frames: int = 0,
            progress=None, **options):
     """Scene(volume, **options).rotate(...): an iterator of frames (`splat rotate`)."""

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <numeric>
 
@@ -65,8 +66,18 @@ struct View {
 
 class Analyzer {
   public:
-    Analyzer(const Scene& scene, const Sweep& sweep, const PoppingOptions& options)
-        : scene_(scene), sweep_(sweep), options_(options) {
+    /// `positions` are the views' sweep angles or path positions, `cameraAt` the camera at
+    /// any position between the first and the last.
+    Analyzer(const Scene& scene, const Sweep& sweep, std::size_t pathViews,
+             std::vector<double> positions, std::function<CameraParams(double)> cameraAt,
+             std::vector<double> predicted, const PoppingOptions& options)
+        : scene_(scene),
+          sweep_(sweep),
+          pathViews_(pathViews),
+          positions_(std::move(positions)),
+          predicted_(std::move(predicted)),
+          cameraAt_(std::move(cameraAt)),
+          options_(options) {
         kinds_ = options.renderers;
         if (kinds_.empty()) throw Error("popping: no renderer to analyse");
         for (std::size_t i = 0; i < kinds_.size(); ++i)
@@ -87,27 +98,32 @@ class Analyzer {
         const auto start = Clock::now();
         PoppingResult r;
         r.sweep = sweep_;
+        r.pathViews = pathViews_;
         r.options = options_;
         r.options.progress = nullptr;
         r.settings = scene_.settings();
         r.renderers = kinds_;
-        r.angles = sweep_.angles();
-        if (r.angles.size() < 3)
-            throw Error("popping: a sweep needs at least 3 views (from, to and step give " +
-                        std::to_string(r.angles.size()) + ")");
-        r.predictedSwitches = predictSheetSwitches(sweep_, scene_.volume());
+        r.angles = positions_;
+        r.predictedSwitches = predicted_;
         const std::size_t views = r.angles.size();
         totalUnits_ = views * kinds_.size();
+        const CameraParams& base = cameraAt_(r.angles.front());
         r.series.resize(kinds_.size());
         for (std::size_t k = 0; k < kinds_.size(); ++k) r.series[k].renderer = kinds_[k];
 
         std::vector<std::vector<double>> frameMs(kinds_.size());
         CameraPath path;
-        for (double angle : r.angles) path.views.push_back(sweep_.camera(angle));
+        for (double angle : r.angles) path.views.push_back(cameraAt_(angle));
         SequenceOptions so;
         so.parallelFrames = options_.parallelFrames;
-        so.progress = [&](std::size_t, std::size_t, const std::string& what) {
-            report(what);
+        std::size_t sequenceDone = 0;
+        so.progress = [&](std::size_t done, std::size_t, const std::string& what) {
+            if (done > sequenceDone) {  // a frame finished
+                sequenceDone = done;
+                report(what);
+            } else {  // a tile of the frame in flight
+                poll(what);
+            }
             return !cancelled_;
         };
         // Views whose frames are all in the journal are read back, not rendered.
@@ -115,9 +131,8 @@ class Analyzer {
         for (std::size_t v = 0; v < views && !options_.frameJournal.empty(); ++v) {
             journaled[v] = true;
             for (std::size_t k = 0; k < kinds_.size(); ++k)
-                journaled[v] =
-                    journaled[v] && journal::hasFrame(journalFile(r.angles[v], k),
-                                                      sweep_.base.width, sweep_.base.height);
+                journaled[v] = journaled[v] && journal::hasFrame(journalFile(r.angles[v], k),
+                                                                 base.width, base.height);
         }
         so.skip = [&](std::size_t v) { return bool(journaled[v]); };
         View prev;
@@ -155,10 +170,16 @@ class Analyzer {
             for (RendererSeries& s : r.series)
                 s.flickerRatio =
                     r.series[ref_].medianT > 0 ? s.medianT / r.series[ref_].medianT : 0;
+        std::vector<std::pair<std::size_t, std::size_t>> found;
         for (std::size_t k = 0; k < kinds_.size(); ++k)
             for (std::size_t n = 0; n < r.series[k].signal.size(); ++n)
-                if (r.series[k].signal[n] > r.series[k].threshold)
-                    r.events.push_back(event(r, k, n));
+                if (r.series[k].signal[n] > r.series[k].threshold) found.emplace_back(k, n);
+        {
+            // The refinement's frames are known now: the total grows once, here.
+            std::lock_guard<std::mutex> lock(progressMutex_);
+            totalUnits_ = done_ + found.size() * std::size_t(options_.refine + 2) * kinds_.size();
+        }
+        for (const auto& [k, n] : found) r.events.push_back(event(r, k, n));
         r.totalMs = msSince(start);
         return r;
     }
@@ -171,6 +192,10 @@ class Analyzer {
             s.totalMs += cur.stats[k].milliseconds;
             s.sheetAxis.push_back(cur.stats[k].sheetAxis);
             s.sheetSign.push_back(cur.stats[k].sheetSign);
+            s.exactPixels.push_back(
+                kinds_[k] == RendererKind::Reference ? 0 : cur.stats[k].exactPixels);
+            if (s.exactReason.empty() && s.exactPixels.back() > 0)
+                s.exactReason = cur.stats[k].exactReason;
             s.thumbnails.push_back(downscale(cur.images[k], options_.thumbnail));
             if (ref_ >= 0) {
                 s.e.push_back(rmsDiff(cur.images[k], cur.images[ref_]));
@@ -296,7 +321,11 @@ class Analyzer {
         v.images.resize(kinds_.size());
         v.stats.resize(kinds_.size());
         RenderSettings s = scene_.settings();
-        s.camera = sweep_.camera(angle);
+        s.camera = cameraAt_(angle);
+        s.progress = [this](std::size_t, std::size_t, const std::string& what) {
+            poll(what);
+            return !cancelled_;
+        };
         const bool journaling = !options_.frameJournal.empty();
         for (std::size_t k = 0; k < kinds_.size(); ++k) {
             s.renderer = kinds_[k];
@@ -316,8 +345,15 @@ class Analyzer {
     void report(const std::string& what) {
         std::lock_guard<std::mutex> lock(progressMutex_);
         ++done_;
-        totalUnits_ = std::max(totalUnits_, done_);
         if (options_.progress && !options_.progress(done_, totalUnits_, what)) cancelled_ = true;
+    }
+
+    /// Inside a frame: ask the progress callback again (same done and total), so that a
+    /// cancel stops the frame in flight.
+    void poll(const std::string& what) {
+        std::lock_guard<std::mutex> lock(progressMutex_);
+        if (!cancelled_ && options_.progress && !options_.progress(done_, totalUnits_, what))
+            cancelled_ = true;
     }
 
     void setWindow(const View& first) {
@@ -350,6 +386,9 @@ class Analyzer {
 
     const Scene& scene_;
     const Sweep& sweep_;
+    std::size_t pathViews_;
+    std::vector<double> positions_, predicted_;
+    std::function<CameraParams(double)> cameraAt_;
     const PoppingOptions& options_;
     std::vector<RendererKind> kinds_;
     int ref_ = -1, axis_ = -1, sheet_ = -1;
@@ -376,8 +415,9 @@ std::vector<double> Sweep::angles() const {
 
 CameraParams Sweep::camera(double angle) const {
     if (base.lookAtSet)
-        throw Error("sweep: a free camera (--eye/--look-at) does not turn; sweeps orbit the "
-                    "volume centre by azimuth or elevation");
+        throw Error(
+            "sweep: a free camera (--eye/--look-at) does not turn; sweeps orbit the "
+            "volume centre by azimuth or elevation");
     CameraParams c = base;
     (this->angle == Angle::Azimuth ? c.azimuthDeg : c.elevationDeg) = angle;
     return c;
@@ -389,10 +429,39 @@ const RendererSeries* PoppingResult::find(RendererKind k) const {
     return nullptr;
 }
 
-std::vector<double> predictSheetSwitches(const Sweep& sweep, const Volume& volume) {
-    const std::vector<double> angles = sweep.angles();
+namespace {
+
+/// The camera at path position u: view floor(u) interpolated towards the next.
+CameraParams pathCamera(const CameraPath& path, double u) {
+    const std::size_t last = path.views.size() - 1;
+    if (!(u > 0)) return path.views.front();
+    if (u >= double(last)) return path.views.back();
+    const std::size_t a = std::min(last - 1, std::size_t(u));
+    return interpolateCamera(path.views[a], path.views[a + 1], u - double(a));
+}
+
+std::vector<double> pathPositions(const CameraPath& path) {
+    if (path.views.size() < 3)
+        throw Error("popping: a camera path needs at least 3 views (" +
+                    std::to_string(path.views.size()) + " given)");
+    if (path.views.size() > kMaxViews)
+        throw Error("popping: " + std::to_string(path.views.size()) + " views is more than " +
+                    std::to_string(kMaxViews));
+    std::vector<double> u(path.views.size());
+    for (std::size_t n = 0; n < u.size(); ++n) u[n] = double(n);
+    // Every interval must be interpolable (refinement renders between its views).
+    for (std::size_t n = 0; n + 1 < u.size(); ++n)
+        (void)interpolateCamera(path.views[n], path.views[n + 1], 0.5);
+    return u;
+}
+
+/// Where the sheet axis changes between consecutive positions, to 1e-9.
+std::vector<double> sheetSwitches(const std::vector<double>& positions,
+                                  const std::function<CameraParams(double)>& cameraAt,
+                                  const Volume& volume) {
+    const std::vector<double>& angles = positions;
     auto axisAt = [&](double angle) {
-        const Camera cam(sweep.camera(angle), volume);
+        const Camera cam(cameraAt(angle), volume);
         return sheetAxis(cam.view, volume.spacing).axis;
     };
     std::vector<double> out;
@@ -412,9 +481,46 @@ std::vector<double> predictSheetSwitches(const Sweep& sweep, const Volume& volum
     return out;
 }
 
+}  // namespace
+
+std::vector<double> predictSheetSwitches(const Sweep& sweep, const Volume& volume) {
+    return sheetSwitches(
+        sweep.angles(), [&](double a) { return sweep.camera(a); }, volume);
+}
+
+std::vector<double> predictSheetSwitches(const CameraPath& path, const Volume& volume) {
+    return sheetSwitches(
+        pathPositions(path), [&](double u) { return pathCamera(path, u); }, volume);
+}
+
 PoppingResult analyzePopping(const Scene& scene, const Sweep& sweep,
                              const PoppingOptions& options) {
-    return Analyzer(scene, sweep, options).run();
+    std::vector<double> angles = sweep.angles();
+    if (angles.size() < 3)
+        throw Error("popping: a sweep needs at least 3 views (from, to and step give " +
+                    std::to_string(angles.size()) + ")");
+    auto cameraAt = [&sweep](double a) { return sweep.camera(a); };
+    std::vector<double> predicted = sheetSwitches(angles, cameraAt, scene.volume());
+    return Analyzer(scene, sweep, 0, std::move(angles), cameraAt, std::move(predicted), options)
+        .run();
+}
+
+PoppingResult analyzePopping(const Scene& scene, const CameraPath& path,
+                             const PoppingOptions& options) {
+    std::vector<double> u = pathPositions(path);
+    auto cameraAt = [&path](double x) { return pathCamera(path, x); };
+    std::vector<double> predicted = sheetSwitches(u, cameraAt, scene.volume());
+    const Sweep none;
+    return Analyzer(scene, none, path.views.size(), std::move(u), cameraAt, std::move(predicted),
+                    options)
+        .run();
+}
+
+PoppingResult analyzePopping(const Scene& scene, const std::vector<CameraParams>& views,
+                             const PoppingOptions& options) {
+    CameraPath path;
+    path.views = views;
+    return analyzePopping(scene, path, options);
 }
 
 }  // namespace splat

@@ -23,10 +23,10 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <tuple>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include "analysis/html_report.h"
 #include "analysis/svg_plot.h"
@@ -81,10 +81,19 @@ std::string csvNumber(double v) {
     return buf;
 }
 
-std::string deg(double v) { return formatNumber(v, 6) + "°"; }
+// The unit of the positions in the report being written: degrees for a sweep, none for a
+// camera path (positions are view indices). Set by writePoppingReport for its thread.
+thread_local const char* positionUnit = "°";
+
+std::string deg(double v) { return formatNumber(v, 6) + positionUnit; }
 
 const char* angleName(Sweep::Angle a) {
     return a == Sweep::Angle::Azimuth ? "azimuth" : "elevation";
+}
+
+/// What the positions are: the swept angle, or the camera path's view index.
+std::string positionName(const PoppingResult& r) {
+    return r.pathViews > 0 ? "path position (view)" : angleName(r.sweep.angle);
 }
 
 std::string sheetName(int axis, int sign) {
@@ -290,11 +299,18 @@ json summaryJson(const PoppingResult& r) {
     json j;
     j["version"] = 1;
     j["settings"] = settingsJson(r.settings);
-    j["sweep"] = {{"angle", angleName(r.sweep.angle)},
-                  {"from", r.sweep.from},
-                  {"to", r.sweep.to},
-                  {"step", r.sweep.step},
-                  {"views", r.angles.size()}};
+    if (r.pathViews > 0)
+        j["sweep"] = {{"angle", "path"},
+                      {"from", 0},
+                      {"to", r.pathViews - 1},
+                      {"step", 1},
+                      {"views", r.angles.size()}};
+    else
+        j["sweep"] = {{"angle", angleName(r.sweep.angle)},
+                      {"from", r.sweep.from},
+                      {"to", r.sweep.to},
+                      {"step", r.sweep.step},
+                      {"views", r.angles.size()}};
     j["options"] = optionsJson(r.options);
     json renderers = json::object();
     for (const RendererSeries& s : r.series) {
@@ -306,6 +322,12 @@ json summaryJson(const PoppingResult& r) {
         o["median_error"] = number(median(s.e));
         o["ms_per_frame"] = number(s.msPerFrame);
         o["total_ms"] = number(s.totalMs);
+        // Views whose pixels the splatter handed to the reference (issue 24): listed, so
+        // that a flat signal there is not read as "no popping".
+        o["exact_views"] = json::array();
+        for (std::size_t n = 0; n < s.exactPixels.size(); ++n)
+            if (s.exactPixels[n] > 0) o["exact_views"].push_back(r.angles[n]);
+        if (!s.exactReason.empty()) o["exact_reason"] = s.exactReason;
         o["events"] = json::array();
         for (const PoppingEvent& e : r.events) {
             if (e.renderer != s.renderer) continue;
@@ -434,15 +456,32 @@ std::string headerSection(const PoppingResult& r, const std::string& commandLine
                    toString(s.classification) + "-classified, kernel " + s.kernel + ", " +
                    std::to_string(s.camera.width) + "×" + std::to_string(s.camera.height) +
                    " pixels, " + toString(s.camera.projection)));
-    row("sweep", escapeHtml(std::string(angleName(r.sweep.angle)) + " from " + deg(r.sweep.from) +
-                            " to " + deg(r.sweep.to) + " in steps of " + deg(r.sweep.step) + " (" +
-                            std::to_string(r.angles.size()) + " views)"));
+    if (r.pathViews > 0)
+        row("camera path",
+            escapeHtml(std::to_string(r.pathViews) +
+                       " views; positions are view indices, refinement renders the camera "
+                       "interpolated between two views"));
+    else
+        row("sweep",
+            escapeHtml(std::string(angleName(r.sweep.angle)) + " from " + deg(r.sweep.from) +
+                       " to " + deg(r.sweep.to) + " in steps of " + deg(r.sweep.step) + " (" +
+                       std::to_string(r.angles.size()) + " views)"));
     std::string names;
     for (std::size_t i = 0; i < r.renderers.size(); ++i)
         names += (i ? ", " : "") + std::string(toString(r.renderers[i]));
     row("renderers", escapeHtml(names));
     row("events", std::to_string(r.events.size()) + " detected, " +
                       std::to_string(r.predictedSwitches.size()) + " predicted sheet switches");
+    for (const RendererSeries& x : r.series) {
+        std::size_t exact = 0;
+        for (std::size_t p : x.exactPixels) exact += p > 0;
+        if (exact > 0)
+            row("warning",
+                escapeHtml(std::string(toString(x.renderer)) + ": " + std::to_string(exact) +
+                           " of " + std::to_string(x.exactPixels.size()) +
+                           " views are the reference's pixels, not the splatter's (" +
+                           x.exactReason + "); its measures there say nothing"));
+    }
     row("machine", escapeHtml(cpuModel() + ", " +
                               std::to_string(std::thread::hardware_concurrency()) + " cores"));
     row("date", escapeHtml(nowString()));
@@ -511,7 +550,8 @@ std::string plotsSection(const PoppingResult& r) {
     std::vector<report::PlotMarker> markers;
     for (double a : r.predictedSwitches) markers.push_back({a, "predicted switch " + deg(a)});
     const std::vector<double> mid = midpoints(r.angles);
-    const std::string xLabel = std::string(angleName(r.sweep.angle)) + " (degrees)";
+    const std::string xLabel =
+        r.pathViews > 0 ? positionName(r) : std::string(angleName(r.sweep.angle)) + " (degrees)";
 
     auto makePlot = [&](const std::string& title, const std::string& yLabel) {
         report::LinePlot p;
@@ -735,9 +775,9 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
             }
         }
         h << "</div>\n<figcaption>Frames at both ends of the interval, "
-          << (windowed(r.settings.mode)
-                  ? "windowed to [" + formatNumber(display.windowLow, 4) + ", " + formatNumber(display.windowHigh, 4) + "]"
-                  : std::string("sRGB"))
+          << (windowed(r.settings.mode) ? "windowed to [" + formatNumber(display.windowLow, 4) +
+                                              ", " + formatNumber(display.windowHigh, 4) + "]"
+                                        : std::string("sRGB"))
           << "; heat maps (inferno) of the largest RGB difference, |after − before| scaled to [0, "
           << formatNumber(changeScale, 4) << "]"
           << (ref < R ? ", |X − ref| to [0, " + formatNumber(errScale, 4) + "]" : std::string())
@@ -796,7 +836,7 @@ std::string animationSection(const PoppingResult& r) {
       << report::imgTag(encodeAnimatedGif(movie, display, fps), "image/gif", "animation",
                         "the sweep: " + order, "the sweep: " + order, scale * movie[0].width)
       << "\n<figcaption>Left to right: " << escapeHtml(order) << "; " << frames << " views, "
-      << angleName(r.sweep.angle) << " " << deg(first) << " to " << deg(last) << ", " << fps
+      << positionName(r) << " " << deg(first) << " to " << deg(last) << ", " << fps
       << " frames per second, looping.</figcaption>\n</figure>\n";
     return h.str();
 }
@@ -841,6 +881,7 @@ std::string reportHtml(const PoppingResult& r, const std::string& commandLine,
 void writePoppingReport(const PoppingResult& result, const std::string& dir,
                         const std::string& commandLine) {
     if (dir.empty()) throw Error("popping report: no folder given");
+    positionUnit = result.pathViews > 0 ? "" : "°";
     const fs::path folder(dir);
     prepareFolder(folder);
     removeStaleTemporaries(folder);  // left by a killed run

@@ -129,7 +129,8 @@ nlohmann::json pointJson(const StudyPoint& p) {
             {"rmse", num(p.rmse)},
             {"psnr", num(p.psnr)},
             {"max_abs", num(p.maxAbs)},
-            {"flip", num(p.flip)}};
+            {"flip", num(p.flip)},
+            {"exact_frames", p.exactFrames}};
 }
 
 void restorePoint(StudyPoint& p, const nlohmann::json& j) {
@@ -141,6 +142,7 @@ void restorePoint(StudyPoint& p, const nlohmann::json& j) {
     p.peakMiB = num("peak_mib");
     p.splats = j.at("splats").get<std::size_t>();
     p.footprintPixels = j.at("footprint_pixels").get<std::size_t>();
+    p.exactFrames = j.value("exact_frames", std::size_t(0));
     p.footprintPixelRate = num("footprint_pixel_rate");
     p.rmse = num("rmse");
     p.psnr = num("psnr");
@@ -155,6 +157,8 @@ class Progress {
         ++done_;
         if (fn_ && !fn_(done_, std::max(total_, done_), what)) throw Cancelled();
     }
+    /// Inside a frame: the same done and total, so that a cancel stops the frame in flight.
+    bool poll(const std::string& what) const { return !fn_ || fn_(done_, total_, what); }
 
   private:
     const ProgressFn& fn_;
@@ -477,8 +481,13 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
             Image img;
             RenderStats st;
             for (int r = 0; r < options.warmup + options.repeats; ++r) {
+                frame.progress = [&](std::size_t, std::size_t, const std::string& what) {
+                    return progress.poll(point.label() + ": " + what);
+                };
                 img = scene->render(frame, &st);
+                frame.progress = nullptr;
                 if (r >= options.warmup) ms.push_back(st.milliseconds);
+                if (r >= options.warmup && st.exactPixels > 0) ++point.exactFrames;
                 progress.step(point.label());
             }
             if (v == 0) {

@@ -196,7 +196,7 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
     std::ostringstream csv;
     for (const auto& k : knobNames) csv << k << ',';
     csv << "ms_median,ms_min,ms_max,ms_mad,peak_mib,splats,footprint_pixels,"
-           "footprint_pixels_per_s,rmse,psnr,max_abs,flip,pareto\n";
+           "footprint_pixels_per_s,rmse,psnr,max_abs,flip,pareto,exact_frames\n";
     for (const auto& p : r.points) {
         for (const auto& k : knobNames) {
             std::string v;
@@ -207,7 +207,8 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
         csv << num(p.msMedian) << ',' << num(p.msMin) << ',' << num(p.msMax) << ',' << num(p.msMad)
             << ',' << num(p.peakMiB) << ',' << p.splats << ',' << p.footprintPixels << ','
             << num(p.footprintPixelRate) << ',' << num(p.rmse) << ',' << num(p.psnr) << ','
-            << num(p.maxAbs) << ',' << num(p.flip) << ',' << (p.pareto ? 1 : 0) << '\n';
+            << num(p.maxAbs) << ',' << num(p.flip) << ',' << (p.pareto ? 1 : 0) << ','
+            << p.exactFrames << '\n';
     }
     const std::string csvText = csv.str();
 
@@ -242,6 +243,8 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
         o["max_abs"] = orNull(p.maxAbs);
         o["flip"] = orNull(p.flip);
         o["pareto"] = p.pareto;
+        // Frames the splatter handed to the reference: their error says nothing.
+        o["exact_frames"] = p.exactFrames;
         j["points"].push_back(o);
     }
     for (const auto& c : r.convergence) {

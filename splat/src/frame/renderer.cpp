@@ -262,6 +262,10 @@ Image renderFrame(const Scene::Impl& scene, const RenderSettings& given, RenderS
         } else if (needsExactPath(level, camera)) {
             image = referenceFrame(scene, camera, s, local, depth);
             local.exactPixels = std::size_t(camera.width()) * std::size_t(camera.height());
+            local.exactReason =
+                "the eye is inside or within two kernel radii of the splats (a kernel straddles "
+                "the perspective near plane, where a splat footprint is invalid): every pixel "
+                "was rendered by the reference ray caster";
         } else {
             local.lodLevel = level.level;
             local.lodSplats = level.splats.size();

@@ -29,17 +29,17 @@ double number(const nlohmann::json& key, const char* name, double fallback, cons
 }  // namespace
 
 CameraPath CameraPath::turn(const CameraParams& base, Angle angle, double from, double to,
-                            int frames, bool closed) {
+                            int frames) {
     if (frames < 1 || frames > kMaxFrames)
         throw Error("a sequence needs 1 to " + std::to_string(kMaxFrames) + " frames");
     if (!std::isfinite(from) || !std::isfinite(to)) throw Error("--from/--to must be finite");
     if (base.lookAtSet)
-        throw Error("a turn orbits the volume centre by azimuth or elevation; a free camera "
-                    "(--eye/--look-at) does not turn: give its views as a camera path");
+        throw Error(
+            "a turn orbits the volume centre by azimuth or elevation; a free camera "
+            "(--eye/--look-at) does not turn: give its views as a camera path");
     CameraPath p;
     for (int f = 0; f < frames; ++f) {
-        const double t =
-            closed ? double(f) / frames : (frames > 1 ? double(f) / (frames - 1) : 0.0);
+        const double t = frames > 1 ? double(f) / (frames - 1) : 0.0;
         CameraParams c = base;
         (angle == Angle::Azimuth ? c.azimuthDeg : c.elevationDeg) = from + (to - from) * t;
         p.views.push_back(c);
@@ -119,6 +119,19 @@ void renderSequence(const Scene& scene, const std::vector<RendererKind>& rendere
         if (threads > 0) s.threads = threads;
         for (std::size_t k = 0; k < renderers.size() && !cancelled; ++k) {
             s.renderer = renderers[k];
+            const std::string name =
+                std::string(toString(renderers[k])) + ", view " + std::to_string(v + 1);
+            // Inside the frame: progress polled per tile or row (same done and total), so a
+            // cancel stops the frame in flight, not only the next one.
+            s.progress = [&](std::size_t tick, std::size_t ticks, const std::string& unit) {
+                std::lock_guard<std::mutex> lock(progressMutex);
+                if (!cancelled && options.progress &&
+                    !options.progress(done, total,
+                                      name + ": " + unit + " " + std::to_string(tick) + "/" +
+                                          std::to_string(ticks)))
+                    cancelled = true;
+                return !cancelled;
+            };
             f.images[k] = scene.render(s, &f.stats[k]);
             std::lock_guard<std::mutex> lock(progressMutex);
             ++done;

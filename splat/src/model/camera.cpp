@@ -15,6 +15,31 @@ constexpr int kMaxImageSide = 32768;
 constexpr std::int64_t kMaxImagePixels = std::int64_t(1) << 27;  // 2 GiB of RGBA floats
 }  // namespace
 
+CameraParams interpolateCamera(const CameraParams& a, const CameraParams& b, double t) {
+    if (a.width != b.width || a.height != b.height)
+        throw Error("camera path: views of different image sizes cannot be interpolated");
+    if (a.projection != b.projection)
+        throw Error("camera path: orthographic and perspective views cannot be interpolated");
+    if (a.lookAtSet != b.lookAtSet)
+        throw Error(
+            "camera path: an orbit view and a free (eye/look-at) view cannot be "
+            "interpolated");
+    if (!(t >= 0.0 && t <= 1.0)) throw Error("camera interpolation: t must be in [0, 1]");
+    if (t == 0.0) return a;
+    if (t == 1.0) return b;
+    auto lerp = [t](auto x, auto y) { return x + (y - x) * t; };
+    CameraParams c = a;
+    c.azimuthDeg = lerp(a.azimuthDeg, b.azimuthDeg);
+    c.elevationDeg = lerp(a.elevationDeg, b.elevationDeg);
+    c.distance = lerp(a.distance, b.distance);
+    c.pixelSize = lerp(a.pixelSize, b.pixelSize);
+    c.fovDeg = lerp(a.fovDeg, b.fovDeg);
+    c.eye = lerp(a.eye, b.eye);
+    c.lookAt = lerp(a.lookAt, b.lookAt);
+    c.upHint = lerp(a.upHint, b.upHint);
+    return c;
+}
+
 Camera::Camera(const CameraParams& params, const Volume& volume) : params_(params) {
     if (params.width < 1 || params.height < 1 || params.width > kMaxImageSide ||
         params.height > kMaxImageSide)
