@@ -330,3 +330,35 @@ TEST_CASE("progress: a study's total is fixed; cancel reaches inside its frames"
     CHECK(polls == 2);
     CHECK(doneAtCancel == 0);  // before: only between frames, at done 1
 }
+
+TEST_CASE("splat popping --path analyses a camera path; --path refuses sweep options",
+          "[paths][cli]") {
+    const fs::path dir = test::testTmpDir("popping_cli_path");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    {
+        std::ofstream path(dir / "path.json");
+        path << R"({"keys": [{"azimuth": 40, "elevation": 0}, {"azimuth": 50, "elevation": 5}]})";
+    }
+    const std::vector<std::string> base = {"popping",     "synthetic:cube:16",
+                                           "--size",      "24x24",
+                                           "--renderers", "axis,sheet",
+                                           "--no-flip",   "--refine",
+                                           "1",           "-q",
+                                           "--path",      (dir / "path.json").string()};
+    auto args = base;
+    for (const char* a : {"--frames", "11", "--report"}) args.push_back(a);
+    args.push_back((dir / "report").string());
+    const test::RunResult r = test::runSplat(args);
+    REQUIRE(r.status == 0);
+    std::ifstream in(dir / "report" / "summary.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    CHECK(j["sweep"]["angle"] == "path");
+    CHECK(j["sweep"]["views"] == 11);
+    args = base;
+    for (const char* a : {"--from", "10", "--report"}) args.push_back(a);
+    args.push_back((dir / "bad").string());
+    const test::RunResult bad = test::runSplat(args);
+    CHECK(bad.status == 2);
+    CHECK_THAT(bad.err, Catch::Contains("--from does not apply with --path"));
+}

@@ -58,8 +58,13 @@ TEST_CASE("study: a small sweep measures, marks the front and writes its report"
     const std::filesystem::path dir = std::filesystem::path(SPLAT_TEST_TMP) / "study";
     std::filesystem::remove_all(dir);
     o.cacheDir = (dir / "cache").string();
-    std::size_t calls = 0;
-    o.progress = [&](std::size_t, std::size_t, const std::string&) { return ++calls > 0; };
+    // Called after every frame (done counts them) and polled inside frames (same done).
+    std::size_t calls = 0, lastDone = 0;
+    o.progress = [&](std::size_t done, std::size_t, const std::string&) {
+        calls += done != lastDone;
+        lastDone = done;
+        return true;
+    };
     StudyResult r = runStudy(v, base, o);
     REQUIRE(r.points.size() == 6);  // axis: the slab knob is measured once
     CHECK(calls == 12);

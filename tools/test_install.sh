@@ -42,4 +42,12 @@ for mode in plain static; do
         tail -20 "$tmp/pc_$mode.log"; exit 1; }
     "$tmp/pc_consumer_$mode" "$tmp"
 done
+# The default build is portable (issue 24, finding 7): SPLAT_NATIVE is off and no target
+# compiles with -march=native unless asked for.
+cmake -S . -B "$tmp/defaults" > "$tmp/defaults.log" 2>&1 || { cat "$tmp/defaults.log"; exit 1; }
+grep -q "^SPLAT_NATIVE:BOOL=OFF" "$tmp/defaults/CMakeCache.txt" ||
+    { echo "test_install: SPLAT_NATIVE is not off by default"; exit 1; }
+if grep -rq --include=flags.make -e "-march=native" "$tmp/defaults"; then
+    echo "test_install: the default build compiles with -march=native"; exit 1
+fi
 echo "install: ok (find_package(splat) without warnings; pkg-config splat from a moved prefix, plain and --static)"

@@ -163,18 +163,28 @@ void bindAnalysis(py::module_& m) {
         [](const PyVolume& v, const std::vector<std::string>& argv, const std::string& tfJson,
            const py::object& progress) {
             cli::PoppingArgs pa;
-            RenderSettings settings =
-                parseRenderSettings(argv, tfJson, v.volume.get(), false,
-                                    [&pa](CLI::App& app) { cli::addPoppingOptions(app, pa); });
             Sweep sweep;
             PoppingOptions o;
-            cli::poppingFromArgs(pa, settings, sweep, o);
+            RenderSettings settings = parseRenderSettings(
+                argv, tfJson, v.volume.get(), false,
+                [&pa](CLI::App& app) { cli::addPoppingOptions(app, pa); },
+                [&](const CLI::App& app, const RenderSettings& s) {
+                    cli::poppingFromArgs(app, pa, s, sweep, o);
+                });
             settings.renderer = o.renderers.front();
             PyScene scene = makeSceneFrom(v.volume, settings);
             Interrupt in(progress);
             o.progress = in.progress();
             return interruptible(
-                in, [&] { return analyzePopping(*scene.scene, sweep, o); }, scene.cancel.get());
+                in,
+                [&] {
+                    if (pa.path.empty()) return analyzePopping(*scene.scene, sweep, o);
+                    return analyzePopping(
+                        *scene.scene,
+                        CameraPath::fromJson(pa.path, scene.scene->settings().camera, pa.frames),
+                        o);
+                },
+                scene.cancel.get());
         },
         py::arg("volume"), py::arg("argv"), py::arg("tf_json"), py::arg("progress"));
     m.def("_popping_options", [] {

@@ -93,11 +93,12 @@ auto interruptible(Interrupt& in, F&& work, SceneCancel* scene = nullptr) -> dec
 /// like a scene file's inline "tf". With `volume`, the data-dependent defaults of the CLI
 /// (ct-hu for CT in Hounsfield units, the free camera's target). Errors: splat::Error with
 /// the CLI's message.
-/// `extra`: adds a command's own options to the same app before parsing (splat.popping's
-/// sweep options) and reads them after.
-RenderSettings parseRenderSettings(const std::vector<std::string>& argv, const std::string& tfJson,
-                                   const Volume* volume, bool oneRenderer,
-                                   const std::function<void(CLI::App&)>& addExtra = {});
+/// `addExtra` adds a command's own options to the same app before parsing (splat.popping's
+/// sweep options); `readExtra` reads them once the render settings are parsed.
+RenderSettings parseRenderSettings(
+    const std::vector<std::string>& argv, const std::string& tfJson, const Volume* volume,
+    bool oneRenderer, const std::function<void(CLI::App&)>& addExtra = {},
+    const std::function<void(const CLI::App&, const RenderSettings&)>& readExtra = {});
 
 /// The render options the CLI knows: (keyword, flag, help, default) for docstrings and the
 /// stub test.

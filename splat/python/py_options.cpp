@@ -75,9 +75,10 @@ std::vector<std::tuple<std::string, std::string, std::string, std::string>> tabl
 
 }  // namespace
 
-RenderSettings parseRenderSettings(const std::vector<std::string>& argv, const std::string& tfJson,
-                                   const Volume* volume, bool oneRenderer,
-                                   const std::function<void(CLI::App&)>& addExtra) {
+RenderSettings parseRenderSettings(
+    const std::vector<std::string>& argv, const std::string& tfJson, const Volume* volume,
+    bool oneRenderer, const std::function<void(CLI::App&)>& addExtra,
+    const std::function<void(const CLI::App&, const RenderSettings&)>& readExtra) {
     CommandScope scope;
     cli::RenderArgs args;
     cli::addRenderOptions(scope.app, args, false);
@@ -88,6 +89,7 @@ RenderSettings parseRenderSettings(const std::vector<std::string>& argv, const s
     cli::RenderUse use;
     use.oneRenderer = oneRenderer;
     RenderSettings s = cli::settingsFromArgs(args, use);
+    if (readExtra) readExtra(scope.app, s);
     if (volume) s = cli::withDataDefaults(args, s, *volume);
     return s;
 }

@@ -47,13 +47,15 @@ void printSummary(const PoppingResult& r) {
                  std::to_string(s.exactPixels.size()) +
                  " views handed to the exact path (the reference's pixels): " + s.exactReason);
     }
-    for (double a : r.predictedSwitches) std::printf("predicted sheet switch at %.6f degrees\n", a);
+    // Positions: degrees of a sweep, or view positions of a camera path.
+    const char* unit = r.pathViews > 0 ? " (path position)" : " degrees";
+    for (double a : r.predictedSwitches) std::printf("predicted sheet switch at %.6f%s\n", a, unit);
     for (const PoppingEvent& e : r.events)
         std::printf(
-            "event (%s) %.4g..%.4g: signal %.3g; refined to %.3g degrees at %.6f: jump "
+            "event (%s) %.4g..%.4g: signal %.3g; refined to %.3g%s at %.6f: jump "
             "%.3g, slope %.2f (%s); sheet axis %d -> %d%s\n",
-            toString(e.renderer), e.angleFrom, e.angleTo, e.signal, e.refinedWidth, e.refinedAngle,
-            e.refinedJump, e.refinedSlope,
+            toString(e.renderer), e.angleFrom, e.angleTo, e.signal, e.refinedWidth, unit,
+            e.refinedAngle, e.refinedJump, e.refinedSlope,
             std::abs(e.refinedSlope) < 0.25 ? "a discontinuity" : "continuous change",
             e.sheetAxisBefore, e.sheetAxisAfter, e.predicted ? ", predicted" : "");
 }
@@ -85,7 +87,7 @@ void registerPopping(CLI::App& app) {
         RenderSettings settings = settingsFromArgs(a->render, use);
         Sweep sweep;
         PoppingOptions o;
-        poppingFromArgs(a->popping, settings, sweep, o);
+        poppingFromArgs(*cmd, a->popping, settings, sweep, o);
         loadOptionsFromArgs(a->volume);
         // The Scene is validated against its first renderer (iso: the reference alone).
         settings.renderer = o.renderers.front();
@@ -105,7 +107,12 @@ void registerPopping(CLI::App& app) {
         };
         PoppingResult result;
         try {
-            result = analyzePopping(scene, sweep, o);
+            result =
+                a->popping.path.empty()
+                    ? analyzePopping(scene, sweep, o)
+                    : analyzePopping(
+                          scene, CameraPath::fromJson(a->popping.path, scene.settings().camera, a->popping.frames),
+                          o);
         } catch (const Cancelled&) {
             progress.finish();
             throw Error(

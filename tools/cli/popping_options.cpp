@@ -25,6 +25,11 @@ void addPoppingOptions(CLI::App& cmd, PoppingArgs& a) {
     addOption(cmd, "--to", a.to, "last angle of the sweep (inclusive), degrees", sw);
     addOption(cmd, "--step", a.step, "angle step, degrees", sw);
     addOption(cmd, "--sweep", a.sweep, "the angle swept: azimuth or elevation", sw);
+    addOption(cmd, "--path", a.path,
+              "analyse a camera path instead of a sweep: JSON {\"keys\": [...]} as for rotate, "
+              "interpolated over --frames views",
+              sw, PathKind::Input);
+    addOption(cmd, "--frames", a.frames, "views of --path (at least 3)", sw);
     addOption(cmd, "--renderers", a.renderers, "renderers to compare (reference: ground truth)",
               sw);
     addOption(cmd, "--refine", a.refine, "bisection levels around each event (0: none)", sw);
@@ -34,8 +39,8 @@ void addPoppingOptions(CLI::App& cmd, PoppingArgs& a) {
     addFlag(cmd, "--no-flip", a.noFlip, "skip the perceptual (LDR-FLIP) columns", sw);
 }
 
-void poppingFromArgs(const PoppingArgs& a, const RenderSettings& settings, Sweep& sweep,
-                     PoppingOptions& o) {
+void poppingFromArgs(const CLI::App& cmd, const PoppingArgs& a, const RenderSettings& settings,
+                     Sweep& sweep, PoppingOptions& o) {
     asUsage([&] {
         if (a.sweep != "azimuth" && a.sweep != "elevation")
             throw Error("--sweep must be azimuth or elevation");
@@ -44,7 +49,16 @@ void poppingFromArgs(const PoppingArgs& a, const RenderSettings& settings, Sweep
         sweep.to = a.to;
         sweep.step = a.step;
         sweep.base = settings.camera;
-        (void)sweep.angles();  // refuse a bad sweep before loading anything
+        if (!a.path.empty()) {
+            for (const char* k : {"from", "to", "step", "sweep"})
+                if (given(cmd, k))
+                    throw Error(std::string("--") + k + " does not apply with --path");
+            if (a.frames < 3 || a.frames > 100000)
+                throw Error("--frames must be between 3 and 100000");
+        } else {
+            if (given(cmd, "frames")) throw Error("--frames applies only with --path");
+            (void)sweep.angles();  // refuse a bad sweep before loading anything
+        }
         o.renderers = parseRenderers(a.renderers);
         if (a.refine < 0 || a.refine > 60) throw Error("--refine must be between 0 and 60");
         for (double v : {a.k, a.floor, a.ppd})

@@ -380,6 +380,8 @@ def popping(
     to: float = ...,
     step: float = ...,
     sweep: str = ...,
+    path: str | None = ...,
+    frames: int = ...,
     renderers: str | Sequence[str] = ...,
     refine: int = ...,
     threshold_k: float = ...,

@@ -1,7 +1,5 @@
 // splat::Scene (the view-independent state, built once), splat::Renderer and render().
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -72,13 +70,10 @@ void validateScene(const Volume& v, const RenderSettings& s) {
     // The loaders' NaN policy at the library boundary (issue 24): an in-memory volume with
     // NaN/Inf samples is refused, not rendered differently by each renderer.
     // The values are scanned, whatever the storage (a scale can overflow float).
-    const std::size_t bad = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, v.voxelCount(), 1 << 16), std::size_t(0),
-        [&](const tbb::blocked_range<std::size_t>& r, std::size_t n) {
-            for (std::size_t q = r.begin(); q != r.end(); ++q) n += !std::isfinite(v.value(q));
-            return n;
-        },
-        [](std::size_t a, std::size_t b) { return a + b; });
+    // Serial: validation runs before the Scene's thread arena exists (threads = 1 means one).
+    std::size_t bad = 0;
+    const std::size_t count = v.voxelCount();
+    for (std::size_t q = 0; q < count; ++q) bad += !std::isfinite(v.value(q));
     if (bad > 0)
         throw Error("volume has " + std::to_string(bad) +
                     " NaN/Inf samples; replace them (the loaders' --nan-policy zero does)");
@@ -307,7 +302,9 @@ const ReferenceField& Scene::Impl::referenceField() const {
     std::lock_guard<std::mutex> lock(lazyMutex_);
     if (!field_) {
         validateReferenceKernel(kernel);
-        if (splats.paletted()) {  // the field reads the emission arrays: a full copy
+        if (splats.paletted() && fieldLayout(settings, splats) == FieldLayout::Emission) {
+            // The field reads the emission arrays: a full copy (the other layouts expand
+            // the densities alone, in ReferenceField).
             SplatList full = splats;
             full.expandEmission();
             field_ = std::make_shared<ReferenceField>(*volume, full, kernel,

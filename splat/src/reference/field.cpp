@@ -10,11 +10,21 @@ ReferenceField::ReferenceField(const Volume& volume, const SplatList& splats,
         grid4_ = buildGrid<4>(volume, splats, lut_, radius_,
                               {&splats.extinction, &splats.r, &splats.g, &splats.b},
                               splats.label.empty() ? nullptr : &splats.label);
-    else if (layout == FieldLayout::DensityGradient)
-        grid4_ = buildGrid<4>(volume, splats, lut_, radius_,
-                              {&splats.density, &splats.gx, &splats.gy, &splats.gz});
-    else
-        grid1_ = buildGrid<1>(volume, splats, lut_, radius_, {&splats.density});
+    else {
+        // A paletted list holds densities by value: only they are expanded, for the build
+        // (4 bytes a splat, freed after it), not the emission the layout does not read.
+        std::vector<float> expanded;
+        if (splats.density.empty() && splats.paletted()) {
+            expanded.resize(splats.size());
+            for (std::size_t q = 0; q < expanded.size(); ++q) expanded[q] = splats.densityOf(q);
+        }
+        const std::vector<float>* density = expanded.empty() ? &splats.density : &expanded;
+        if (layout == FieldLayout::DensityGradient)
+            grid4_ = buildGrid<4>(volume, splats, lut_, radius_,
+                                  {density, &splats.gx, &splats.gy, &splats.gz});
+        else
+            grid1_ = buildGrid<1>(volume, splats, lut_, radius_, {density});
+    }
 }
 
 }  // namespace splat
