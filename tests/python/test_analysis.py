@@ -85,3 +85,20 @@ def test_iso_surface_of_the_sphere():
     radius = np.linalg.norm(mesh.vertices - np.array(v.center), axis=1)
     assert mesh.triangles.shape[1] == 3 and mesh.triangles.max() < len(mesh.vertices)
     assert np.abs(radius - 0.375 * 32).max() < 0.5
+
+
+def test_popping_over_a_camera_path_equals_the_cli(cli, tmp, phantom):
+    path = tmp / "path.json"
+    path.write_text(json.dumps({"keys": [{"azimuth": 40, "elevation": 5}, {"azimuth": 46}]}))
+    pop = splat.popping(phantom, path=str(path), frames=5, size=(24, 24), refine=2)
+    cli("popping", SPEC, "--path", path, "--frames", 5, "--size", "24x24", "--refine", 2,
+        "--report", tmp / "cli", "-q")
+    summary = json.loads((tmp / "cli" / "summary.json").read_text())
+    assert len(pop.angles) == 5
+    for name, s in pop.series.items():
+        for key in ["spike_ratio", "median_T", "threshold"]:
+            assert s[key] == pytest.approx(summary["renderers"][name][key], rel=1e-12, abs=0)
+    p = cli("popping", SPEC, "--path", path, "--step", 2, "--report", tmp / "x", check=False)
+    with pytest.raises(splat.InputError) as e:
+        splat.popping(phantom, path=str(path), step=2)
+    assert str(e.value) == p.stderr.strip().splitlines()[-1][len("splat: error: "):]
