@@ -332,10 +332,9 @@ void Scene::Impl::releaseWorkspace(std::unique_ptr<FrameWorkspace> w) const {
 
 Scene::Scene(std::shared_ptr<const Volume> volume, const RenderSettings& settings) {
     if (!volume) throw Error("scene: no volume");
-    runOnThreads(settings.threads, [&] {
-        validateScene(*volume, settings);  // its NaN scan is parallel: on settings.threads too
-        impl_ = std::make_unique<Impl>(std::move(volume), settings);
-    });
+    validateScene(*volume, settings);
+    runOnThreads(settings.threads,
+                 [&] { impl_ = std::make_unique<Impl>(std::move(volume), settings); });
     impl_->given = settings;
 }
 
