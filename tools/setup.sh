@@ -7,7 +7,8 @@ packages=(build-essential cmake pkg-config libglm-dev libopenimageio-dev openima
           clang-14 libclang-rt-14-dev mricron-data chromium
           xvfb xauth  # xvfb, xauth: tools/bench/vs_vtk.py runs VTK without a display
           python3 python3-nibabel python3-pydicom teem-apps libbz2-dev  # tests: faults, third-party files and oracles
-          libopenmpi-dev openmpi-bin)  # splat::mpi (README "Beyond one machine")
+          libopenmpi-dev openmpi-bin  # splat::mpi (README "Beyond one machine")
+          pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib)  # the Python module (README "Python")
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -19,6 +19,15 @@ cmake --build "$tmp/build" -j2 > "$tmp/build.log" 2>&1 || { cat "$tmp/build.log"
 # libraries' dependencies are in Libs, so a plain --libs links (with or without --static).
 pc=$(find "$tmp/prefix" -name splat.pc | head -1)
 [ -n "$pc" ] || { echo "test_install: no splat.pc installed"; exit 1; }
+# The Python package (SPLAT_PYTHON): imported from the prefix's site folder, one render.
+if grep -q "^SPLAT_PYTHON:BOOL=ON" build/CMakeCache.txt; then
+    python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' build/CMakeCache.txt)
+    site=$(dirname "$(find "$tmp/prefix" -name '_splat*.so' | head -1)")
+    [ "$site" != "." ] || { echo "test_install: the Python module was not installed"; exit 1; }
+    (cd "$tmp" && PYTHONPATH=$(dirname "$site") "$python" -c \
+        "import splat; assert splat.render(splat.synthetic('blob', 16), size=(8, 8)).shape == (8, 8, 4)")
+    echo "install: Python package splat imports from $(dirname "$site")"
+fi
 mv "$tmp/prefix" "$tmp/moved"  # any prefix: the installed tree moved after installing
 pcdir=$(dirname "${pc/$tmp\/prefix/$tmp/moved}")
 flags=$(PKG_CONFIG_PATH=$pcdir pkg-config --cflags --libs splat)

@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "diagnostics.h"
 #include "parallel.h"
+#include "popping_options.h"
 #include "progress.h"
 #include "render_options.h"
 #include "resume_journal.h"
@@ -25,21 +26,10 @@ namespace {
 struct PoppingCommand {
     VolumeArgs volume;
     RenderArgs render;
-    std::string report, sweep = "azimuth", renderers = "axis,sheet,reference", path;
-    int frames = 21;
-    double from = 40, to = 50, step = 0.5, k = 5, floor = 2, ppd = 67;
-    int refine = 10;
-    bool noFlip = false, quiet = false, resume = false;
+    PoppingArgs popping;
+    std::string report;
+    bool quiet = false, resume = false;
 };
-
-std::vector<RendererKind> parseRenderers(const std::string& text) {
-    std::vector<RendererKind> out;
-    std::stringstream in(text);
-    std::string item;
-    while (std::getline(in, item, ',')) out.push_back(parseRenderer(item));
-    if (out.empty()) throw Error("--renderers is empty");
-    return out;
-}
 
 void printSummary(const PoppingResult& r) {
     std::printf("%-10s %12s %12s %10s %8s %12s\n", "renderer", "spike ratio", "median T", "flicker",
@@ -78,23 +68,8 @@ void registerPopping(CLI::App& app) {
         "popping", "find and prove popping: sweep views with both splatters and the reference");
     addVolumeOptions(*cmd, a->volume);
     addRenderOptions(*cmd, a->render, false);
-    const std::string sw = "Sweep", out = "Output";
-    addOption(*cmd, "--from", a->from, "first angle of the sweep, degrees", sw);
-    addOption(*cmd, "--to", a->to, "last angle of the sweep (inclusive), degrees", sw);
-    addOption(*cmd, "--step", a->step, "angle step, degrees", sw);
-    addOption(*cmd, "--sweep", a->sweep, "the angle swept: azimuth or elevation", sw);
-    addOption(*cmd, "--path", a->path,
-              "analyse a camera path instead of a sweep: JSON {\"keys\": [...]} as for rotate, "
-              "interpolated over --frames views",
-              sw, PathKind::Input);
-    addOption(*cmd, "--frames", a->frames, "views of --path (at least 3)", sw);
-    addOption(*cmd, "--renderers", a->renderers, "renderers to compare (reference: ground truth)",
-              sw);
-    addOption(*cmd, "--refine", a->refine, "bisection levels around each event (0: none)", sw);
-    addOption(*cmd, "--threshold-k", a->k, "event threshold: median + K * MAD of the signal", sw);
-    addOption(*cmd, "--threshold-floor", a->floor, "... and at least FLOOR * median", sw);
-    addOption(*cmd, "--ppd", a->ppd, "LDR-FLIP pixels per degree", sw);
-    addFlag(*cmd, "--no-flip", a->noFlip, "skip the perceptual (LDR-FLIP) columns", sw);
+    addPoppingOptions(*cmd, a->popping);
+    const std::string out = "Output";
     addOption(*cmd, "--report", a->report, "report folder (report.html, metrics.csv, summary.json)",
               out, PathKind::Output);
     addFlag(*cmd, "--resume", a->resume,
@@ -113,37 +88,8 @@ void registerPopping(CLI::App& app) {
         RenderSettings settings = settingsFromArgs(a->render, use);
         Sweep sweep;
         PoppingOptions o;
-        asUsage([&] {
-            if (a->sweep != "azimuth" && a->sweep != "elevation")
-                throw Error("--sweep must be azimuth or elevation");
-            sweep.angle = a->sweep == "azimuth" ? Sweep::Angle::Azimuth : Sweep::Angle::Elevation;
-            sweep.from = a->from;
-            sweep.to = a->to;
-            sweep.step = a->step;
-            sweep.base = settings.camera;
-            if (!a->path.empty()) {
-                for (const char* k : {"from", "to", "step", "sweep"})
-                    if (given(*cmd, k))
-                        throw Error(std::string("--") + k + " does not apply with --path");
-                if (a->frames < 3 || a->frames > 100000)
-                    throw Error("--frames must be between 3 and 100000");
-            } else {
-                if (given(*cmd, "frames")) throw Error("--frames applies only with --path");
-                (void)sweep.angles();  // refuse a bad sweep before loading anything
-            }
-            o.renderers = parseRenderers(a->renderers);
-            if (a->refine < 0 || a->refine > 60) throw Error("--refine must be between 0 and 60");
-            for (double v : {a->k, a->floor, a->ppd})
-                if (!std::isfinite(v) || v < 0)
-                    throw Error(
-                        "--threshold-k, --threshold-floor and --ppd must be finite and >= 0");
-        });
+        poppingFromArgs(*cmd, a->popping, settings, sweep, o);
         loadOptionsFromArgs(a->volume);
-        o.refine = a->refine;
-        o.madK = a->k;
-        o.floorRatio = a->floor;
-        o.pixelsPerDegree = a->ppd;
-        o.flip = !a->noFlip;
         // The Scene is validated against its first renderer (iso: the reference alone).
         settings.renderer = o.renderers.front();
         if (workerProcess())  // under mpirun: render the frames rank 0 asks for (parallel.h)
@@ -168,10 +114,10 @@ void registerPopping(CLI::App& app) {
         PoppingResult result;
         try {
             result =
-                a->path.empty()
+                a->popping.path.empty()
                     ? analyzePopping(scene, sweep, o)
                     : analyzePopping(
-                          scene, CameraPath::fromJson(a->path, scene.settings().camera, a->frames),
+                          scene, CameraPath::fromJson(a->popping.path, scene.settings().camera, a->popping.frames),
                           o);
         } catch (const Cancelled&) {
             progress.finish();

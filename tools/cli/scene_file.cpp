@@ -450,6 +450,8 @@ void beginRun(const CLI::App& cmd) {
                      {"DateTime", ""}};
 }
 
+void forgetCommand(const CLI::App& cmd) { tables().erase(&cmd); }
+
 std::vector<std::pair<std::string, std::string>>& runMetadata() {
     static std::vector<std::pair<std::string, std::string>> m;
     return m;

@@ -105,6 +105,11 @@ bool isTransferPreset(const std::string& name);
 /// exist (splat::Error naming `flag`).
 void checkOutputFile(const std::string& path, const std::string& flag);
 
+/// Drops what was recorded for `cmd` (its options and scene); call before destroying a
+/// CLI::App that is not the program's own (the Python module parses each call's keyword
+/// arguments with a short-lived one, splat/python/py_options.cpp).
+void forgetCommand(const CLI::App& cmd);
+
 /// Every subcommand's recorded option keys (for shell completion).
 std::vector<std::string> recordedKeys(const CLI::App& cmd);
 

@@ -98,7 +98,7 @@ LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
     });
 }
 
-Volume loadVolumeFromArgs(const VolumeArgs& args) {
+Volume loadVolumeWith(const VolumeArgs& args) {
     const LoadOptions options = loadOptionsFromArgs(args);
     std::optional<float> background;
     if (!args.backgroundValue.empty() && args.backgroundValue != "auto") {
@@ -118,6 +118,11 @@ Volume loadVolumeFromArgs(const VolumeArgs& args) {
         v.background = backgroundFromFaces(v);
         v.backgroundSource = "median of the outer faces (--background-value auto)";
     }
+    return v;
+}
+
+Volume loadVolumeFromArgs(const VolumeArgs& args) {
+    Volume v = loadVolumeWith(args);
     // Recorded in every image the run writes, so that a scene reproduces.
     char b[64];
     std::snprintf(b, sizeof b, "%.9g", double(v.background));

@@ -25,6 +25,11 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args);
 /// Parses the options (UsageError on malformed ones).
 LoadOptions loadOptionsFromArgs(const VolumeArgs& args);
 
+/// Parses the options and loads the volume with its background value (--background-value);
+/// throws splat::Error on bad input. Prints nothing and records nothing (the Python module's
+/// splat.load).
+Volume loadVolumeWith(const VolumeArgs& args);
+
 /// Parses the options and loads the volume; throws splat::Error on bad input. Prints the
 /// volume's note (what the loader assumed or changed) as warning lines.
 Volume loadVolumeFromArgs(const VolumeArgs& args);
