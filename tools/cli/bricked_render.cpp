@@ -15,7 +15,8 @@
 namespace splat::cli {
 
 void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
-                         RenderSettings settings, int bricks, const std::string& output) {
+                         RenderSettings settings, int bricks, const std::string& output,
+                         BrickComposite composite) {
     const LoadOptions options = loadOptionsFromArgs(volume);
     bool alone = false;
     Volume geometry = volumeGeometry(volume.spec, options, &alone);
@@ -31,10 +32,10 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
         warn(volume.spec +
              ": its samples are not read by byte ranges (compressed, or not a .raw file): every "
              "rank loads the whole volume once and keeps its brick");
-    if (settings.renderer == RendererKind::Sheet)
+    if (settings.renderer == RendererKind::Sheet && composite == BrickComposite::Fast)
         warn(
-            "--renderer sheet in bricks is approximate where its slabs cross a brick face "
-            "(README \"Beyond one machine\"); axis and reference are exact");
+            "--renderer sheet with --brick-composite fast is approximate where its slabs cross a "
+            "brick face (README \"Beyond one machine\"); --brick-composite exact is not");
     char b[64];
     std::snprintf(b, sizeof b, "%.9g", double(geometry.background));
     runMetadata().push_back(
@@ -50,7 +51,7 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
         [&](const Brick& brick) {
             return loadVolumeBrick(volume.spec, options, brick.loadLo, brick.loadHi);
         },
-        settings, bricks, *group, &st);
+        settings, bricks, *group, &st, composite);
     const std::vector<BrickStats> all = group->gather(st);
     if (workerProcess()) return;
     removeStaleTemporaries(std::filesystem::path(output).parent_path());

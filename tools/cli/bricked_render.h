@@ -4,6 +4,7 @@
 #include <string>
 
 #include "render_options.h"
+#include "splat/bricks.h"
 #include "volume_options.h"
 
 namespace splat::cli {
@@ -11,6 +12,7 @@ namespace splat::cli {
 /// Every process loads and renders its bricks, the group composites the frame, and rank 0
 /// writes it to `output` and prints what the frame took.
 void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
-                         RenderSettings settings, int bricks, const std::string& output);
+                         RenderSettings settings, int bricks, const std::string& output,
+                         BrickComposite composite = BrickComposite::Exact);
 
 }  // namespace splat::cli

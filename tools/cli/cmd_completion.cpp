@@ -23,6 +23,7 @@ std::map<std::string, std::string> choices() {
     return {{"--renderer", "axis sheet reference"},
             {"--mode", "dvr mip xray iso"},
             {"--order", "ftb btf"},
+            {"--brick-composite", "exact fast"},
             {"--classify", "pre post"},
             {"--projection", "ortho perspective"},
             {"--kernel", "gaussian bspline"},

@@ -21,6 +21,7 @@ struct RenderCommand {
     RenderArgs render;
     std::string output;
     int bricks = 0;
+    std::string brickComposite = "exact";
 };
 }  // namespace
 
@@ -35,6 +36,11 @@ void registerRender(CLI::App& app) {
     addOption(*cmd, "--bricks", args->bricks,
               "sort-last: cut the volume into K bricks, each loaded alone, rendered and "
               "composited (0: off; under mpirun one per process)",
+              "Output");
+    addOption(*cmd, "--brick-composite", args->brickComposite,
+              "bricks of --renderer sheet: exact (every slab's sheets summed across bricks, the "
+              "one-process image; exchanges sheets) | fast (partial images, a seam of a few "
+              "percent)",
               "Output");
     cmd->footer(
         "Examples:\n"
@@ -51,10 +57,15 @@ void registerRender(CLI::App& app) {
         loadOptionsFromArgs(args->volume);  // malformed volume options: usage errors, now
         if (args->bricks < 0 || args->bricks > 4096)
             throw UsageError("--bricks must be between 0 and 4096");
+        if (args->brickComposite != "exact" && args->brickComposite != "fast")
+            throw UsageError("--brick-composite must be exact or fast (got '" +
+                             args->brickComposite + "')");
         if (args->bricks > 0 || processCount() > 1) {  // README "Beyond one machine"
             if (!workerProcess()) beginRun(*cmd);
-            renderBrickedToFile(args->volume, args->render, settings,
-                                args->bricks > 0 ? args->bricks : processCount(), args->output);
+            renderBrickedToFile(
+                args->volume, args->render, settings,
+                args->bricks > 0 ? args->bricks : processCount(), args->output,
+                args->brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
             if (!workerProcess()) finishRun(*cmd);
             return;
         }

@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "diagnostics.h"
+#include "parallel.h"
 #include "progress.h"
 #include "render_options.h"
 #include "resume_journal.h"
@@ -125,6 +126,12 @@ void registerStudy(CLI::App& app) {
         o.referenceStep = a->truthStep;
         o.referenceTolerance = a->truthTolerance;
         o.pixelsPerDegree = a->ppd;
+        if (workerProcess())  // under mpirun: render the references rank 0 asks for (parallel.h)
+            return serveFrames([&] {
+                auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
+                const RenderSettings base = withDataDefaults(a->render, settings, *v);
+                return Scene(v, studyReferenceSettings(base, o, base.camera));
+            });
         o.cacheDir = a->report + "/cache";
         removeStaleTemporaries(o.cacheDir);  // left by a killed run
         beginRun(*cmd);

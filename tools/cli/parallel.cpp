@@ -63,7 +63,7 @@ int processRank() {
 }
 
 bool workersTakePart(const std::string& command) {
-    return command == "rotate" || command == "popping" || command == "render";
+    return command == "rotate" || command == "popping" || command == "render" || command == "study";
 }
 
 void printError(const std::string& line) {

@@ -133,6 +133,17 @@ class BrickGroup {
                             RenderMode mode, const glm::vec4& background, std::uint64_t* bytes) = 0;
     /// Every process's stats, on process 0 (rank order; others: empty).
     virtual std::vector<BrickStats> gather(const BrickStats& mine) = 0;
+    /// Exact sheets (splat/slab_sheets.h): sums `blocks` and takes the minimum of `rects`
+    /// element by element over the processes, and leaves process r its part, the tiles
+    /// [tileStart[r], tileStart[r + 1]) (`tileFloats` floats and `tileInts` ints each), at the
+    /// front of both arrays. Adds the bytes this process sent and received to `bytes` (as a
+    /// direct exchange: every part to its owner).
+    virtual void reduceSlabs(std::vector<float>& blocks, std::vector<int>& rects,
+                             const std::vector<int>& tileStart, std::size_t tileFloats,
+                             std::size_t tileInts, std::uint64_t* bytes) = 0;
+    /// The sum of every process's `image` on process 0 (others: empty); their non-zero
+    /// pixels are disjoint, so the sum is exact.
+    virtual Image sumImages(const Image& image, std::uint64_t* bytes) = 0;
 };
 
 /// One process, every brick: what `splat render --bricks K` does without mpirun (each
@@ -147,6 +158,20 @@ class LocalBrickGroup : public BrickGroup {
                     const std::vector<int>& frontToBack, int width, int height, RenderMode mode,
                     const glm::vec4& background, std::uint64_t* bytes) override;
     std::vector<BrickStats> gather(const BrickStats& mine) override { return {mine}; }
+    void reduceSlabs(std::vector<float>&, std::vector<int>&, const std::vector<int>&, std::size_t,
+                     std::size_t, std::uint64_t*) override {}
+    Image sumImages(const Image& image, std::uint64_t*) override { return image; }
+};
+
+/// How the partial results of the image-aligned splatter's bricks are composited (the
+/// reference and the axis-aligned splatter composite their partial images exactly either way).
+enum class BrickComposite {
+    /// Every slab's sheets summed over the bricks before compositing (splat/slab_sheets.h):
+    /// the one-process frame to float rounding; exchanges the sheets, not images.
+    Exact,
+    /// Partial images composited over each other: each brick's slabs are cut at its faces as
+    /// if uniform across a slab, a seam of up to a few percent of the peak (README).
+    Fast,
 };
 
 /// Renders `frame` of the volume of geometry `geometry` cut into `bricks` bricks: this
@@ -155,8 +180,16 @@ class LocalBrickGroup : public BrickGroup {
 /// normalised iso level are resolved against the whole volume's range (the group's). Edge
 /// enhancement (its scale is the whole volume's largest gradient) and labels are refused.
 /// Returns the frame on process 0.
+/// `composite`: how the image-aligned splatter's bricks are composited.
 Image renderBricked(const Volume& geometry, const std::function<Volume(const Brick&)>& load,
                     const RenderSettings& frame, int bricks, BrickGroup& group,
-                    BrickStats* stats = nullptr);
+                    BrickStats* stats = nullptr, BrickComposite composite = BrickComposite::Exact);
+
+/// renderBricked's exact path of the image-aligned splatter (slab_sheets.h): this process's
+/// bricks `mine` of `layout` (`load` gives brick b's samples) are all held at once, their
+/// sheets summed over the processes one group of slabs at a time.
+Image renderBrickedSlabs(const Volume& geometry, const BrickLayout& layout,
+                         const std::vector<int>& mine, const std::function<Volume(int)>& load,
+                         const RenderSettings& frame, BrickGroup& group, BrickStats& stats);
 
 }  // namespace splat

@@ -99,8 +99,16 @@ struct StudyResult {
     bool flipAvailable = false;
 };
 
+/// The settings of the study's reference frames: the base model (its scene knobs) with the
+/// reference ray caster at the options' step and tolerance, seen by `camera`. The processes
+/// of a frame farm (splat/frame_farm.h) render the references from a Scene of these.
+RenderSettings studyReferenceSettings(const RenderSettings& base, const StudyOptions& options,
+                                      const CameraParams& camera);
+
 /// Runs the study on `volume`. Throws splat::Error on bad knobs, splat::Cancelled when
-/// progress returns false.
+/// progress returns false. With a frame farm installed (splat/frame_farm.h, e.g. under
+/// mpirun), the references missing from the cache are rendered on the farm first, before
+/// any frame is timed; the timed frames are rendered here alone.
 StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings& base,
                      const StudyOptions& options);
 

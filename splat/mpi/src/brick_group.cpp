@@ -3,6 +3,7 @@
 
 #include <mpi.h>
 
+#include <climits>
 #include <cstring>
 #include <type_traits>
 
@@ -123,6 +124,40 @@ class MpiBrickGroup : public BrickGroup {
         MPI_Gather(&mine, int(sizeof mine), MPI_BYTE, all.data(), int(sizeof mine), MPI_BYTE, 0,
                    MPI_COMM_WORLD);
         return all;
+    }
+
+    void reduceSlabs(std::vector<float>& blocks, std::vector<int>& rects,
+                     const std::vector<int>& tileStart, std::size_t tileFloats,
+                     std::size_t tileInts, std::uint64_t* bytes) override {
+        const int p = size(), me = rank();
+        std::vector<int> floats(p), ints(p);
+        for (int r = 0; r < p; ++r) {
+            const std::size_t tiles = std::size_t(tileStart[r + 1] - tileStart[r]);
+            if (tiles * tileFloats > std::size_t(INT_MAX))
+                throw Error("exact brick sheets: a slab group exceeds MPI's count");
+            floats[r] = int(tiles * tileFloats);
+            ints[r] = int(tiles * tileInts);
+        }
+        // In place: each process's part, summed (minimum), lands at the front of its arrays.
+        MPI_Reduce_scatter(MPI_IN_PLACE, blocks.data(), floats.data(), MPI_FLOAT, MPI_SUM,
+                           MPI_COMM_WORLD);
+        MPI_Reduce_scatter(MPI_IN_PLACE, rects.data(), ints.data(), MPI_INT, MPI_MIN,
+                           MPI_COMM_WORLD);
+        // As a direct exchange: every other process's part out, my part from every other.
+        std::uint64_t all = 0;
+        for (int r = 0; r < p; ++r) all += 4ull * (std::uint64_t(floats[r]) + ints[r]);
+        const std::uint64_t own = 4ull * (std::uint64_t(floats[me]) + ints[me]);
+        if (bytes) *bytes += (all - own) + std::uint64_t(p - 1) * own;
+    }
+
+    Image sumImages(const Image& image, std::uint64_t* bytes) override {
+        Image out = rank() == 0 ? Image(image.width, image.height) : Image();
+        const int n = int(image.pixels.size() * 4);
+        MPI_Reduce(&image.pixels[0].x, rank() == 0 ? &out.pixels[0].x : nullptr, n, MPI_FLOAT,
+                   MPI_SUM, 0, MPI_COMM_WORLD);
+        if (bytes)
+            *bytes += 4ull * std::uint64_t(n) * (rank() == 0 ? std::uint64_t(size() - 1) : 1);
+        return out;
     }
 
   private:

@@ -3,9 +3,11 @@
 
 #include <mpi.h>
 
+#include <chrono>
 #include <cstring>
 #include <map>
 #include <optional>
+#include <thread>
 #include <type_traits>
 
 #include "splat/error.h"
@@ -18,11 +20,11 @@ namespace {
 static_assert(std::is_trivially_copyable_v<CameraParams>);
 
 // RenderStats on the wire: its numbers field by field, then the exact-path reason.
-#define SPLAT_STATS_FIELDS(X)                                                                  \
-    X(milliseconds) X(splats) X(voxels) X(footprintPixels) X(sheets) X(culledSplats)          \
-    X(referenceStep) X(sheetAxis) X(sheetSign) X(slabs) X(shadeMs) X(projectMs) X(orderMs)   \
-    X(binMs) X(tilesMs) X(perspective) X(normals) X(pathScalePixels) X(exactPixels)          \
-    X(lodLevel) X(lodSplats)
+#define SPLAT_STATS_FIELDS(X)                                                                      \
+    X(milliseconds)                                                                                \
+    X(splats) X(voxels) X(footprintPixels) X(sheets) X(culledSplats) X(referenceStep) X(sheetAxis) \
+        X(sheetSign) X(slabs) X(shadeMs) X(projectMs) X(orderMs) X(binMs) X(tilesMs)               \
+            X(perspective) X(normals) X(pathScalePixels) X(exactPixels) X(lodLevel) X(lodSplats)
 
 void putStats(Writer& w, const RenderStats& s) {
 #define SPLAT_PUT(f) w.put(s.f);
@@ -177,8 +179,14 @@ void serveFrames(Session& session, const std::function<Scene()>& build) {
     std::vector<char> sending;
     MPI_Request pending = MPI_REQUEST_NULL;
     for (;;) {
+        // Waiting sleeps between polls: a blocking probe spins on a core (OpenMPI), which
+        // would distort what rank 0 times meanwhile (`study`), for 1 ms at most per job.
         MPI_Status st;
-        MPI_Probe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &st);
+        for (int arrived = 0;;) {
+            MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, &st);
+            if (arrived) break;
+            std::this_thread::sleep_for(std::chrono::microseconds(500));
+        }
         if (st.MPI_TAG != kJob) break;  // the stop: Session::finish receives it
         const std::vector<char> msg = receiveBytes(0, kJob);
         Reader r(msg);

@@ -8,10 +8,12 @@
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "splat/atomic_file.h"
 #include "splat/error.h"
+#include "splat/frame_farm.h"
 #include "splat/image_io.h"
 #include "splat/metrics.h"
 #include "splat/scene.h"
@@ -300,6 +302,16 @@ Image boxDownsample(const Image& img, int f) {
     return out;
 }
 
+RenderSettings studyReferenceSettings(const RenderSettings& base, const StudyOptions& options,
+                                      const CameraParams& camera) {
+    RenderSettings r = base;
+    r.renderer = RendererKind::Reference;
+    r.camera = camera;
+    r.quality.referenceStep = options.referenceStep;
+    r.quality.referenceTolerance = options.referenceTolerance;
+    return r;
+}
+
 StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings& base,
                      const StudyOptions& options) {
     const auto start = Clock::now();
@@ -365,33 +377,33 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
     // References: the base model (its scene knobs), per view and image size.
     std::map<std::string, Image> references;
     std::unique_ptr<Scene> referenceScene;
-    auto referenceFor = [&](const RenderSettings& frame) -> const Image& {
-        RenderSettings r = base;
-        r.renderer = RendererKind::Reference;
-        r.camera = frame.camera;
-        r.quality.referenceStep = options.referenceStep;
-        r.quality.referenceTolerance = options.referenceTolerance;
+    auto cacheFile = [&](const std::string& key) {
+        return options.cacheDir.empty()
+                   ? std::string()
+                   : (std::filesystem::path(options.cacheDir) /
+                      ("reference_" +
+                       std::to_string(std::hash<std::string>{}(key + volume->source)) + ".exr"))
+                         .string();
+    };
+    // The reference of `r` from the map or the cache; null when it is to be rendered.
+    auto knownReference = [&](const RenderSettings& r) -> const Image* {
         const std::string key = referenceKey(r, options);
         auto it = references.find(key);
-        if (it != references.end()) return it->second;
-        const std::string file =
-            options.cacheDir.empty()
-                ? std::string()
-                : (std::filesystem::path(options.cacheDir) /
-                   ("reference_" + std::to_string(std::hash<std::string>{}(key + volume->source)) +
-                    ".exr"))
-                      .string();
+        if (it != references.end()) return &it->second;
+        const std::string file = cacheFile(key);
         if (!file.empty() && std::filesystem::exists(file)) {
             // A cached reference that does not decode whole (damaged) is rendered again.
             try {
                 Image img = readImage(file);
                 if (img.width == r.camera.width && img.height == r.camera.height)
-                    return references[key] = std::move(img);
+                    return &(references[key] = std::move(img));
             } catch (const Error&) {
             }
         }
-        if (!referenceScene) referenceScene = std::make_unique<Scene>(volume, r);
-        Image img = referenceScene->render(r);
+        return nullptr;
+    };
+    auto keepReference = [&](const RenderSettings& r, Image img) -> const Image& {
+        const std::string key = referenceKey(r, options), file = cacheFile(key);
         if (!file.empty()) {
             std::filesystem::create_directories(options.cacheDir);
             WriteOptions wo;
@@ -399,6 +411,45 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         }
         return references[key] = std::move(img);
     };
+    auto renderReference = [&](const RenderSettings& r) {
+        if (!referenceScene) referenceScene = std::make_unique<Scene>(volume, r);
+        return referenceScene->render(r);
+    };
+    auto referenceFor = [&](const RenderSettings& frame) -> const Image& {
+        const RenderSettings r = studyReferenceSettings(base, options, frame.camera);
+        if (const Image* known = knownReference(r)) return *known;
+        return keepReference(r, renderReference(r));
+    };
+    // On a frame farm, every reference missing is rendered first, spread over its processes
+    // (the ground truth is the costly part); nothing is timed while they run.
+    if (FrameFarm* farm = installedFrameFarm()) {
+        std::vector<RenderSettings> wanted;
+        std::vector<FrameJob> jobs;
+        std::set<std::string> keys;
+        for (const auto& combo : combos) {
+            RenderSettings s = base;
+            for (const auto& [k, v] : combo) applyKnob(s, k, v);
+            for (const CameraParams& view : views) {
+                CameraParams c = view;
+                c.width = s.camera.width;
+                c.height = s.camera.height;
+                const RenderSettings r = studyReferenceSettings(base, options, c);
+                if (!keys.insert(referenceKey(r, options)).second || knownReference(r)) continue;
+                jobs.push_back({wanted.size(), r.camera});
+                wanted.push_back(r);
+            }
+        }
+        farm->render(
+            {RendererKind::Reference}, jobs,
+            [&](const FrameJob& job) {
+                SequenceFrame f;
+                f.view = job.view;
+                f.images.push_back(renderReference(wanted[job.view]));
+                f.stats.resize(1);
+                return f;
+            },
+            [&](SequenceFrame&& f) { keepReference(wanted[f.view], std::move(f.images[0])); });
+    }
 
     // Points measured by an interrupted run (StudyOptions::pointJournal), by label.
     std::map<std::string, nlohmann::json> journaled;

@@ -193,7 +193,8 @@ Image LocalBrickGroup::composite(std::vector<std::pair<int, Image>>& partials,
 }
 
 Image renderBricked(const Volume& geometry, const std::function<Volume(const Brick&)>& load,
-                    const RenderSettings& frame, int bricks, BrickGroup& group, BrickStats* stats) {
+                    const RenderSettings& frame, int bricks, BrickGroup& group, BrickStats* stats,
+                    BrickComposite composite) {
     if (frame.edges.enabled())
         throw Error(
             "--bricks: edge enhancement scales by the whole volume's largest gradient; "
@@ -212,6 +213,8 @@ Image renderBricked(const Volume& geometry, const std::function<Volume(const Bri
     // The whole volume's range, when the settings are relative to it: one pass that loads
     // each brick, unless this process holds a single brick (kept for rendering).
     const bool relative = frame.transfer.normalized || frame.isoNormalized;
+    const bool exactSheets =
+        frame.renderer == RendererKind::Sheet && composite == BrickComposite::Exact;
     std::optional<Volume> kept;
     std::string error;
     float lo = INFINITY, hi = -INFINITY;
@@ -224,7 +227,7 @@ Image renderBricked(const Volume& geometry, const std::function<Volume(const Bri
         return v;
     };
     try {
-        if (relative || mine.size() == 1)
+        if (relative || (mine.size() == 1 && !exactSheets))
             for (int b : mine) {
                 Volume v = loadBrick(b);
                 for (std::size_t n = 0; n < v.voxelCount(); ++n)
@@ -244,6 +247,11 @@ Image renderBricked(const Volume& geometry, const std::function<Volume(const Bri
             s.isoNormalized = false;
         }
     }
+    if (exactSheets) {
+        Image out = renderBrickedSlabs(geometry, layout, mine, loadBrick, s, group, st);
+        if (stats) *stats = st;
+        return out;
+    }
     std::vector<std::pair<int, Image>> partials;
     try {
         for (int b : mine) {
@@ -259,7 +267,6 @@ Image renderBricked(const Volume& geometry, const std::function<Volume(const Bri
             partials.emplace_back(b, scene.render(bs, &rs));
             st.renderMs += msSince(t);
             st.splats += rs.splats;
-            st.renderMs += msSince(t);
         }
     } catch (const std::exception& e) {
         error = e.what();

@@ -1,6 +1,8 @@
 #pragma once
 // One frame of a Scene (frame/renderer.cpp).
+#include "frame/compositing.h"
 #include "model/scene_impl.h"
+#include "splat/camera.h"
 
 namespace splat {
 
@@ -12,5 +14,9 @@ void validateFrame(const RenderSettings& settings);
 /// With `depth` (iso only): the hit depths as well (Scene::renderIsoDepth).
 Image renderFrame(const Scene::Impl& scene, const RenderSettings& settings, RenderStats* stats,
                   Image* depth = nullptr);
+
+/// The compositing policy's parameters for a frame of `scene` seen by `camera`.
+PolicyContext policyContext(const Scene::Impl& scene, const Camera& camera,
+                            const RenderSettings& settings);
 
 }  // namespace splat

@@ -72,7 +72,8 @@ void bin(const Camera& camera, const RenderSettings& s, FrameWorkspace& work, Re
     stats.binMs = msSince(start);
 }
 
-/// The compositing policy's parameters for this frame.
+}  // namespace
+
 PolicyContext policyContext(const Scene::Impl& scene, const Camera& camera,
                             const RenderSettings& s) {
     PolicyContext ctx;
@@ -94,6 +95,8 @@ PolicyContext policyContext(const Scene::Impl& scene, const Camera& camera,
         ctx.labelTable = &scene.labelTable;
     return ctx;
 }
+
+namespace {
 
 /// Iso: the hit positions (fractional sheets in visiting order) as world distances along
 /// each pixel's ray from Camera::ray's origin.

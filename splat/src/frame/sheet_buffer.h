@@ -33,6 +33,13 @@ class SheetBuffer {
     }
 
     bool dirty() const { return dx0_ <= dx1_; }
+    /// The tile-local pixels that may have been written, [x0, x1] x [y0, y1].
+    void dirtyBounds(int& x0, int& y0, int& x1, int& y1) const {
+        x0 = dx0_;
+        y0 = dy0_;
+        x1 = dx1_;
+        y1 = dy1_;
+    }
 
     /// Re-targets a clean sheet to the tile at (ox, oy) of size w x h, no larger than the
     /// tile it was made for (the streaming splatters reuse one sheet per thread for every

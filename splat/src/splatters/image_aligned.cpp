@@ -9,8 +9,14 @@
 // slab for back-to-front). The tile sweep keeps a ring of sheets as deep as a kernel is
 // thick: when it reaches a splat, the splat's sections are added to every slab it crosses
 // at once (sharing r^2, the footprint and the section boundaries between them).
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
+#include <type_traits>
 
 #include "footprint/lanes.h"
 #include "splat/error.h"
@@ -163,11 +169,13 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
     return splatSectionsScalar(sheets, n, values, sx, sy, e, rect, table, poly, tb);
 }
 
-/// Each splat is cut into the slabs it crosses: `span` slabs from `key` in visiting order.
+/// Each splat is cut into the slabs it crosses: `span` slabs from `key` in visiting order;
+/// only those in [lo, hi) (exact bricks cut one group of slabs at a time: slab_sheets.h).
 struct SlabSections {
     const TileInputs& in;
     const footprint::SlabTable& table;
     bool ftb;
+    std::uint32_t lo = 0, hi = ~std::uint32_t(0);
 
     std::uint32_t key(const SheetRecord& s) const { return s.key; }
     std::uint32_t span(const SheetRecord& s) const { return s.span; }
@@ -186,8 +194,10 @@ struct SlabSections {
             const std::uint32_t plane = ftb ? base + std::uint32_t(b) : base - std::uint32_t(b);
             tb[b] = (in.plan.depthOrigin + float(plane) * in.plan.thickness - s.depth) * perRay;
         }
-        return splatSections(sheets, n, v, s.sx, s.sy, e, r, table,
-                             in.scene.poly ? &*in.scene.poly : nullptr, tb);
+        const int j0 = lo > s.key ? int(lo - s.key) : 0;
+        const int j1 = hi - s.key < s.span ? int(hi - s.key) : n;
+        return splatSections(sheets + j0, j1 - j0, v, s.sx, s.sy, e, r, table,
+                             in.scene.poly ? &*in.scene.poly : nullptr, tb + j0);
     }
 };
 
@@ -197,8 +207,6 @@ class ImageAligned final : public Splatter {
                     FrameWorkspace& work, RenderStats& stats) const override {
         const ProjectedSplats& proj = work.proj;
         const std::size_t count = proj.depth.size();
-        const bool ftb = s.order == CompositeOrder::FrontToBack;
-        const float thickness = float(s.quality.slab * scene.volume->minSpacing());
         const float ext = proj.depthExtent;
         // The slab grid covers every kernel's depth range [depth - ext, depth + ext].
         float zmin = 0.0f, zmax = 0.0f;
@@ -211,37 +219,9 @@ class ImageAligned final : public Splatter {
         }
         zmin -= ext;
         zmax += ext;
-        const double slabCount = double(std::floor((zmax - zmin) / thickness)) + 1;
-        const double span = double(std::ceil(2.0f * ext / thickness)) + 2;
-        if (!(slabCount <= kMaxSlabs) || !(span <= kMaxSpan))
-            throw Error("image-aligned splatter: the volume's depth range (" +
-                        std::to_string(zmax - zmin) + ") at slab thickness " +
-                        std::to_string(thickness) +
-                        " would need too many slabs; use a thicker --slab or check the spacing");
-        const std::uint32_t slabs = std::uint32_t(slabCount);
-        work.key.resize(count);
-        work.span.resize(count);
-        for (std::size_t n = 0; n < count; ++n) {
-            const std::uint32_t first =
-                std::min(slabs - 1, std::uint32_t((proj.depth[n] - ext - zmin) / thickness));
-            const std::uint32_t last =
-                std::min(slabs - 1, std::uint32_t((proj.depth[n] + ext - zmin) / thickness));
-            work.key[n] = ftb ? first : slabs - 1 - last;
-            work.span[n] = last - first + 1;
-        }
-        // Within a slab, splats are visited in slice order along the major axis, which keeps
-        // the accesses to the splat arrays coherent.
-        const int m = sheetAxis(camera.view, scene.volume->spacing).axis;
-        orderByKey(work.key, slabs, scene.sliceOrder(m).base(), work.order);
-        SheetPlan plan;
-        plan.sheets = slabs;
-        plan.ring = std::uint32_t(span);
-        plan.pathLength = thickness;
-        plan.normal = camera.view;
-        plan.depthOrigin = zmin;
-        plan.thickness = thickness;
-        stats.slabs = slabs;
-        return plan;
+        const float thickness = float(s.quality.slab * scene.volume->minSpacing());
+        return orderOnSlabs(scene, camera, s, work, stats, zmin,
+                            double(std::floor((zmax - zmin) / thickness)) + 1);
     }
 
     Image rasterize(const TileInputs& in, FrameWorkspace&, RenderStats* stats) const override {
@@ -252,6 +232,120 @@ class ImageAligned final : public Splatter {
 };
 
 }  // namespace
+
+SheetPlan orderOnSlabs(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
+                       FrameWorkspace& work, RenderStats& stats, float zmin, double slabCount) {
+    const ProjectedSplats& proj = work.proj;
+    const std::size_t count = proj.depth.size();
+    const bool ftb = s.order == CompositeOrder::FrontToBack;
+    const float thickness = float(s.quality.slab * scene.volume->minSpacing());
+    const float ext = proj.depthExtent;
+    const double span = double(std::ceil(2.0f * ext / thickness)) + 2;
+    if (!(slabCount <= kMaxSlabs) || !(span <= kMaxSpan))
+        throw Error("image-aligned splatter: the volume's depth range (" +
+                    std::to_string(slabCount * thickness) + ") at slab thickness " +
+                    std::to_string(thickness) +
+                    " would need too many slabs; use a thicker --slab or check the spacing");
+    const std::uint32_t slabs = std::uint32_t(slabCount);
+    work.key.resize(count);
+    work.span.resize(count);
+    for (std::size_t n = 0; n < count; ++n) {
+        // (Exact bricks: a brick's ghost kernels may lie before the grid; never visited.)
+        const std::uint32_t first = std::min(
+            slabs - 1, std::uint32_t(std::max(0.0f, (proj.depth[n] - ext - zmin) / thickness)));
+        const std::uint32_t last = std::min(
+            slabs - 1, std::uint32_t(std::max(0.0f, (proj.depth[n] + ext - zmin) / thickness)));
+        work.key[n] = ftb ? first : slabs - 1 - last;
+        work.span[n] = last - first + 1;
+    }
+    // Within a slab, splats are visited in slice order along the major axis, which keeps
+    // the accesses to the splat arrays coherent.
+    const int m = sheetAxis(camera.view, scene.volume->spacing).axis;
+    orderByKey(work.key, slabs, scene.sliceOrder(m).base(), work.order);
+    SheetPlan plan;
+    plan.sheets = slabs;
+    plan.ring = std::uint32_t(span);
+    plan.pathLength = thickness;
+    plan.normal = camera.view;
+    plan.depthOrigin = zmin;
+    plan.thickness = thickness;
+    stats.slabs = slabs;
+    return plan;
+}
+
+void addSlabSheets(const TileInputs& in, std::uint32_t first, std::uint32_t count, float* blocks,
+                   int* rects) {
+    withPolicy(in.policy, [&](const auto& policy) {
+        using Policy = std::decay_t<decltype(policy)>;
+        constexpr int NCh = Policy::kChannels;
+        const SlabSections cutter{in, in.scene.slabTable(),
+                                  in.settings.order == CompositeOrder::FrontToBack, first,
+                                  first + count};
+        const TileGrid& g = in.bins.grid;
+        const std::size_t block = std::size_t(NCh) * g.tileSize * g.tileSize;
+        struct Group {
+            std::vector<std::unique_ptr<SheetBuffer<NCh>>> sheets;
+        };
+        tbb::enumerable_thread_specific<Group> groups;
+        tbb::parallel_for(0, g.count(), 1, [&](int t) {
+            const BinnedSplats src{in, t};
+            if (src.begin() == src.end()) return;
+            const DenormalsAreZero ftz;
+            const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
+            const int w = std::min(g.tileSize, g.width - ox),
+                      h = std::min(g.tileSize, g.height - oy);
+            Group& group = groups.local();
+            while (group.sheets.size() < count)
+                group.sheets.push_back(
+                    std::make_unique<SheetBuffer<NCh>>(ox, oy, g.tileSize, g.tileSize));
+            for (std::uint32_t k = 0; k < count; ++k) group.sheets[k]->moveTo(ox, oy, w, h);
+            // The records are in key order: skip those that end before the group.
+            const SheetRecord* const records = &in.bins.records[0];
+            std::uint32_t q =
+                std::uint32_t(std::partition_point(records + src.begin(), records + src.end(),
+                                                   [&](const SheetRecord& r) {
+                                                       return r.key + in.plan.ring <= first;
+                                                   }) -
+                              records);
+            SheetBuffer<NCh>* target[kMaxRing];
+            for (; q < src.end() && src.record(q).key < first + count; ++q) {
+                const SheetRecord& rec = src.record(q);
+                if (rec.key + rec.span <= first) continue;
+                const PixelRect r = clipToTile(src.rect(rec), g, ox, oy);
+                const std::uint32_t j0 = first > rec.key ? first - rec.key : 0;
+                const std::uint32_t j1 = std::min(rec.span, first + count - rec.key);
+                for (std::uint32_t j = j0; j < j1; ++j)
+                    target[j] = group.sheets[rec.key + j - first].get();
+                float v[NCh];
+                splatValues<Policy>(in, rec.id, v);
+                cutter.cut(target, rec, v, src.ellipse(rec), r);
+            }
+            // Add the dirty sheets into the tile's blocks and widen their rectangles.
+            for (std::uint32_t k = 0; k < count; ++k) {
+                SheetBuffer<NCh>& sheet = *group.sheets[k];
+                if (!sheet.dirty()) continue;
+                int x0, y0, x1, y1;
+                sheet.dirtyBounds(x0, y0, x1, y1);
+                x1 = std::min(x1, w - 1);
+                const std::size_t at = std::size_t(t) * count + k;
+                float* out = blocks + at * block;
+                for (int c = 0; c < NCh; ++c)
+                    for (int y = y0; y <= y1; ++y) {
+                        const float* row = sheet.row(c, y);
+                        float* o = out + std::size_t(c) * g.tileSize * g.tileSize +
+                                   std::size_t(y) * g.tileSize;
+                        for (int x = x0; x <= x1; ++x) o[x] += row[x];
+                    }
+                int* rect = rects + 4 * at;
+                rect[0] = std::min(rect[0], x0);
+                rect[1] = std::min(rect[1], y0);
+                rect[2] = std::min(rect[2], -x1);
+                rect[3] = std::min(rect[3], -y1);
+                sheet.discard();
+            }
+        });
+    });
+}
 
 const Splatter& imageAlignedSplatter() {
     static const ImageAligned splatter;

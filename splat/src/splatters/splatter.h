@@ -30,6 +30,21 @@ class Splatter {
 };
 
 const Splatter& axisAlignedSplatter();
+
+/// The image-aligned splatter's stage "order" on `slabCount` slabs of settings.quality.slab
+/// voxels whose first boundary lies at depth zmin: the one-process frame's grid when zmin is
+/// its nearest kernel's front (exact bricks, splat/slab_sheets.h, give every brick the
+/// whole frame's grid).
+SheetPlan orderOnSlabs(const Scene::Impl& scene, const Camera& camera,
+                       const RenderSettings& settings, FrameWorkspace& work, RenderStats& stats,
+                       float zmin, double slabCount);
+/// Exact bricks (splat/slab_sheets.h): adds the slab sections of the binned splats in slabs
+/// [first, first + count) (visiting order) into per-tile blocks, tile t's slab first + k at
+/// blocks + (t count + k) B, B = channels tileSize^2 floats (channel c, tile-local pixel (x, y)
+/// at c tileSize^2 + y tileSize + x), and widens each block's written rectangle, rects + 4 (t
+/// count + k) = (x0, y0, -x1, -y1) (tile-local, inclusive), by the minimum.
+void addSlabSheets(const TileInputs& in, std::uint32_t first, std::uint32_t count, float* blocks,
+                   int* rects);
 const Splatter& imageAlignedSplatter();
 
 /// Index (0, 1, 2) of the volume axis most parallel to the ray direction in index space,
