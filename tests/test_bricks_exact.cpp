@@ -7,6 +7,7 @@
 #include "splat/bricks.h"
 #include "splat/scene.h"
 #include "splat/slab_sheets.h"
+#include "splat/volume.h"
 #include "splat/volume_io.h"
 
 using namespace splat;
@@ -112,4 +113,51 @@ TEST_CASE("bricks exact: a slab group fits its byte budget", "[bricks]") {
     CHECK(slabGroup(L, std::size_t(64) << 20) == 64);  // 1 MiB per slab of the frame
     CHECK(slabGroup(L, 100) == 1);                     // at least one slab
     CHECK(slabGroup(L, std::size_t(1) << 40) == 400);  // at most the frame
+}
+
+TEST_CASE("bricks exact: a brick's sheets cut group by group equal its sheets at once",
+          "[bricks]") {
+    // Memory stays bounded by one group of slabs: cutting the kernels that straddle a group's
+    // ends into its slabs alone must give each slab what the whole frame's sweep gives it.
+    const std::string spec = "synthetic:phantom:21";
+    RenderSettings s = sheetSettings(RenderMode::Dvr);
+    bool alone = false;
+    const Volume whole = volumeGeometry(spec, {}, &alone);
+    const BrickLayout layout = splitBricks(whole.dims, 2, 3);
+    const Brick& brick = layout.bricks[1];
+    auto v = std::make_shared<const Volume>(loadVolumeBrick(spec, {}, brick.loadLo, brick.loadHi));
+    RenderSettings bs = brickSettings(s, whole, brick, whole.dims);
+    bs.clipping.planes.clear();
+    const Scene scene(v, bs);
+    BrickSheets sheets(scene, bs, brick.lo - brick.loadLo, brick.hi - brick.loadLo, whole);
+    REQUIRE(sheets.splats() > 0);
+    const SlabLayout L = sheets.plan(sheets.nearest(), sheets.farthest());
+    REQUIRE(L.slabs > 8);
+    const std::size_t B = L.blockFloats();
+    std::vector<float> once(std::size_t(L.tiles) * L.slabs * B, 0.0f);
+    std::vector<int> onceRects(std::size_t(L.tiles) * L.slabs * 4, kNoRect);
+    sheets.add(0, L.slabs, once.data(), onceRects.data());
+    float peak = 0;
+    for (float x : once) peak = std::max(peak, std::abs(x));
+    REQUIRE(peak > 0);
+    const std::uint32_t G = 3;  // slabs per group: most kernels straddle a group's end
+    float worst = 0;
+    int rectsDiffer = 0;
+    for (std::uint32_t first = 0; first < L.slabs; first += G) {
+        const std::uint32_t n = std::min(G, L.slabs - first);
+        std::vector<float> part(std::size_t(L.tiles) * n * B, 0.0f);
+        std::vector<int> rects(std::size_t(L.tiles) * n * 4, kNoRect);
+        sheets.add(first, n, part.data(), rects.data());
+        for (int t = 0; t < L.tiles; ++t)
+            for (std::uint32_t k = 0; k < n; ++k) {
+                const float* a = &part[(std::size_t(t) * n + k) * B];
+                const float* b = &once[(std::size_t(t) * L.slabs + first + k) * B];
+                for (std::size_t q = 0; q < B; ++q) worst = std::max(worst, std::abs(a[q] - b[q]));
+                for (int c = 0; c < 4; ++c)
+                    rectsDiffer += rects[(std::size_t(t) * n + k) * 4 + c] !=
+                                   onceRects[(std::size_t(t) * L.slabs + first + k) * 4 + c];
+            }
+    }
+    CHECK(worst <= 1e-6f * peak);
+    CHECK(rectsDiffer == 0);
 }
