@@ -8,7 +8,7 @@
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <set>
+#include <optional>
 #include <sstream>
 
 #include "splat/atomic_file.h"
@@ -385,31 +385,28 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
                        std::to_string(std::hash<std::string>{}(key + volume->source)) + ".exr"))
                          .string();
     };
-    // The reference of `r` from the map or the cache; null when it is to be rendered.
-    auto knownReference = [&](const RenderSettings& r) -> const Image* {
-        const std::string key = referenceKey(r, options);
-        auto it = references.find(key);
-        if (it != references.end()) return &it->second;
-        const std::string file = cacheFile(key);
+    // References rendered (or read) ahead on a frame farm, moved to `references` when a point
+    // first asks for them: the PSNR scale is the peak of the references asked for so far,
+    // as in one process.
+    std::map<std::string, Image> prefetched;
+    auto cachedReference = [&](const RenderSettings& r) -> std::optional<Image> {
+        const std::string file = cacheFile(referenceKey(r, options));
         if (!file.empty() && std::filesystem::exists(file)) {
             // A cached reference that does not decode whole (damaged) is rendered again.
             try {
                 Image img = readImage(file);
-                if (img.width == r.camera.width && img.height == r.camera.height)
-                    return &(references[key] = std::move(img));
+                if (img.width == r.camera.width && img.height == r.camera.height) return img;
             } catch (const Error&) {
             }
         }
-        return nullptr;
+        return std::nullopt;
     };
-    auto keepReference = [&](const RenderSettings& r, Image img) -> const Image& {
-        const std::string key = referenceKey(r, options), file = cacheFile(key);
-        if (!file.empty()) {
-            std::filesystem::create_directories(options.cacheDir);
-            WriteOptions wo;
-            writeImage(file, img, wo);
-        }
-        return references[key] = std::move(img);
+    auto writeCache = [&](const RenderSettings& r, const Image& img) {
+        const std::string file = cacheFile(referenceKey(r, options));
+        if (file.empty()) return;
+        std::filesystem::create_directories(options.cacheDir);
+        WriteOptions wo;
+        writeImage(file, img, wo);
     };
     auto renderReference = [&](const RenderSettings& r) {
         if (!referenceScene) referenceScene = std::make_unique<Scene>(volume, r);
@@ -417,15 +414,23 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
     };
     auto referenceFor = [&](const RenderSettings& frame) -> const Image& {
         const RenderSettings r = studyReferenceSettings(base, options, frame.camera);
-        if (const Image* known = knownReference(r)) return *known;
-        return keepReference(r, renderReference(r));
+        const std::string key = referenceKey(r, options);
+        if (auto it = references.find(key); it != references.end()) return it->second;
+        if (auto it = prefetched.find(key); it != prefetched.end()) {
+            Image& img = references[key] = std::move(it->second);
+            prefetched.erase(it);
+            return img;
+        }
+        if (std::optional<Image> img = cachedReference(r)) return references[key] = std::move(*img);
+        Image img = renderReference(r);
+        writeCache(r, img);
+        return references[key] = std::move(img);
     };
     // On a frame farm, every reference missing is rendered first, spread over its processes
     // (the ground truth is the costly part); nothing is timed while they run.
     if (FrameFarm* farm = installedFrameFarm()) {
         std::vector<RenderSettings> wanted;
         std::vector<FrameJob> jobs;
-        std::set<std::string> keys;
         for (const auto& combo : combos) {
             RenderSettings s = base;
             for (const auto& [k, v] : combo) applyKnob(s, k, v);
@@ -434,7 +439,13 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
                 c.width = s.camera.width;
                 c.height = s.camera.height;
                 const RenderSettings r = studyReferenceSettings(base, options, c);
-                if (!keys.insert(referenceKey(r, options)).second || knownReference(r)) continue;
+                const std::string key = referenceKey(r, options);
+                if (prefetched.count(key)) continue;
+                if (std::optional<Image> img = cachedReference(r)) {
+                    prefetched[key] = std::move(*img);
+                    continue;
+                }
+                prefetched[key] = Image();  // claimed: rendered by the farm below
                 jobs.push_back({wanted.size(), r.camera});
                 wanted.push_back(r);
             }
@@ -448,7 +459,11 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
                 f.stats.resize(1);
                 return f;
             },
-            [&](SequenceFrame&& f) { keepReference(wanted[f.view], std::move(f.images[0])); });
+            [&](SequenceFrame&& f) {
+                const RenderSettings& r = wanted[f.view];
+                writeCache(r, f.images[0]);
+                prefetched[referenceKey(r, options)] = std::move(f.images[0]);
+            });
     }
 
     // Points measured by an interrupted run (StudyOptions::pointJournal), by label.
