@@ -78,7 +78,8 @@ TEST_CASE("bricks exact: the image-aligned splatter's bricks equal one process w
         }
 }
 
-TEST_CASE("bricks exact: back to front, a thin slab and 4 slabs a group agree too", "[bricks]") {
+TEST_CASE("bricks exact: back to front, a thin slab and post-classified shading agree too",
+          "[bricks]") {
     RenderSettings s = sheetSettings(RenderMode::Dvr);
     s.order = CompositeOrder::BackToFront;
     s.quality.slab = 0.5;

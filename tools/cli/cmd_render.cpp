@@ -60,7 +60,13 @@ void registerRender(CLI::App& app) {
         if (args->brickComposite != "exact" && args->brickComposite != "fast")
             throw UsageError("--brick-composite must be exact or fast (got '" +
                              args->brickComposite + "')");
-        if (args->bricks > 0 || processCount() > 1) {  // README "Beyond one machine"
+        const bool bricked = args->bricks > 0 || processCount() > 1;
+        if (given(*cmd, "brick-composite") &&
+            (!bricked || settings.renderer != RendererKind::Sheet))
+            warn(
+                "--brick-composite applies to bricked renders (--bricks or mpirun) of "
+                "--renderer sheet: ignored");
+        if (bricked) {  // README "Beyond one machine"
             if (!workerProcess()) beginRun(*cmd);
             renderBrickedToFile(
                 args->volume, args->render, settings,

@@ -3,11 +3,13 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <climits>
 #include <cstring>
 #include <type_traits>
 
 #include "splat/error.h"
+#include "splat/slab_sheets.h"
 
 namespace splat::mpi {
 
@@ -126,28 +128,69 @@ class MpiBrickGroup : public BrickGroup {
         return all;
     }
 
+    // Sparse direct exchange: every process sends the owner of each tile only the blocks it
+    // wrote (a block whose rectangle is empty holds zeros), with their index and rectangle;
+    // the owner adds them to its own. A brick writes only the tiles its footprint covers and
+    // the slabs its depth range crosses, so this moves a fraction of the dense sheets an
+    // MPI_Reduce_scatter would.
     void reduceSlabs(std::vector<float>& blocks, std::vector<int>& rects,
                      const std::vector<int>& tileStart, std::size_t tileFloats,
                      std::size_t tileInts, std::uint64_t* bytes) override {
         const int p = size(), me = rank();
-        std::vector<int> floats(p), ints(p);
-        for (int r = 0; r < p; ++r) {
-            const std::size_t tiles = std::size_t(tileStart[r + 1] - tileStart[r]);
-            if (tiles * tileFloats > std::size_t(INT_MAX))
+        const std::size_t perTile = tileInts / 4, B = perTile ? tileFloats / perTile : 0;
+        constexpr int kHead = 5;  // block index in the owner's part, then its rectangle
+        std::vector<int> heads, headCount(p, 0), headOff(p, 0), floatCount(p, 0), floatOff(p, 0);
+        std::vector<float> data;
+        for (int d = 0; d < p; ++d) {
+            headOff[d] = int(heads.size());
+            floatOff[d] = int(data.size());
+            if (d == me) continue;
+            const std::size_t q0 = std::size_t(tileStart[d]) * perTile,
+                              q1 = std::size_t(tileStart[d + 1]) * perTile;
+            for (std::size_t q = q0; q < q1; ++q) {
+                if (rects[4 * q] == kNoRect) continue;
+                heads.push_back(int(q - q0));
+                heads.insert(heads.end(), &rects[4 * q], &rects[4 * q] + 4);
+                data.insert(data.end(), &blocks[q * B], &blocks[q * B] + B);
+            }
+            if (data.size() > std::size_t(INT_MAX))
                 throw Error("exact brick sheets: a slab group exceeds MPI's count");
-            floats[r] = int(tiles * tileFloats);
-            ints[r] = int(tiles * tileInts);
+            headCount[d] = int(heads.size()) - headOff[d];
+            floatCount[d] = int(data.size()) - floatOff[d];
         }
-        // In place: each process's part, summed (minimum), lands at the front of its arrays.
-        MPI_Reduce_scatter(MPI_IN_PLACE, blocks.data(), floats.data(), MPI_FLOAT, MPI_SUM,
-                           MPI_COMM_WORLD);
-        MPI_Reduce_scatter(MPI_IN_PLACE, rects.data(), ints.data(), MPI_INT, MPI_MIN,
-                           MPI_COMM_WORLD);
-        // As a direct exchange: every other process's part out, my part from every other.
-        std::uint64_t all = 0;
-        for (int r = 0; r < p; ++r) all += 4ull * (std::uint64_t(floats[r]) + ints[r]);
-        const std::uint64_t own = 4ull * (std::uint64_t(floats[me]) + ints[me]);
-        if (bytes) *bytes += (all - own) + std::uint64_t(p - 1) * own;
+        std::vector<int> recvHeads(p), recvHeadOff(p), recvFloats(p), recvFloatOff(p);
+        MPI_Alltoall(headCount.data(), 1, MPI_INT, recvHeads.data(), 1, MPI_INT, MPI_COMM_WORLD);
+        std::size_t nh = 0, nf = 0;
+        for (int q = 0; q < p; ++q) {
+            recvHeadOff[q] = int(nh);
+            recvFloatOff[q] = int(nf);
+            recvFloats[q] = recvHeads[q] / kHead * int(B);
+            nh += std::size_t(recvHeads[q]);
+            nf += std::size_t(recvFloats[q]);
+        }
+        std::vector<int> inHeads(nh);
+        std::vector<float> in(nf);
+        MPI_Alltoallv(heads.data(), headCount.data(), headOff.data(), MPI_INT, inHeads.data(),
+                      recvHeads.data(), recvHeadOff.data(), MPI_INT, MPI_COMM_WORLD);
+        MPI_Alltoallv(data.data(), floatCount.data(), floatOff.data(), MPI_FLOAT, in.data(),
+                      recvFloats.data(), recvFloatOff.data(), MPI_FLOAT, MPI_COMM_WORLD);
+        // My tiles to the front, then every other process's blocks added in rank order.
+        const std::size_t mine0 = std::size_t(tileStart[me]) * perTile,
+                          mine1 = std::size_t(tileStart[me + 1]) * perTile;
+        if (mine0 > 0) {
+            std::copy(blocks.begin() + std::ptrdiff_t(mine0 * B),
+                      blocks.begin() + std::ptrdiff_t(mine1 * B), blocks.begin());
+            std::copy(rects.begin() + std::ptrdiff_t(4 * mine0),
+                      rects.begin() + std::ptrdiff_t(4 * mine1), rects.begin());
+        }
+        for (std::size_t h = 0, f = 0; h < nh; h += kHead, f += B) {
+            const std::size_t q = std::size_t(inHeads[h]);
+            float* to = &blocks[q * B];
+            for (std::size_t i = 0; i < B; ++i) to[i] += in[f + i];
+            for (int c = 0; c < 4; ++c)
+                rects[4 * q + c] = std::min(rects[4 * q + c], inHeads[h + 1 + c]);
+        }
+        if (bytes) *bytes += 4ull * (heads.size() + data.size() + nh + nf);
     }
 
     Image sumImages(const Image& image, std::uint64_t* bytes) override {

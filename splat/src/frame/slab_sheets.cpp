@@ -321,9 +321,14 @@ Image renderBrickedSlabs(const Volume& geometry, const BrickLayout& layout,
         tileStart[std::size_t(r)] = int(std::int64_t(L.tiles) * r / holders);
     const int me = group.rank();
     std::optional<SlabCompositor> compositor;
-    if (me < holders)
-        compositor.emplace(*scenes.front(), settings.front(), L, tileStart[std::size_t(me)],
-                           tileStart[std::size_t(me) + 1]);
+    try {
+        if (me < holders)
+            compositor.emplace(*scenes.front(), settings.front(), L, tileStart[std::size_t(me)],
+                               tileStart[std::size_t(me) + 1]);
+    } catch (const std::exception& e) {
+        error = e.what();
+    }
+    group.agree(error);
     // One group of slabs of the whole frame in at most 64 MiB.
     const std::uint32_t group0 = slabGroup(L, std::size_t(64) << 20);
     std::vector<float> blocks;
@@ -331,9 +336,14 @@ Image renderBrickedSlabs(const Volume& geometry, const BrickLayout& layout,
     for (std::uint32_t first = 0; first < L.slabs; first += group0) {
         const std::uint32_t n = std::min(group0, L.slabs - first);
         auto t = Clock::now();
-        blocks.assign(std::size_t(L.tiles) * n * L.blockFloats(), 0.0f);
-        rects.assign(std::size_t(L.tiles) * n * 4, kNoRect);
-        for (const BrickSheets& sh : sheets) sh.add(first, n, blocks.data(), rects.data());
+        try {  // (an allocation that fails on one process must not leave the others waiting)
+            blocks.assign(std::size_t(L.tiles) * n * L.blockFloats(), 0.0f);
+            rects.assign(std::size_t(L.tiles) * n * 4, kNoRect);
+            for (const BrickSheets& sh : sheets) sh.add(first, n, blocks.data(), rects.data());
+        } catch (const std::exception& e) {
+            error = e.what();
+        }
+        group.agree(error);
         st.renderMs += msSince(t);
         t = Clock::now();
         group.reduceSlabs(blocks, rects, tileStart, n * L.blockFloats(), std::size_t(n) * 4,
