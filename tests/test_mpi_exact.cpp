@@ -1,6 +1,6 @@
 // Exact bricks of the image-aligned splatter under mpirun (splat/slab_sheets.h, issue 26):
-// every slab's sheets are summed across ranks (MPI_Reduce_scatter onto ranges of screen
-// tiles) before compositing, so the frame equals one process's within 1e-5 of the peak; the
+// every slab's sheets are summed across ranks (onto ranges of screen tiles, a sparse direct
+// exchange) before compositing, so the frame equals one process's within 1e-5 of the peak; the
 // fast composite stays within its documented bound. Hidden tag [.mpi]: run by mpi.ranks.
 #if SPLAT_TEST_HAVE_MPI  // the whole file: splat built with MPI (SPLAT_MPI)
 #include <catch2/catch.hpp>

@@ -136,8 +136,8 @@ class BrickGroup {
     /// Exact sheets (splat/slab_sheets.h): sums `blocks` and takes the minimum of `rects`
     /// element by element over the processes, and leaves process r its part, the tiles
     /// [tileStart[r], tileStart[r + 1]) (`tileFloats` floats and `tileInts` ints each), at the
-    /// front of both arrays. Adds the bytes this process sent and received to `bytes` (as a
-    /// direct exchange: every part to its owner).
+    /// front of both arrays. A block whose rectangle is empty (kNoRect) holds zeros and
+    /// need not be sent. Adds the bytes this process sent and received to `bytes`.
     virtual void reduceSlabs(std::vector<float>& blocks, std::vector<int>& rects,
                              const std::vector<int>& tileStart, std::size_t tileFloats,
                              std::size_t tileInts, std::uint64_t* bytes) = 0;

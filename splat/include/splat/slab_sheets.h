@@ -6,7 +6,7 @@
 // it owns (every kernel once: no ghost kernel, no clip plane), and compositing only the sums
 // gives the one-process frame to float rounding. The core stays free of MPI: BrickSheets
 // gives one brick's sheets of a group of slabs as plain float blocks, the caller sums them
-// (one process: into the same blocks; MPI: a reduce-scatter onto ranges of screen tiles),
+// (one process: into the same blocks; MPI: onto ranges of screen tiles, splat/bricks.h),
 // and SlabCompositor composites the summed blocks of its tiles group after group, front to
 // back in visiting order, so memory stays bounded by one group.
 //
