@@ -271,7 +271,9 @@ Image renderBrickedSlabs(const Volume& geometry, const BrickLayout& layout,
         throw Error(
             "--bricks with --renderer sheet: clipping needs --brick-composite fast (approximate)");
     if (s.quality.lod > 0)
-        throw Error("--bricks with --renderer sheet renders full resolution: leave out --lod");
+        throw Error(
+            "--bricks with --renderer sheet renders full resolution: leave out --lod or use "
+            "--brick-composite fast");
     // Every brick of this process, held at once: a slab group needs them all.
     std::vector<std::unique_ptr<Scene>> scenes;
     std::vector<RenderSettings> settings;
