@@ -171,7 +171,9 @@ TEST_CASE("mpi: popping on 3 ranks finds what one process finds", "[.mpi]") {
             if (line.rfind("wrote ", 0) == 0) continue;
             const auto last = line.find_last_of(' ');
             const bool row = line.rfind("event", 0) != 0 && line.rfind("predicted", 0) != 0;
-            kept += (row && last != std::string::npos ? line.substr(0, last) : line) + "\n";
+            std::string k = row && last != std::string::npos ? line.substr(0, last) : line;
+            k.erase(k.find_last_not_of(' ') + 1);  // the time column's width varies
+            kept += k + "\n";
         }
         return kept;
     };

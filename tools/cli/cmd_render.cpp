@@ -61,7 +61,7 @@ void registerRender(CLI::App& app) {
             throw UsageError("--brick-composite must be exact or fast (got '" +
                              args->brickComposite + "')");
         const bool bricked = args->bricks > 0 || processCount() > 1;
-        if (given(*cmd, "brick-composite") &&
+        if (given(*cmd, "brick-composite") && !fromScene(*cmd, "brick-composite") &&
             (!bricked || settings.renderer != RendererKind::Sheet))
             warn(
                 "--brick-composite applies to bricked renders (--bricks or mpirun) of "
