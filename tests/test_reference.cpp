@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "footprint/footprint_table.h"
+#include "reference/reference_frame.h"
 #include "reference_util.h"
 #include "splat/error.h"
 #include "splat/synthetic.h"
@@ -387,7 +388,7 @@ double maxAbsDiff(const Image& a, const Image& b) {
 
 }  // namespace
 
-TEST_CASE("reference: the separable Gaussian path equals the kernel table's to 1e-6",
+TEST_CASE("reference: the separable Gaussian path equals the kernel table's to 2e-6",
           "[reference]") {
     // Random values, background -1000 (the grid holds d - b): every point of a ray's path,
     // near the faces (plain fallback) and inside, for R = 2 (W = 4) and R = 2.5 (W = 6).
@@ -417,7 +418,7 @@ TEST_CASE("reference: the separable Gaussian path equals the kernel table's to 1
             maxDiff = std::max(maxDiff, std::abs(a - b));
         }
         INFO("R = " << radius << ": max |separable - table| = " << maxDiff);
-        CHECK(maxDiff <= 1e-6 * 2000.0);  // 1e-6 of the largest |d - b|
+        CHECK(maxDiff <= 2e-6 * 2000.0);  // 2e-6 of the largest |d - b|
     }
 }
 

@@ -41,6 +41,12 @@ ReferenceField::ReferenceField(const Volume& volume, const SplatList& splats,
             grid1_ = buildGrid<1>(volume, splats, lut_, radius_, {density});
     }
     grid4_.gauss = grid1_.gauss = gauss_.get();
+    if (gauss_) {
+        if (layout == FieldLayout::Density)
+            grid1_.buildWindowFlags(gauss_->window());
+        else
+            grid4_.buildWindowFlags(gauss_->window());
+    }
 }
 
 }  // namespace splat

@@ -10,10 +10,14 @@
 //    1e-6 of the peak, see tests/test_reference.cpp): the plain path, any kernel;
 //  - the tapered Gaussian (the default kernel) is evaluated separably instead: with
 //    q = dx^2 + dy^2 + dz^2, h = N [g(dx^2) g(dy^2) g(dz^2) - e_R (1 + (R^2 - q) / 2 sigma^2)]
-//    for q < R^2 (footprint/kernel.h), g(q) = exp(-q / 2 sigma^2) tabulated once per axis and
-//    sample (16384 entries over [0, R^2], relative error < 2e-8), then the 2 ceil(R) lattice
-//    points per axis combined in branch-free rows. Same kernel, same truncation at R; the
-//    tests hold the two paths to 1e-6 of each other (tests/test_reference.cpp).
+//    for q < R^2 (footprint/kernel.h), g(q) = exp(-q / 2 sigma^2) once per axis and sample
+//    (AVX2 + FMA where the CPU has them: a degree-7 polynomial after reduction by ln 2,
+//    relative error < 2e-7; else a 16384-entry table over [0, R^2], < 2e-8), then the
+//    2 ceil(R) lattice points per axis combined in rows with the points at or beyond R
+//    masked. Same kernel, same truncation at R; the tests hold the two paths to 2e-6 of each
+//    other (tests/test_reference.cpp);
+//  - a cell flag per voxel (separable path) says whether the window of lattice points a
+//    sample in that cell reads holds any non-zero value: if not the sample is exactly 0.
 // Views through the volume (slices, MPR, CPR) evaluate the same fields.
 #include <algorithm>
 #include <array>
@@ -216,6 +220,45 @@ struct FieldGrid {
     std::vector<std::uint8_t> bricks;
     const KernelLut* lut = nullptr;
     const SeparableGaussian* gauss = nullptr;  ///< the separable path (null: plain path only)
+    /// Separable path: per cell floor(p), 1 when its W^3 window holds a non-zero voxel; a
+    /// sample whose window is all zero is 0 without the sum (empty space at the kernel's
+    /// support, finer than the bricks).
+    std::vector<std::uint8_t> windowFlags;
+
+    // Fills windowFlags for windows of w points per axis from floor(p) - (w / 2 - 1).
+    void buildWindowFlags(int w) {
+        const std::size_t n = std::size_t(dims.x) * dims.y * dims.z;
+        std::vector<std::uint8_t> a(n), b(n);
+        for (std::size_t v = 0; v < n; ++v) {
+            bool any = false;
+            for (int c = 0; c < C; ++c) any = any || values[v * C + c] != 0.0f;
+            a[v] = any;
+        }
+        // Separable dilation: cell c sees voxels c - (w / 2 - 1) .. c + w / 2 on each axis.
+        const int lo = w / 2 - 1, hi = w / 2;
+        const std::size_t stride[3] = {1, std::size_t(dims.x), std::size_t(dims.x) * dims.y};
+        for (int axis = 0; axis < 3; ++axis) {
+            for (int k = 0; k < dims.z; ++k)
+                for (int j = 0; j < dims.y; ++j)
+                    for (int i = 0; i < dims.x; ++i) {
+                        const int at[3] = {i, j, k};
+                        const std::size_t v = (std::size_t(k) * dims.y + j) * dims.x + i;
+                        std::uint8_t any = 0;
+                        for (int d = std::max(0, at[axis] - lo);
+                             d <= std::min(dims[axis] - 1, at[axis] + hi) && !any; ++d)
+                            any = a[v + (std::ptrdiff_t(d) - at[axis]) * std::ptrdiff_t(stride[axis])];
+                        b[v] = any;
+                    }
+            std::swap(a, b);
+        }
+        windowFlags = std::move(a);
+    }
+    bool windowEmpty(const int base[3], int w) const {
+        const std::size_t c = (std::size_t(base[2] + w / 2 - 1) * dims.y + (base[1] + w / 2 - 1)) *
+                                  dims.x +
+                              std::size_t(base[0] + w / 2 - 1);
+        return !windowFlags.empty() && windowFlags[c] == 0;
+    }
 
     std::size_t index(int i, int j, int k) const {
         return ((std::size_t(k) * dims.y + j) * dims.x + i) * C;
@@ -253,6 +296,10 @@ struct FieldGrid {
                     base[a] = int(fl) - 1;
                     frac[a] = float(p[a] - double(base[a]));
                 }
+                if (windowEmpty(base, W)) {
+                    for (int c = 0; c < C; ++c) out[c] = 0.0;
+                    return;
+                }
                 return separableLanes<C>(values.data() + index(base[0], base[1], base[2]),
                                          std::ptrdiff_t(dims.x) * C,
                                          std::ptrdiff_t(dims.x) * dims.y * C, frac, k, out);
@@ -267,6 +314,10 @@ struct FieldGrid {
                 q[a][n] = d * d;
                 g[a][n] = q[a][n] < r2 ? k.g(q[a][n]) : 0.0f;
             }
+        }
+        if (windowEmpty(base, W)) {
+            for (int c = 0; c < C; ++c) out[c] = 0.0;
+            return;
         }
 #if defined(__SSE2__)
         if constexpr (W == 4) return rowsSse2(base, q, g, out);

@@ -24,7 +24,7 @@
 //
 //  - dvr: optical depth tau(t) by Simpson/quadratic interpolation of rho at every sample,
 //    I = int e exp(-tau) by Simpson. Early termination: a ray stops once
-//    T < 0.01 * tolerance / B. What follows the stop is rest = int e exp(-tau) <= B (T - T_end)
+//    T < 0.01 * min(tolerance, 1e-4) / B. What follows the stop is rest = int e exp(-tau) <= B (T - T_end)
 //    per colour channel, where B >= e / rho everywhere (pre-classified: the largest voxel
 //    ratio e_i / rho_i, which bounds e(x) / rho(x) because h >= 0 makes it a weighted mean of
 //    them, label colours included; post-classified unshaded: the largest colour of the
@@ -161,7 +161,7 @@ class Caster {
         bound = std::max({bound, std::abs(double(bg.r)), std::abs(double(bg.g)),
                           std::abs(double(bg.b)), std::abs(1.0 - double(bg.a))});
         if (!std::isfinite(bound)) return plain;
-        return std::max(plain, 0.01 * tol / bound);
+        return std::max(plain, 0.01 * std::min(tol, 1e-4) / bound);
     }
 
     // Converts a grid sample into the quantities integrated: dvr -> (rho, e rgb), else f.
