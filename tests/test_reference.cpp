@@ -372,8 +372,7 @@ namespace {
 // The reference image of `v` under `s` from a field with the given accelerations.
 Image referenceWith(const Volume& v, const RenderSettings& s, ReferenceAcceleration acc) {
     const footprint::Kernel kernel = kernelOf(s);
-    const SplatList splats =
-        classify(v, s.transfer, s.mode, s.classification, kernel.radius());
+    const SplatList splats = classify(v, s.transfer, s.mode, s.classification, kernel.radius());
     const ReferenceField field(v, splats, kernel, fieldLayout(s, splats), acc);
     return renderReference(v, field, Camera(s.camera, v), s, nullptr, nullptr);
 }

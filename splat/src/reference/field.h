@@ -142,18 +142,17 @@ void separableRowsLanes(const float* at, std::ptrdiff_t row, std::ptrdiff_t plan
             const float* r = at + kz * plane + jy * row;
             if constexpr (C == 4) {
                 const __m256 w8 = _mm256_castps128_ps256(w);
-                acc8[jy] = _mm256_fmadd_ps(_mm256_permutevar8x32_ps(w8, hi23),
-                                           _mm256_loadu_ps(r + 8),
-                                           _mm256_mul_ps(_mm256_permutevar8x32_ps(w8, lo01),
-                                                         _mm256_loadu_ps(r)));
+                acc8[jy] = _mm256_fmadd_ps(
+                    _mm256_permutevar8x32_ps(w8, hi23), _mm256_loadu_ps(r + 8),
+                    _mm256_mul_ps(_mm256_permutevar8x32_ps(w8, lo01), _mm256_loadu_ps(r)));
             } else {
                 acc4[jy] = _mm_mul_ps(w, _mm_loadu_ps(r));
             }
         }
         __m128 p4;
         if constexpr (C == 4) {
-            const __m256 a = _mm256_add_ps(_mm256_add_ps(acc8[0], acc8[1]),
-                                           _mm256_add_ps(acc8[2], acc8[3]));
+            const __m256 a =
+                _mm256_add_ps(_mm256_add_ps(acc8[0], acc8[1]), _mm256_add_ps(acc8[2], acc8[3]));
             p4 = _mm_add_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
         } else {
             p4 = _mm_add_ps(_mm_add_ps(acc4[0], acc4[1]), _mm_add_ps(acc4[2], acc4[3]));
@@ -176,24 +175,23 @@ inline __m256 expLanes(__m256 x) {
     __m256 r = _mm256_fnmadd_ps(k, _mm256_set1_ps(0.693359375f), x);
     r = _mm256_fnmadd_ps(k, _mm256_set1_ps(-2.12194440e-4f), r);
     __m256 p = _mm256_set1_ps(1.0f / 5040.0f);
-    for (const float c : {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f,
-                          1.0f})
+    for (const float c :
+         {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f, 1.0f})
         p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(c));
-    const __m256i e = _mm256_slli_epi32(
-        _mm256_add_epi32(_mm256_cvtps_epi32(k), _mm256_set1_epi32(127)), 23);
+    const __m256i e =
+        _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(k), _mm256_set1_epi32(127)), 23);
     return _mm256_mul_ps(p, _mm256_castsi256_ps(e));
 }
 
 // FieldGrid::evalSeparable for W = 4 with AVX2 + FMA: `frac` = p - base per axis (in [1, 2)),
 // the twelve per-axis q = d^2 and g(q) in two vectors, then the rows.
 template <int C>
-void separableLanes(const float* at, std::ptrdiff_t row, std::ptrdiff_t plane,
-                    const float frac[3], const SeparableGaussian& k, double out[C]) {
+void separableLanes(const float* at, std::ptrdiff_t row, std::ptrdiff_t plane, const float frac[3],
+                    const SeparableGaussian& k, double out[C]) {
     alignas(32) float q[3][4], g[3][4], qz[8], gz[8];
     const __m256 n = _mm256_setr_ps(0, 1, 2, 3, 0, 1, 2, 3);
     const __m256 dxy = _mm256_sub_ps(
-        _mm256_setr_ps(frac[0], frac[0], frac[0], frac[0], frac[1], frac[1], frac[1], frac[1]),
-        n);
+        _mm256_setr_ps(frac[0], frac[0], frac[0], frac[0], frac[1], frac[1], frac[1], frac[1]), n);
     const __m256 dz = _mm256_sub_ps(_mm256_set1_ps(frac[2]), n);
     const __m256 qxy = _mm256_mul_ps(dxy, dxy), qzz = _mm256_mul_ps(dz, dz);
     const __m256 s = _mm256_set1_ps(k.minusInvS2());
@@ -246,7 +244,8 @@ struct FieldGrid {
                         std::uint8_t any = 0;
                         for (int d = std::max(0, at[axis] - lo);
                              d <= std::min(dims[axis] - 1, at[axis] + hi) && !any; ++d)
-                            any = a[v + (std::ptrdiff_t(d) - at[axis]) * std::ptrdiff_t(stride[axis])];
+                            any = a[v +
+                                    (std::ptrdiff_t(d) - at[axis]) * std::ptrdiff_t(stride[axis])];
                         b[v] = any;
                     }
             std::swap(a, b);
@@ -254,9 +253,9 @@ struct FieldGrid {
         windowFlags = std::move(a);
     }
     bool windowEmpty(const int base[3], int w) const {
-        const std::size_t c = (std::size_t(base[2] + w / 2 - 1) * dims.y + (base[1] + w / 2 - 1)) *
-                                  dims.x +
-                              std::size_t(base[0] + w / 2 - 1);
+        const std::size_t c =
+            (std::size_t(base[2] + w / 2 - 1) * dims.y + (base[1] + w / 2 - 1)) * dims.x +
+            std::size_t(base[0] + w / 2 - 1);
         return !windowFlags.empty() && windowFlags[c] == 0;
     }
 
@@ -270,10 +269,14 @@ struct FieldGrid {
     // Sum of the C channels times h at index position p.
     void eval(const glm::dvec3& p, double out[C]) const {
         if (gauss) switch (gauss->window()) {
-                case 2: return evalSeparable<2>(p, out);
-                case 4: return evalSeparable<4>(p, out);
-                case 6: return evalSeparable<6>(p, out);
-                default: break;
+                case 2:
+                    return evalSeparable<2>(p, out);
+                case 4:
+                    return evalSeparable<4>(p, out);
+                case 6:
+                    return evalSeparable<6>(p, out);
+                default:
+                    break;
             }
         evalPlain(p, out);
     }
@@ -366,20 +369,20 @@ struct FieldGrid {
                 const __m128 qq = _mm_add_ps(qx, _mm_set1_ps(qyz));
                 const __m128 gyz = _mm_set1_ps(k.n() * g[1][jy] * g[2][kz]);
                 // h = N gx gy gz - A + B (qx + qyz)
-                const __m128 h = _mm_add_ps(_mm_add_ps(_mm_mul_ps(gx, gyz), bqx),
-                                            _mm_set1_ps(k.b() * qyz));
+                const __m128 h =
+                    _mm_add_ps(_mm_add_ps(_mm_mul_ps(gx, gyz), bqx), _mm_set1_ps(k.b() * qyz));
                 const __m128 w =
                     _mm_and_ps(h, _mm_and_ps(_mm_cmplt_ps(qq, vr2), _mm_cmpgt_ps(h, zero)));
                 const float* row = values.data() + index(base[0], base[1] + jy, base[2] + kz);
                 if constexpr (C == 4) {
-                    plane = _mm_add_ps(plane, _mm_mul_ps(_mm_shuffle_ps(w, w, 0x00),
-                                                         _mm_loadu_ps(row)));
-                    plane = _mm_add_ps(plane, _mm_mul_ps(_mm_shuffle_ps(w, w, 0x55),
-                                                         _mm_loadu_ps(row + 4)));
-                    plane = _mm_add_ps(plane, _mm_mul_ps(_mm_shuffle_ps(w, w, 0xaa),
-                                                         _mm_loadu_ps(row + 8)));
-                    plane = _mm_add_ps(plane, _mm_mul_ps(_mm_shuffle_ps(w, w, 0xff),
-                                                         _mm_loadu_ps(row + 12)));
+                    plane = _mm_add_ps(plane,
+                                       _mm_mul_ps(_mm_shuffle_ps(w, w, 0x00), _mm_loadu_ps(row)));
+                    plane = _mm_add_ps(
+                        plane, _mm_mul_ps(_mm_shuffle_ps(w, w, 0x55), _mm_loadu_ps(row + 4)));
+                    plane = _mm_add_ps(
+                        plane, _mm_mul_ps(_mm_shuffle_ps(w, w, 0xaa), _mm_loadu_ps(row + 8)));
+                    plane = _mm_add_ps(
+                        plane, _mm_mul_ps(_mm_shuffle_ps(w, w, 0xff), _mm_loadu_ps(row + 12)));
                 } else {
                     plane = _mm_add_ps(plane, _mm_mul_ps(w, _mm_loadu_ps(row)));
                 }

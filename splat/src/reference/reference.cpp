@@ -24,14 +24,15 @@
 //
 //  - dvr: optical depth tau(t) by Simpson/quadratic interpolation of rho at every sample,
 //    I = int e exp(-tau) by Simpson. Early termination: a ray stops once
-//    T < 0.01 * min(tolerance, 1e-4) / B. What follows the stop is rest = int e exp(-tau) <= B (T - T_end)
-//    per colour channel, where B >= e / rho everywhere (pre-classified: the largest voxel
-//    ratio e_i / rho_i, which bounds e(x) / rho(x) because h >= 0 makes it a weighted mean of
-//    them, label colours included; post-classified unshaded: the largest colour of the
-//    transfer function) and B >= 1 and >= |background|; the stop composites the background
-//    with T instead of rest + T_end * background, so it moves each channel by at most
-//    B (T - T_end) < B T <= 0.01 * tolerance (alpha: (1 - bg.a)(T - T_end) likewise). Without
-//    such a bound (shaded post-classified, emission without extinction) the ray stops at
+//    T < 0.01 * min(tolerance, 1e-4) / B. What follows the stop is
+//    rest = int e exp(-tau) <= B (T - T_end) per colour channel, where B >= e / rho
+//    everywhere (pre-classified: the largest voxel ratio e_i / rho_i, which bounds
+//    e(x) / rho(x) because h >= 0 makes it a weighted mean of them, label colours included;
+//    post-classified unshaded: the largest colour of the transfer function) and B >= 1 and
+//    >= |background|; the stop composites the background with T instead of
+//    rest + T_end * background, so it moves each channel by at most B (T - T_end) < B T <=
+//    0.01 * tolerance (alpha: (1 - bg.a)(T - T_end) likewise). Without such a bound (shaded
+//    post-classified, emission without extinction) the ray stops at
 //    T < min(tolerance, 1e-3) * 1e-3 as before. Tested in tests/test_reference.cpp.
 //  - xray: int f dt (world units). mip: max of the samples, polished by a golden-section
 //    search around the largest one (0 when the ray meets nothing).
