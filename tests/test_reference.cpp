@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "footprint/footprint_table.h"
+#include "reference/reference_frame.h"
 #include "reference_util.h"
 #include "splat/error.h"
 #include "splat/synthetic.h"
@@ -364,4 +365,86 @@ TEST_CASE("reference: perspective camera and empty volumes", "[reference]") {
     RenderSettings bad = s;
     bad.quality.referenceStep = 0;
     CHECK_THROWS_AS(renderReference(v, none, kernel, cam, bad), Error);
+}
+
+namespace {
+
+// The reference image of `v` under `s` from a field with the given accelerations.
+Image referenceWith(const Volume& v, const RenderSettings& s, ReferenceAcceleration acc) {
+    const footprint::Kernel kernel = kernelOf(s);
+    const SplatList splats = classify(v, s.transfer, s.mode, s.classification, kernel.radius());
+    const ReferenceField field(v, splats, kernel, fieldLayout(s, splats), acc);
+    return renderReference(v, field, Camera(s.camera, v), s, nullptr, nullptr);
+}
+
+double maxAbsDiff(const Image& a, const Image& b) {
+    double m = 0;
+    for (std::size_t n = 0; n < a.pixels.size(); ++n)
+        for (int c = 0; c < 4; ++c)
+            m = std::max(m, double(std::abs(a.pixels[n][c] - b.pixels[n][c])));
+    return m;
+}
+
+}  // namespace
+
+TEST_CASE("reference: the separable Gaussian path equals the kernel table's to 2e-6",
+          "[reference]") {
+    // Random values, background -1000 (the grid holds d - b): every point of a ray's path,
+    // near the faces (plain fallback) and inside, for R = 2 (W = 4) and R = 2.5 (W = 6).
+    for (const double radius : {2.0, 2.5, 1.0}) {
+        Volume v = makeVolume({12, 11, 13}, {1.0, 1.0, 1.0}, "random");
+        v.background = -1000.0f;
+        std::uint32_t seed = 12345;
+        auto rnd = [&] {
+            seed = seed * 1664525u + 1013904223u;
+            return double(seed >> 8) / double(1u << 24);
+        };
+        for (float& d : v.data) d = float(-1000.0 + 2000.0 * rnd());
+        SplatList splats = splatsByHand(v);
+        splats.background = v.background;
+        for (float& d : splats.density) d -= v.background;
+        const footprint::Kernel kernel = footprint::Kernel::gaussian(0.65, radius);
+        const ReferenceField fast(v, splats, kernel, FieldLayout::Density);
+        const ReferenceField plain(v, splats, kernel, FieldLayout::Density, {false, false});
+        REQUIRE(fast.grid1().gauss != nullptr);
+        REQUIRE(plain.grid1().gauss == nullptr);
+        double maxDiff = 0;
+        for (int n = 0; n < 20000; ++n) {
+            const glm::dvec3 p(-2.5 + 16.0 * rnd(), -2.5 + 15.0 * rnd(), -2.5 + 17.0 * rnd());
+            double a, b;
+            fast.grid1().eval(p, &a);
+            plain.grid1().eval(p, &b);
+            maxDiff = std::max(maxDiff, std::abs(a - b));
+        }
+        INFO("R = " << radius << ": max |separable - table| = " << maxDiff);
+        CHECK(maxDiff <= 2e-6 * 2000.0);  // 2e-6 of the largest |d - b|
+    }
+}
+
+TEST_CASE("reference: fast paths give the plain path's image within the tolerance (CT in HU)",
+          "[reference]") {
+    // ct-phantom: Hounsfield units, background -1000 (air), ct-hu: the skull opaque, so rays
+    // terminate early; pre- and post-classified, two views.
+    const Volume v = makeSynthetic("ct-phantom", 48);
+    REQUIRE(v.background == -1000.0f);
+    for (const Classification cls : {Classification::Pre, Classification::Post})
+        for (const double az : {30.0, 45.0}) {
+            RenderSettings s = settingsFor(RenderMode::Dvr, 48, az, 15.0);
+            s.classification = cls;
+            s.transfer = TransferFunction::preset("ct-hu");
+            s.background = glm::vec4(0.2f, 0.3f, 0.4f, 1.0f);
+            const double tol = s.quality.referenceTolerance;
+            const Image plain = referenceWith(v, s, {false, false});
+            const Image kernelOnly = referenceWith(v, s, {true, false});
+            const Image termOnly = referenceWith(v, s, {false, true});
+            const Image fast = referenceWith(v, s, {true, true});
+            double maxAlpha = 0;
+            for (const auto& p : plain.pixels) maxAlpha = std::max(maxAlpha, double(p.a));
+            INFO("classification " << int(cls) << ", azimuth " << az);
+            REQUIRE(maxAlpha > 0.999);  // some rays are opaque: termination is exercised
+            CHECK(maxAbsDiff(kernelOnly, plain) <= 0.1 * tol);
+            CHECK(maxAbsDiff(termOnly, plain) <= 0.2 * tol);
+            CHECK(maxAbsDiff(fast, plain) <= 0.2 * tol);
+            CHECK(compareImages(fast, plain).rmse <= 0.02 * tol);
+        }
 }

@@ -6,11 +6,13 @@
 // Acceleration (exact, no change of the model):
 //  - the splat list is scattered into a dense per-voxel grid (absent splats are 0), so a
 //    field sample visits only the (2R + 1)^3 lattice points around it;
-//  - a brick grid (8^3 voxels) marks bricks whose points lie within R of a non-zero voxel;
+//  - a brick grid (4^3 voxels) marks bricks whose points lie within R of a non-zero voxel;
 //    each ray is clipped to the volume bounds padded by R and cut into the segments that
 //    cross marked bricks (3D DDA); the fields are exactly 0 elsewhere;
 //  - h is tabulated in u^2 (65536 entries, linear interpolation; its error is far below
-//    1e-6 of the peak, see tests/test_reference.cpp).
+//    1e-6 of the peak, see tests/test_reference.cpp); the default tapered Gaussian is
+//    evaluated separably, four lattice points a vector (field.h, SeparableGaussian);
+//  - dvr rays stop where what follows cannot move the pixel by 1% of the tolerance (below).
 //
 // Error control, per ray (each pixel is computed independently, so the image does not
 // depend on the thread count): each segment is integrated with composite Simpson at sample
@@ -21,8 +23,17 @@
 // stats->referenceStep is the finest spacing any ray needed.
 //
 //  - dvr: optical depth tau(t) by Simpson/quadratic interpolation of rho at every sample,
-//    I = int e exp(-tau) by Simpson; a ray stops once T < min(tolerance, 1e-3) * 1e-3 (what follows
-//    can change the pixel by at most that much, colours being <= 1).
+//    I = int e exp(-tau) by Simpson. Early termination: a ray stops once
+//    T < 0.01 * min(tolerance, 1e-4) / B. What follows the stop is
+//    rest = int e exp(-tau) <= B (T - T_end) per colour channel, where B >= e / rho
+//    everywhere (pre-classified: the largest voxel ratio e_i / rho_i, which bounds
+//    e(x) / rho(x) because h >= 0 makes it a weighted mean of them, label colours included;
+//    post-classified unshaded: the largest colour of the transfer function) and B >= 1 and
+//    >= |background|; the stop composites the background with T instead of
+//    rest + T_end * background, so it moves each channel by at most B (T - T_end) < B T <=
+//    0.01 * tolerance (alpha: (1 - bg.a)(T - T_end) likewise). Without such a bound (shaded
+//    post-classified, emission without extinction) the ray stops at
+//    T < min(tolerance, 1e-3) * 1e-3 as before. Tested in tests/test_reference.cpp.
 //  - xray: int f dt (world units). mip: max of the samples, polished by a golden-section
 //    search around the largest one (0 when the ray meets nothing).
 //  - iso: first sample pair bracketing f = level, refined by bisection to 1e-9 voxels,
@@ -94,6 +105,7 @@ class Caster {
     void setLabels(const LabelLookup* labels) { labels_ = labels; }
 
     Image render(RenderStats* stats, Image* depth) {
+        cutoff_ = terminationCutoff();
         const int w = camera_.width(), h = camera_.height();
         Image image(w, h);
         if (depth) *depth = Image(w, h);
@@ -129,6 +141,30 @@ class Caster {
     }
 
   private:
+    // The transmittance below which a dvr ray stops (see "Early termination" above).
+    double terminationCutoff() const {
+        const double tol = settings_.quality.referenceTolerance;
+        const double plain = std::min(tol, 1e-3) * 1e-3;
+        if (!field_.acceleration().toleranceTermination) return plain;
+        double bound = 1.0;  // B: colours of what follows, relative to its extinction
+        if (layout_ == FieldLayout::Emission) {
+            bound = std::max(bound, field_.emissionRatioBound());
+            if (labels_)
+                for (const glm::vec4& c : *labels_->table)
+                    bound = std::max({bound, double(c.r), double(c.g), double(c.b)});
+        } else if (shadePost_) {
+            return plain;
+        } else {
+            for (const TransferPoint& p : settings_.transfer.points)
+                bound = std::max({bound, double(p.rgba.r), double(p.rgba.g), double(p.rgba.b)});
+        }
+        const glm::vec4 bg = settings_.background;
+        bound = std::max({bound, std::abs(double(bg.r)), std::abs(double(bg.g)),
+                          std::abs(double(bg.b)), std::abs(1.0 - double(bg.a))});
+        if (!std::isfinite(bound)) return plain;
+        return std::max(plain, 0.01 * std::min(tol, 1e-4) / bound);
+    }
+
     // Converts a grid sample into the quantities integrated: dvr -> (rho, e rgb), else f.
     template <int C>
     void sampleAt(const FieldGrid<C>& g, const glm::dvec3& p0, const glm::dvec3& v, double t,
@@ -246,7 +282,7 @@ class Caster {
     glm::dvec4 integrate(const FieldGrid<C>& g, RayScratch<C>& sc, const glm::dvec3& p0,
                          const glm::dvec3& v, int level, double& depth) const {
         const RenderMode mode = settings_.mode;
-        const double cutoff = std::min(settings_.quality.referenceTolerance, 1e-3) * 1e-3;
+        const double cutoff = cutoff_;
         double tau = 0, xray = 0, mip = 0;
         glm::dvec3 emission(0.0);
         double T = 1.0;
@@ -433,6 +469,7 @@ class Caster {
     LightFrame light_;
     float invGradientScale_ = 0;
     const LabelLookup* labels_ = nullptr;
+    double cutoff_ = 0;  ///< dvr early termination: T below which a ray stops
 };
 
 }  // namespace

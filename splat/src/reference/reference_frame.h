@@ -2,6 +2,7 @@
 // The reference ray caster as a frame stage: it reads a Scene's prebuilt field.
 #include "reference/field.h"
 #include "splat/camera.h"
+#include "splat/image.h"
 #include "splat/settings.h"
 
 namespace splat {
