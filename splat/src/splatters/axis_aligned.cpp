@@ -49,16 +49,16 @@ int splatFootprintLanes(SheetBuffer<NCh>& sheet, const float (&values)[NCh], flo
         const float gyy = e.gamma * dy * dy, shift = e.beta * dy;
         const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(shift);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
-        const __m256 firstX = _mm256_set1_ps(float(x0) - 0.5f);
-        for (int x = x0 & ~7; x <= x1; x += 8) {
+        // Lanes start at the box's first pixel, not at an 8-aligned one: a box up to 8
+        // pixels wide is one group per row wherever it lies (the lanes past x1 add zero to
+        // the row's padding or to the next row; SheetBuffer pads the last row's end).
+        for (int x = x0; x <= x1; x += 8) {
             const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
             const __m256 q =
                 _mm256_add_ps(_mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx)), vshift);
             const __m256 r2 = _mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy);
-            const __m256 inside =
-                _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
-                              _mm256_and_ps(_mm256_cmp_ps(px, lastX, _CMP_LT_OQ),
-                                            _mm256_cmp_ps(px, firstX, _CMP_GT_OQ)));
+            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
+                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
             const __m256 fp = footprintOf(_mm256_max_ps(r2, zero));
             const __m256 w = _mm256_and_ps(inside, _mm256_mul_ps(fp, vScale));
             for (int c = 0; c < NCh; ++c) {
