@@ -58,7 +58,7 @@ bool Occlusion::visible(const PixelRect& r) const {
 
 std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
                      const std::vector<std::uint32_t>& runs, const TileGrid& grid,
-                     const Occlusion& occlusion, ChunkBins& out) {
+                     const Occlusion& occlusion, const SplatRecordFields& fields, ChunkBins& out) {
     const bool cull = occlusion.enabled();
     const std::size_t n = runs.empty() ? 0 : runs.back(), tileCount = std::size_t(grid.count());
     const std::size_t runCount = runs.empty() ? 0 : runs.size() - 1;
@@ -144,7 +144,10 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
         for (std::size_t q = partStart(c); q < e; ++q) {
             const std::uint32_t bits = out.visible[q];
             if (bits == 0) continue;
-            const SplatRecord rec{order[q], std::uint32_t(q), out.sx[q], out.sy[q]};
+            const std::uint32_t id = order[q];
+            const SplatRecord rec{id, std::uint32_t(q), out.sx[q], out.sy[q],
+                                  fields.slice ? fields.slice[id] : std::uint16_t(0),
+                                  fields.value ? fields.value[id] : std::uint16_t(0)};
             forTilesOf(out.rect[q], grid, [&](int tx, int ty, int k) {
                 if (bits >> std::min(k, kMaskTiles) & 1)
                     out.records[next[ty * grid.tilesX + tx]++] = rec;
