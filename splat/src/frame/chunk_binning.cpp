@@ -14,6 +14,8 @@ constexpr std::size_t kParts = 32;
 // A splat records whether it is visible in each of the first kMaskTiles tiles of its box;
 // boxes over more tiles (huge footprints) are binned to all of them unculled.
 constexpr int kMaskTiles = 16;
+// Runs (pass 1) and positions (pass 2) ahead whose splat data binning prefetches.
+constexpr std::size_t kAhead = 8, kAheadPositions = 32;
 
 /// Calls f(tx, ty, k) for the tiles the box touches, k counting them from 0 (row-major).
 template <class F>
@@ -81,6 +83,7 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
         std::size_t h = 0;
         for (std::size_t run = std::min(runCount, c * runsPerPart); run < re; ++run) {
             const std::size_t a = runs[run], b = runs[run + 1];
+            if (run + kAhead < re) projector.prefetch(order[runs[run + kAhead]]);
             // Orthographic: the run's positions are affine along its row.
             const SplatProjector::Row row =
                 ortho ? projector.row(order[a]) : SplatProjector::Row{0, 0, 0, 0};
@@ -142,6 +145,11 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
         std::uint32_t* next = &out.counts[c * tileCount];
         const std::size_t e = partStart(c + 1);
         for (std::size_t q = partStart(c); q < e; ++q) {
+            if (q + kAheadPositions < e) {
+                const std::uint32_t ahead = order[q + kAheadPositions];
+                if (fields.slice) __builtin_prefetch(&fields.slice[ahead]);
+                if (fields.value) __builtin_prefetch(&fields.value[ahead]);
+            }
             const std::uint32_t bits = out.visible[q];
             if (bits == 0) continue;
             const std::uint32_t id = order[q];
