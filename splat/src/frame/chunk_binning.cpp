@@ -14,6 +14,8 @@ constexpr std::size_t kParts = 32;
 // A splat records whether it is visible in each of the first kMaskTiles tiles of its box;
 // boxes over more tiles (huge footprints) are binned to all of them unculled.
 constexpr int kMaskTiles = 16;
+// Runs (pass 1) and positions (pass 2) ahead whose splat data binning prefetches.
+constexpr std::size_t kAhead = 8, kAheadPositions = 32;
 
 /// Calls f(tx, ty, k) for the tiles the box touches, k counting them from 0 (row-major).
 template <class F>
@@ -58,7 +60,7 @@ bool Occlusion::visible(const PixelRect& r) const {
 
 std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
                      const std::vector<std::uint32_t>& runs, const TileGrid& grid,
-                     const Occlusion& occlusion, ChunkBins& out) {
+                     const Occlusion& occlusion, const SplatRecordFields& fields, ChunkBins& out) {
     const bool cull = occlusion.enabled();
     const std::size_t n = runs.empty() ? 0 : runs.back(), tileCount = std::size_t(grid.count());
     const std::size_t runCount = runs.empty() ? 0 : runs.size() - 1;
@@ -81,6 +83,7 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
         std::size_t h = 0;
         for (std::size_t run = std::min(runCount, c * runsPerPart); run < re; ++run) {
             const std::size_t a = runs[run], b = runs[run + 1];
+            if (run + kAhead < re) projector.prefetch(order[runs[run + kAhead]]);
             // Orthographic: the run's positions are affine along its row.
             const SplatProjector::Row row =
                 ortho ? projector.row(order[a]) : SplatProjector::Row{0, 0, 0, 0};
@@ -142,9 +145,17 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
         std::uint32_t* next = &out.counts[c * tileCount];
         const std::size_t e = partStart(c + 1);
         for (std::size_t q = partStart(c); q < e; ++q) {
+            if (q + kAheadPositions < e) {
+                const std::uint32_t ahead = order[q + kAheadPositions];
+                if (fields.slice) __builtin_prefetch(&fields.slice[ahead]);
+                if (fields.value) __builtin_prefetch(&fields.value[ahead]);
+            }
             const std::uint32_t bits = out.visible[q];
             if (bits == 0) continue;
-            const SplatRecord rec{order[q], std::uint32_t(q), out.sx[q], out.sy[q]};
+            const std::uint32_t id = order[q];
+            const SplatRecord rec{id, std::uint32_t(q), out.sx[q], out.sy[q],
+                                  fields.slice ? fields.slice[id] : std::uint16_t(0),
+                                  fields.value ? fields.value[id] : std::uint16_t(0)};
             forTilesOf(out.rect[q], grid, [&](int tx, int ty, int k) {
                 if (bits >> std::min(k, kMaskTiles) & 1)
                     out.records[next[ty * grid.tilesX + tx]++] = rec;

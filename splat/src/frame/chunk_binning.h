@@ -70,11 +70,21 @@ class BrickTest {
     const Occlusion& occlusion_;
 };
 
-/// One entry of a tile's list: the splat, its position in the chunk and its screen centre
-/// (written by binning, so that the tile sweep streams through its records).
+/// One entry of a tile's list: the splat, its position in the chunk, its screen centre, its
+/// slice along the sheet axis and its palette entry (written by binning, so that the tile
+/// sweep and its sort by sheet stream through the records instead of reading the per-splat
+/// arrays by id; 20 bytes).
 struct SplatRecord {
     std::uint32_t id, local;
     float sx, sy;
+    std::uint16_t slice;  ///< SplatRecordFields::slice[id] (0 without)
+    std::uint16_t value;  ///< SplatRecordFields::value[id] (0 without)
+};
+
+/// The per-splat arrays binChunk copies into each record (either may be null).
+struct SplatRecordFields {
+    const std::uint16_t* slice = nullptr;  ///< slice index along the sheet axis
+    const std::uint16_t* value = nullptr;  ///< palette index (SplatList::emissionIndex)
 };
 
 /// Splat indices in visiting order: base[o] (base null: o), read from the end when reversed.
@@ -122,6 +132,6 @@ struct ChunkBins {
 /// Returns the splats left out of every tile they touch.
 std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
                      const std::vector<std::uint32_t>& runs, const TileGrid& grid,
-                     const Occlusion& occlusion, ChunkBins& out);
+                     const Occlusion& occlusion, const SplatRecordFields& fields, ChunkBins& out);
 
 }  // namespace splat

@@ -115,6 +115,31 @@ inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Polic
     }
 }
 
+/// splatValues for a tile's record: a chunk's records carry the palette index, read there
+/// instead of from the splat list by id.
+template <class Policy, class Record>
+inline void recordValues(const TileInputs& in, const Record& rec, float (&v)[Policy::kChannels]) {
+    if constexpr (std::is_same_v<Record, SplatRecord>) {
+        const SplatList& s = in.scene.splats;
+        if constexpr (Policy::kSource == SheetSource::Emission) {
+            if (s.paletted() && !in.er) {
+                const glm::vec4& e = s.palette[rec.value];
+                v[0] = e.x;
+                v[1] = e.y;
+                v[2] = e.z;
+                v[3] = e.w;
+                return;
+            }
+        } else if constexpr (Policy::kSource == SheetSource::Density) {
+            if (s.paletted()) {
+                v[0] = s.paletteDensity[rec.value];
+                return;
+            }
+        }
+    }
+    splatValues<Policy>(in, rec.id, v);
+}
+
 /// A tile's records as the whole-frame stages made them (projectSplats, binToTiles).
 struct BinnedSplats {
     const TileInputs& in;
@@ -176,7 +201,7 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
             const std::uint32_t n = cutter.span(rec);
             for (std::uint32_t j = 0; j < n; ++j) target[j] = sheets[(step + j) % ring];
             float v[NCh];
-            splatValues<Policy>(in, rec.id, v);
+            recordValues<Policy>(in, rec, v);
             cnt.footprintPixels += cutter.cut(target, rec, v, src.ellipse(rec), r);
             pendingEnd = std::max(pendingEnd, step + n - 1);
             pending = true;
@@ -335,13 +360,16 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
     double binMs = 0, tilesMs = 0;
     std::size_t hidden = 0;
     tbb::enumerable_thread_specific<std::vector<SplatRecord>> sortScratch;
+    const SplatList& splats = in.scene.splats;
+    const SplatRecordFields fields{cutter.sliceIndex(),
+                                   splats.paletted() ? splats.emissionIndex.data() : nullptr};
     FrameProgress progress(in.settings.progress, sc.count, "chunks");
     for (std::size_t c = 0; c < sc.count; ++c) {
         const auto t0 = Clock::now();
         const Occlusion occlusion(g, tiles, cull);
         hidden += sc.gather(c, bins.ids, bins.runs, BrickTest(projector, occlusion));
         hidden += binChunk(projector, VisitOrder{&bins.ids, bins.ids.size(), false}, bins.runs, g,
-                           occlusion, bins);
+                           occlusion, fields, bins);
         const auto t1 = Clock::now();
         tbb::parallel_for(0, g.count(), 1, [&](int t) {
             if (bins.begin[t] == bins.begin[t + 1] || progress.stopped()) return;

@@ -43,28 +43,31 @@ int splatFootprintLanes(SheetBuffer<NCh>& sheet, const float (&values)[NCh], flo
     const footprint::FootprintLanes footprintOf(table, poly);
     __m256 vv[NCh];
     for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+    // Row pointers from plain locals: the stores could alias the sheet's members, which the
+    // compiler would otherwise reload after every store.
+    const std::ptrdiff_t plane = NCh > 1 ? sheet.row(1, 0) - sheet.row(0, 0) : 0;
     for (int y = y0; y <= y1; ++y) {
+        float* const base = sheet.row(0, y);
         const float dy = float(y + oy) + 0.5f - sy;
         // r^2 = a (dx + beta dy)^2 + gamma dy^2 (EllipticalFootprint::r2).
         const float gyy = e.gamma * dy * dy, shift = e.beta * dy;
         const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(shift);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
-        const __m256 firstX = _mm256_set1_ps(float(x0) - 0.5f);
-        for (int x = x0 & ~7; x <= x1; x += 8) {
+        // Lanes start at the box's first pixel, not at an 8-aligned one: a box up to 8
+        // pixels wide is one group per row wherever it lies (the lanes past x1 add zero to
+        // the row's padding or to the next row; SheetBuffer pads the last row's end).
+        for (int x = x0; x <= x1; x += 8) {
             const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
             const __m256 q =
                 _mm256_add_ps(_mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx)), vshift);
             const __m256 r2 = _mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy);
-            const __m256 inside =
-                _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
-                              _mm256_and_ps(_mm256_cmp_ps(px, lastX, _CMP_LT_OQ),
-                                            _mm256_cmp_ps(px, firstX, _CMP_GT_OQ)));
+            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
+                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
             const __m256 fp = footprintOf(_mm256_max_ps(r2, zero));
             const __m256 w = _mm256_and_ps(inside, _mm256_mul_ps(fp, vScale));
-            for (int c = 0; c < NCh; ++c) {
-                float* p = sheet.row(c, y) + x;
+            float* p = base + x;
+            for (int c = 0; c < NCh; ++c, p += plane)
                 _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
-            }
         }
     }
     return (x1 - x0 + 1) * (y1 - y0 + 1);
@@ -108,8 +111,10 @@ struct WholeFootprints {
     const footprint::FootprintPoly* poly;
 
     std::uint32_t key(const SplatRecord& s) const {
-        return ascending ? index[s.id] : slices - 1 - index[s.id];
+        return ascending ? s.slice : slices - 1 - s.slice;  // s.slice = index[s.id]
     }
+    /// What binning copies into each record's `slice`.
+    const std::uint16_t* sliceIndex() const { return index.data(); }
     std::uint32_t span(const SplatRecord&) const { return 1; }
     template <int NCh>
     int cut(SheetBuffer<NCh>* const* sheets, const SplatRecord& s, const float (&v)[NCh],
