@@ -21,6 +21,7 @@ struct RenderCommand {
     RenderArgs render;
     std::string output;
     int bricks = 0;
+    double rankMemory = 0;  ///< MiB; 0: the default under mpirun, off otherwise
 };
 }  // namespace
 
@@ -34,7 +35,12 @@ void registerRender(CLI::App& app) {
               "Output", PathKind::Output);
     addOption(*cmd, "--bricks", args->bricks,
               "sort-last: cut the volume into K bricks, each loaded alone, rendered and "
-              "composited (0: off; under mpirun one per process)",
+              "composited (0: off; under mpirun chosen from --rank-memory)",
+              "Output");
+    addOption(*cmd, "--rank-memory", args->rankMemory,
+              "bricks: memory per process in MiB; the fewest bricks, a multiple of the "
+              "processes, whose estimate fits it (default under mpirun: 80% of the physical "
+              "memory / processes on the node)",
               "Output");
     cmd->footer(
         "Examples:\n"
@@ -51,10 +57,13 @@ void registerRender(CLI::App& app) {
         loadOptionsFromArgs(args->volume);  // malformed volume options: usage errors, now
         if (args->bricks < 0 || args->bricks > 4096)
             throw UsageError("--bricks must be between 0 and 4096");
-        if (args->bricks > 0 || processCount() > 1) {  // README "Beyond one machine"
+        if (!(args->rankMemory >= 0 && args->rankMemory <= 1e9))
+            throw UsageError("--rank-memory must be between 0 and 1e9 MiB");
+        // README "Beyond one machine": bricks when asked, or chosen from the budget.
+        if (args->bricks > 0 || args->rankMemory > 0 || processCount() > 1) {
             if (!workerProcess()) beginRun(*cmd);
-            renderBrickedToFile(args->volume, args->render, settings,
-                                args->bricks > 0 ? args->bricks : processCount(), args->output);
+            renderBrickedToFile(args->volume, args->render, settings, args->bricks,
+                                std::uint64_t(args->rankMemory * 1048576.0), args->output);
             if (!workerProcess()) finishRun(*cmd);
             return;
         }
