@@ -33,8 +33,8 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
     if (!workerProcess()) {
         const double mib = 1048576.0;
         std::printf(
-            "bricks: %d (%d per process) for a budget of %.0f MiB per process%s: estimated "
-            "%.0f MiB for the busiest (largest brick %llu samples); the whole volume %s\n",
+            "bricks: %d (%d per process) for a budget of %.1f MiB per process%s: estimated "
+            "%.1f MiB for the busiest (largest brick %llu samples); the whole volume %s\n",
             c.bricks, (c.bricks + ranks - 1) / ranks, double(budget.rankBytes) / mib,
             rankBytes ? " (--rank-memory)" : " (80% of physical memory / processes on the node)",
             double(c.rankBytes) / mib, static_cast<unsigned long long>(c.largestBrick),

@@ -7,6 +7,7 @@
 #include <cstdlib>
 
 #include "splat/bricks.h"
+#include "splat/error.h"
 
 namespace splat {
 
@@ -29,18 +30,29 @@ BrickChoice chooseBricks(const glm::ivec3& dims, const BrickBudget& budget, int 
     BrickChoice c;
     c.wholeFits = brickMemoryEstimate(samples, budget.width, budget.height, 1, budget.splatShare) <=
                   budget.rankBytes;
-    for (int K = std::min(P, cap); K <= cap; K += P) {
-        const BrickLayout layout = splitBricks(dims, K, budget.ghost);
+    // The largest brick of K bricks; 0 when the volume cannot be cut into K (a brick would
+    // be left without samples: a thin volume).
+    auto largestOf = [&](int K) {
         std::uint64_t largest = 0;
-        for (const Brick& b : layout.bricks) largest = std::max<std::uint64_t>(largest, b.loadedSamples());
+        try {
+            for (const Brick& b : splitBricks(dims, K, budget.ghost).bricks)
+                largest = std::max<std::uint64_t>(largest, b.loadedSamples());
+        } catch (const Error&) {
+            return std::uint64_t(0);
+        }
+        return largest;
+    };
+    int K = std::min(P, cap);
+    while (K > 1 && largestOf(K) == 0) --K;  // more ranks than bricks: some stay idle
+    for (;;) {
         const int held = (K + P - 1) / P;
         c.bricks = K;
-        c.largestBrick = largest;
-        c.rankBytes =
-            brickMemoryEstimate(largest, budget.width, budget.height, held, budget.splatShare);
+        c.largestBrick = largestOf(K);
+        c.rankBytes = brickMemoryEstimate(c.largestBrick, budget.width, budget.height, held,
+                                          budget.splatShare);
         c.withinBudget = c.rankBytes <= budget.rankBytes;
-        if (c.withinBudget || c.wholeFits) break;
-        if (K + P > cap) break;
+        if (c.withinBudget || c.wholeFits || K + P > cap || largestOf(K + P) == 0) break;
+        K += P;
     }
     return c;
 }
