@@ -93,6 +93,19 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
         "processes, composite %.1f ms\n",
         output.c_str(), image.width, image.height, toString(settings.renderer),
         toString(settings.mode), st.bricks, group->size(), st.compositeMs);
+    {
+        // splat/brick_budget.h's estimate for the busiest process, beside its peak RSS.
+        std::size_t largest = 0;
+        int held = 0;
+        for (const BrickStats& r : all) {
+            largest = std::max(largest, r.samplesLoaded);
+            held = std::max(held, r.rendered);
+        }
+        std::printf("memory estimate: %.0f MiB for the busiest process (%zu samples, %d images)\n",
+                    double(brickMemoryEstimate(largest, image.width, image.height, held, 0.25)) /
+                        1048576.0,
+                    largest, held);
+    }
     for (std::size_t r = 0; r < all.size(); ++r)
         std::printf(
             "rank %zu: %d bricks, largest %zu samples (%.1f MiB), %zu splats, load %.1f ms, "

@@ -52,9 +52,10 @@ struct BrickLayout {
 /// samples in that ratio. Ghost layers: `ghost` samples on every inner face.
 BrickLayout splitBricks(const glm::ivec3& dims, int count, int ghost);
 
-/// Ghost layers a kernel of support radius `radius` (in units of the smallest spacing)
-/// needs on a grid of `spacing`: every sample whose kernel reaches the owned box, plus one
-/// layer for the central-difference gradients.
+/// Ghost layers a kernel of support radius `radius` (index units) needs on a grid of
+/// `spacing`: every sample whose kernel a sheet pixel of the owned box sees, up to
+/// R sqrt 2 + 1/2 samples beyond a face (the axis-aligned sheets hold whole kernels, cut
+/// along oblique rays), plus one layer for the central-difference gradients: 5 for R = 2.
 int ghostLayers(double radius, const glm::dvec3& spacing);
 
 /// The bricks of `layout` front to back as seen by `camera` of a volume of geometry `whole`
