@@ -12,8 +12,7 @@ namespace {
 constexpr std::uint64_t MiB = 1ull << 20;
 }
 
-TEST_CASE("brick budget: the estimate is samples, splats, images and the process",
-          "[bricks]") {
+TEST_CASE("brick budget: the estimate is samples, splats, images and the process", "[bricks]") {
     // 4 bytes per sample, 26 per splat for a quarter of them, RGBA float images (1 kept + 3
     // for the composite), 150 MiB for the process.
     CHECK(brickMemoryEstimate(1000000, 256, 256, 1, 0.25) ==

@@ -28,9 +28,9 @@ struct Type {
     int nifti;         // NIfTI datatype
     const char* meta;  // MetaImage ElementType
 };
-const Type kTypes[] = {{"uint8", DT_UINT8, "MET_UCHAR"},   {"int8", DT_INT8, "MET_CHAR"},
-                       {"uint16", DT_UINT16, "MET_USHORT"}, {"int16", DT_INT16, "MET_SHORT"},
-                       {"uint32", DT_UINT32, "MET_UINT"},   {"int32", DT_INT32, "MET_INT"},
+const Type kTypes[] = {{"uint8", DT_UINT8, "MET_UCHAR"},     {"int8", DT_INT8, "MET_CHAR"},
+                       {"uint16", DT_UINT16, "MET_USHORT"},  {"int16", DT_INT16, "MET_SHORT"},
+                       {"uint32", DT_UINT32, "MET_UINT"},    {"int32", DT_INT32, "MET_INT"},
                        {"float32", DT_FLOAT32, "MET_FLOAT"}, {"float64", DT_FLOAT64, "MET_DOUBLE"}};
 
 /// Values that exercise the type: its sign, its range, fractions for floats (uint32 and
@@ -44,7 +44,8 @@ std::vector<double> valuesOf(const std::string& type, std::size_t n) {
         if (type == "uint16") v[i] = double((i * 1237) % 65536);
         if (type == "int16") v[i] = double((i * 1237) % 65536) - 32768;
         if (type == "uint32") v[i] = double((std::uint64_t(i) * 2654435761u) % 4294967296u);
-        if (type == "int32") v[i] = double(std::int64_t((i * 2654435761u) % 4294967296u) - 2147483648LL);
+        if (type == "int32")
+            v[i] = double(std::int64_t((i * 2654435761u) % 4294967296u) - 2147483648LL);
         if (type == "float32") v[i] = double(float(s * 1000.25));
         if (type == "float64") v[i] = s * 1e5 + 1.0 / 3.0;
     }
@@ -75,7 +76,8 @@ void put(std::string& s, std::size_t at, T value, bool big) {
 std::string niftiFile(const Type& t, const std::string& data, bool big, float slope, float inter) {
     std::string s(352, '\0');
     put<std::int32_t>(s, offsetof(nifti_1_header, sizeof_hdr), 348, big);
-    const short dim[8] = {3, short(kFileDims.x), short(kFileDims.y), short(kFileDims.z), 1, 1, 1, 1};
+    const short dim[8] = {3, short(kFileDims.x), short(kFileDims.y), short(kFileDims.z), 1, 1, 1,
+                          1};
     for (int d = 0; d < 8; ++d) put<short>(s, offsetof(nifti_1_header, dim) + 2 * d, dim[d], big);
     put<short>(s, offsetof(nifti_1_header, datatype), short(t.nifti), big);
     std::size_t bits = 8;
@@ -83,7 +85,8 @@ std::string niftiFile(const Type& t, const std::string& data, bool big, float sl
         if (std::string(t.name).find(w) != std::string::npos) bits = std::size_t(std::atoi(w));
     put<short>(s, offsetof(nifti_1_header, bitpix), short(bits), big);
     const float pixdim[4] = {1, 1.5f, 2, 1};
-    for (int d = 0; d < 4; ++d) put<float>(s, offsetof(nifti_1_header, pixdim) + 4 * d, pixdim[d], big);
+    for (int d = 0; d < 4; ++d)
+        put<float>(s, offsetof(nifti_1_header, pixdim) + 4 * d, pixdim[d], big);
     put<float>(s, offsetof(nifti_1_header, vox_offset), 352, big);
     put<float>(s, offsetof(nifti_1_header, scl_slope), slope, big);
     put<float>(s, offsetof(nifti_1_header, scl_inter), inter, big);
@@ -101,8 +104,9 @@ std::string niftiFile(const Type& t, const std::string& data, bool big, float sl
 
 std::string nrrdHeader(const Type& t, bool big, const std::string& encoding,
                        const std::string& extra) {
-    return std::string("NRRD0004\ntype: ") + t.name + "\ndimension: 3\nsizes: 7 6 5\nendian: " +
-           (big ? "big" : "little") + "\nencoding: " + encoding +
+    return std::string("NRRD0004\ntype: ") + t.name +
+           "\ndimension: 3\nsizes: 7 6 5\nendian: " + (big ? "big" : "little") +
+           "\nencoding: " + encoding +
            "\nspace: RAS\nspace directions: (0,-1.5,0) (0,0,2) (-1,0,0)\n"
            "space origin: (10,20,30)\n" +
            extra;
@@ -111,8 +115,8 @@ std::string nrrdHeader(const Type& t, bool big, const std::string& encoding,
 std::string metaHeader(const Type& t, bool big, const std::string& extra,
                        const std::string& dataFile) {
     // LPS: index axis 0 along +y_LPS = -y_RAS, axis 1 along +z, axis 2 along +x_LPS = -x_RAS.
-    return std::string("ObjectType = Image\nNDims = 3\nDimSize = 7 6 5\nElementType = ") +
-           t.meta + "\nElementSpacing = 1.5 2 1\nTransformMatrix = 0 1 0 0 0 1 1 0 0\n" +
+    return std::string("ObjectType = Image\nNDims = 3\nDimSize = 7 6 5\nElementType = ") + t.meta +
+           "\nElementSpacing = 1.5 2 1\nTransformMatrix = 0 1 0 0 0 1 1 0 0\n" +
            "Offset = -10 -20 30\nBinaryDataByteOrderMSB = " + (big ? "True" : "False") + "\n" +
            extra + "ElementDataFile = " + dataFile + "\n";
 }
@@ -141,7 +145,8 @@ void checkBricks(const std::string& spec, const LoadOptions& options = {}) {
     CHECK(g.background == whole.background);  // bit for bit: the same median
     CHECK(g.backgroundSource == whole.backgroundSource);
     std::vector<std::pair<glm::ivec3, glm::ivec3>> boxes;
-    for (const Brick& b : splitBricks(whole.dims, 5, 2).bricks) boxes.emplace_back(b.loadLo, b.loadHi);
+    for (const Brick& b : splitBricks(whole.dims, 5, 2).bricks)
+        boxes.emplace_back(b.loadLo, b.loadHi);
     boxes.emplace_back(glm::ivec3(0), whole.dims);
     boxes.emplace_back(glm::ivec3(1, 2, 3), glm::ivec3(2, 3, 4));
     boxes.emplace_back(glm::ivec3(0, 1, 0), whole.dims - glm::ivec3(1, 0, 2));
@@ -214,8 +219,7 @@ TEST_CASE("brick files: NRRD bricks equal the crop of the whole volume", "[brick
                nrrdHeader(t, true, "raw", "line skip: 2\nbyte skip: 3\ndata file: skip.raw\n"));
     checkBricks((dir / "skip.nhdr").string());
     writeBytes(dir / "end.raw", std::string(11, 'x') + data);
-    writeBytes(dir / "end.nhdr",
-               nrrdHeader(t, true, "raw", "byte skip: -1\ndata file: end.raw\n"));
+    writeBytes(dir / "end.nhdr", nrrdHeader(t, true, "raw", "byte skip: -1\ndata file: end.raw\n"));
     checkBricks((dir / "end.nhdr").string());
     // gzip (attached, and detached with a byte skip in the decompressed stream) and bzip2.
     writeBytes(dir / "gz.nrrd", nrrdHeader(t, true, "gzip", "") + "\n" + deflateBytes(data, true));
@@ -239,8 +243,8 @@ TEST_CASE("brick files: NRRD bricks equal the crop of the whole volume", "[brick
     bool alone = true;
     const Volume g = volumeGeometry((dir / "text.nrrd").string(), {}, &alone);
     CHECK_FALSE(alone);
-    CHECK(loadVolumeBrick((dir / "text.nrrd").string(), {}, glm::ivec3(1), glm::ivec3(3)).at(0, 0, 0) ==
-          loadVolume((dir / "text.nrrd").string()).at(1, 1, 1));
+    CHECK(loadVolumeBrick((dir / "text.nrrd").string(), {}, glm::ivec3(1), glm::ivec3(3))
+              .at(0, 0, 0) == loadVolume((dir / "text.nrrd").string()).at(1, 1, 1));
 }
 
 TEST_CASE("brick files: MetaImage and raw bricks equal the crop of the whole volume",
@@ -261,11 +265,12 @@ TEST_CASE("brick files: MetaImage and raw bricks equal the crop of the whole vol
     writeBytes(dir / "end.mhd", metaHeader(t, true, "HeaderSize = -1\n", "sep.bin"));
     checkBricks((dir / "end.mhd").string());
     const std::string z = deflateBytes(data, false);
-    writeBytes(dir / "z.mha", metaHeader(t, true,
-                                         "CompressedData = True\nCompressedDataSize = " +
-                                             std::to_string(z.size()) + "\n",
-                                         "LOCAL") +
-                                  z);
+    writeBytes(
+        dir / "z.mha",
+        metaHeader(t, true,
+                   "CompressedData = True\nCompressedDataSize = " + std::to_string(z.size()) + "\n",
+                   "LOCAL") +
+            z);
     checkBricks((dir / "z.mha").string());
     // .raw and .raw.gz: dims and type from the name, big-endian from the options.
     LoadOptions o;
@@ -320,7 +325,8 @@ TEST_CASE("brick files: truncated files fail with the loader's message", "[brick
                Catch::Contains("truncated data: the brick of samples"));
     CHECK_NOTHROW(volumeGeometry(spec, {}, &alone, false));
     // Compressed: the stream ends early, or holds more than the header says.
-    writeBytes(dir / "cut_gz.nrrd", nrrdHeader(t, false, "gzip", "") + "\n" + deflateBytes(cut, true));
+    writeBytes(dir / "cut_gz.nrrd",
+               nrrdHeader(t, false, "gzip", "") + "\n" + deflateBytes(cut, true));
     CHECK_THAT(errorOf([&] { volumeGeometry((dir / "cut_gz.nrrd").string(), {}, &alone); }),
                Catch::Contains("truncated data"));
     writeBytes(dir / "long_gz.nrrd",
@@ -328,7 +334,8 @@ TEST_CASE("brick files: truncated files fail with the loader's message", "[brick
     CHECK_THAT(errorOf([&] { volumeGeometry((dir / "long_gz.nrrd").string(), {}, &alone); }),
                Catch::Contains("holds more data than the header declares"));
     const std::string z = deflateBytes(data, true);
-    writeBytes(dir / "broken_gz.nrrd", nrrdHeader(t, false, "gzip", "") + "\n" + z.substr(0, z.size() / 2));
+    writeBytes(dir / "broken_gz.nrrd",
+               nrrdHeader(t, false, "gzip", "") + "\n" + z.substr(0, z.size() / 2));
     CHECK_THAT(errorOf([&] {
                    loadVolumeBrick((dir / "broken_gz.nrrd").string(), {}, glm::ivec3(0),
                                    glm::ivec3(5, 7, 6));

@@ -17,7 +17,8 @@ Volume anisotropicBlob() {
     for (int k = 0; k < 18; ++k)
         for (int j = 0; j < 20; ++j)
             for (int i = 0; i < 24; ++i) {
-                const double r2 = (i - 11.5) * (i - 11.5) + (j - 9.5) * (j - 9.5) + (k - 8.5) * (k - 8.5);
+                const double r2 =
+                    (i - 11.5) * (i - 11.5) + (j - 9.5) * (j - 9.5) + (k - 8.5) * (k - 8.5);
                 v.at(i, j, k) = float(std::exp(-r2 / 32.0));
             }
     return v;
@@ -70,10 +71,10 @@ TEST_CASE("bricks: the axis splatter's seams on an anisotropic grid are within 1
             for (int bricks : {2, 5}) {
                 LocalBrickGroup group;
                 const Image b = renderBricked(
-                    geometry, [&](const Brick& br) { return cropBox(v, br.loadLo, br.loadHi); },
-                    s, bricks, group);
-                INFO(toString(mode) << " azimuth " << az << " elevation " << el << ", " << bricks
-                                    << " bricks");
+                    geometry, [&](const Brick& br) { return cropBox(v, br.loadLo, br.loadHi); }, s,
+                    bricks, group);
+                INFO(toString(mode)
+                     << " azimuth " << az << " elevation " << el << ", " << bricks << " bricks");
                 CHECK(maxAbs(whole, b) <= 1e-5f * peak);
             }
         }

@@ -63,16 +63,16 @@ TEST_CASE("mpi: bricks read from NRRD files, K chosen from --rank-memory", "[.mp
         "space: RAS\nspace directions: (0,-1.5,0) (0,0,2) (-1,0,0)\n";
     {
         std::ofstream(dir / "raw.nrrd", std::ios::binary) << header << "encoding: raw\n\n" << data;
-        std::ofstream(dir / "gz.nrrd", std::ios::binary)
-            << header << "encoding: gzip\n\n" << deflateBytes(data, true);
+        std::ofstream(dir / "gz.nrrd", std::ios::binary) << header << "encoding: gzip\n\n"
+                                                         << deflateBytes(data, true);
     }
     for (const std::string file : {"raw.nrrd", "gz.nrrd"}) {
         const std::string spec = (dir / file).string();
         auto args = [&](const std::string& out, const std::string& budget) {
-            std::vector<std::string> a = {"render",  spec,    "--renderer", "reference",
-                                          "--size",  "32x28", "--azimuth",  "35",
-                                          "--elevation", "20", "--ref-tolerance", "1e-7",
-                                          "-o",      (dir / out).string()};
+            std::vector<std::string> a = {
+                "render",          spec,        "--renderer", "reference",         "--size",
+                "32x28",           "--azimuth", "35",         "--elevation",       "20",
+                "--ref-tolerance", "1e-7",      "-o",         (dir / out).string()};
             if (!budget.empty()) a.insert(a.end(), {"--rank-memory", budget});
             return a;
         };
@@ -91,7 +91,8 @@ TEST_CASE("mpi: bricks read from NRRD files, K chosen from --rank-memory", "[.mp
             b.ranks = n;
             b.width = 32;
             b.height = 28;
-            b.ghost = ghostLayers(footprint::Kernel::fromName("gaussian").radius(), glm::dvec3(1, 1.5, 2));
+            b.ghost = ghostLayers(footprint::Kernel::fromName("gaussian").radius(),
+                                  glm::dvec3(1, 1.5, 2));
             const BrickChoice c = chooseBricks(glm::ivec3(29, 29, 29), b);
             CHECK(c.bricks % n == 0);
             if (n == 2) CHECK(c.bricks > n);  // the whole volume and 2 bricks exceed it

@@ -5,10 +5,10 @@
 #include <filesystem>
 
 #include "diagnostics.h"
+#include "footprint/kernel.h"
 #include "parallel.h"
 #include "scene_file.h"
 #include "splat/atomic_file.h"
-#include "footprint/kernel.h"
 #include "splat/brick_budget.h"
 #include "splat/bricks.h"
 #include "splat/error.h"
@@ -101,10 +101,10 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
             largest = std::max(largest, r.samplesLoaded);
             held = std::max(held, r.rendered);
         }
-        std::printf("memory estimate: %.0f MiB for the busiest process (%zu samples, %d images)\n",
-                    double(brickMemoryEstimate(largest, image.width, image.height, held, 0.25)) /
-                        1048576.0,
-                    largest, held);
+        std::printf(
+            "memory estimate: %.0f MiB for the busiest process (%zu samples, %d images)\n",
+            double(brickMemoryEstimate(largest, image.width, image.height, held, 0.25)) / 1048576.0,
+            largest, held);
     }
     for (std::size_t r = 0; r < all.size(); ++r)
         std::printf(

@@ -33,11 +33,11 @@ std::uint64_t brickMemoryEstimate(std::uint64_t samples, int width, int height, 
 constexpr std::uint64_t kProcessBytes = 150ull << 20;
 
 struct BrickChoice {
-    int bricks = 1;                 ///< K: a multiple of the ranks
-    bool wholeFits = false;         ///< the whole volume fits one process's budget
-    bool withinBudget = false;      ///< the busiest process of K bricks fits the budget
-    std::uint64_t rankBytes = 0;    ///< the estimate for the busiest process with K bricks
-    std::uint64_t largestBrick = 0; ///< its largest brick, samples
+    int bricks = 1;                  ///< K: a multiple of the ranks
+    bool wholeFits = false;          ///< the whole volume fits one process's budget
+    bool withinBudget = false;       ///< the busiest process of K bricks fits the budget
+    std::uint64_t rankBytes = 0;     ///< the estimate for the busiest process with K bricks
+    std::uint64_t largestBrick = 0;  ///< its largest brick, samples
 };
 
 /// The fewest bricks K, a multiple of budget.ranks (each rank gets K / ranks bricks, rendered

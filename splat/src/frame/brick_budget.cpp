@@ -18,7 +18,8 @@ std::uint64_t brickMemoryEstimate(std::uint64_t samples, int width, int height, 
     const std::uint64_t image = std::uint64_t(width) * std::uint64_t(height) * 16;  // RGBA float
     // Partial images kept for the composite, plus the composite's own buffers (the strips
     // received and sent, the frame on rank 0): three images.
-    return kProcessBytes + std::uint64_t(double(samples) * (sampleBytes + splatShare * splatBytes)) +
+    return kProcessBytes +
+           std::uint64_t(double(samples) * (sampleBytes + splatShare * splatBytes)) +
            image * std::uint64_t(images + 3);
 }
 

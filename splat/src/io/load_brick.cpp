@@ -2,12 +2,12 @@
 // NIfTI, NRRD, MetaImage and .raw files are read by byte ranges when raw-stored and by one
 // pass over the decompressed stream when compressed (sample_layout.h); anything else (DICOM,
 // slice folders, NRRD text/hex, ANALYZE pairs) is loaded whole and cropped.
+#include "sample_layout.h"
 #include "splat/atomic_file.h"
 #include "splat/bricks.h"
 #include "splat/error.h"
 #include "splat/synthetic.h"
 #include "splat/volume_io.h"
-#include "sample_layout.h"
 #include "volume_detail.h"
 
 namespace fs = std::filesystem;

@@ -15,8 +15,8 @@
 #include <map>
 #include <sstream>
 
-#include "splat/error.h"
 #include "sample_layout.h"
+#include "splat/error.h"
 #include "volume_detail.h"
 
 namespace fs = std::filesystem;

@@ -17,8 +17,8 @@
 #include <cstdio>
 #include <cstring>
 
-#include "splat/error.h"
 #include "sample_layout.h"
+#include "splat/error.h"
 #include "volume_detail.h"
 
 namespace fs = std::filesystem;
@@ -172,10 +172,10 @@ Header parseHeader(const std::string& bytes, const std::string& name) {
         if (std::isfinite(f1) && f1 != 0) {
             h.sclSlope = f1;
             h.sclInter = std::isfinite(f2) ? f2 : 0.0;
-        } else if (n1.glmax != n1.glmin && n1.cal_max != n1.cal_min &&
-                   std::isfinite(n1.cal_max) && std::isfinite(n1.cal_min)) {
-            h.sclSlope = (double(n1.cal_max) - double(n1.cal_min)) /
-                         (double(n1.glmax) - double(n1.glmin));
+        } else if (n1.glmax != n1.glmin && n1.cal_max != n1.cal_min && std::isfinite(n1.cal_max) &&
+                   std::isfinite(n1.cal_min)) {
+            h.sclSlope =
+                (double(n1.cal_max) - double(n1.cal_min)) / (double(n1.glmax) - double(n1.glmin));
             h.sclInter = double(n1.cal_min) - h.sclSlope * double(n1.glmin);
         }
     }
@@ -406,8 +406,8 @@ std::optional<SampleLayout> niftiLayout(const fs::path& p) { return niftiParse(p
 
 Volume loadNifti(const fs::path& given) {
     const SampleLayout L = niftiParse(given);
-    std::vector<unsigned char> data = readData(
-        L.file, L.codec == SampleLayout::Codec::Gzip ? L.skip : L.start, L.sampleBytes());
+    std::vector<unsigned char> data =
+        readData(L.file, L.codec == SampleLayout::Codec::Gzip ? L.skip : L.start, L.sampleBytes());
     Volume v = makeVolume(L.dims, glm::dvec3(1.0), L.name);
     decodeSamples(data.data(), v.voxelCount(), L.type, L.bigEndian, v.data.data());
     if (L.scaled())

@@ -15,8 +15,8 @@
 #include <optional>
 #include <sstream>
 
-#include "splat/error.h"
 #include "sample_layout.h"
+#include "splat/error.h"
 #include "volume_detail.h"
 
 namespace fs = std::filesystem;
@@ -444,8 +444,7 @@ std::optional<SampleLayout> nrrdLayout(const fs::path& p, const LoadOptions& opt
     SampleLayout L = P.layout;
     L.file = P.dataFile ? *P.dataFile : p;
     L.fileName = displayName(L.file);
-    const std::uint64_t dataStart =
-        afterLines(L.file, P.dataFile ? 0 : header.pos, P.lineSkip);
+    const std::uint64_t dataStart = afterLines(L.file, P.dataFile ? 0 : header.pos, P.lineSkip);
     const std::uint64_t size = regularFileSize(L.file);
     if (P.gzip || P.bzip2) {
         L.codec = P.gzip ? SampleLayout::Codec::Gzip : SampleLayout::Codec::Bzip2;

@@ -22,8 +22,7 @@ namespace fs = std::filesystem;
 namespace splat::detail {
 
 std::uint64_t SampleLayout::sampleBytes() const {
-    return std::uint64_t(dims.x) * std::uint64_t(dims.y) * std::uint64_t(dims.z) *
-           sampleSize(type);
+    return std::uint64_t(dims.x) * std::uint64_t(dims.y) * std::uint64_t(dims.z) * sampleSize(type);
 }
 
 bool SampleLayout::scaled() const {
@@ -33,8 +32,8 @@ bool SampleLayout::scaled() const {
 namespace {
 
 std::string boxText(const glm::ivec3& lo, const glm::ivec3& hi) {
-    return std::to_string(lo.x) + "," + std::to_string(lo.y) + "," + std::to_string(lo.z) +
-           " to " + std::to_string(hi.x - 1) + "," + std::to_string(hi.y - 1) + "," +
+    return std::to_string(lo.x) + "," + std::to_string(lo.y) + "," + std::to_string(lo.z) + " to " +
+           std::to_string(hi.x - 1) + "," + std::to_string(hi.y - 1) + "," +
            std::to_string(hi.z - 1);
 }
 
@@ -95,7 +94,8 @@ class SampleBytes {
         const std::uint64_t target = L_.skip + at;
         if (target < pos_) throw Error(L_.fileName + ": internal error: stream read backwards");
         while (pos_ < target) {
-            const std::size_t want = std::size_t(std::min<std::uint64_t>(target - pos_, scratch_.size()));
+            const std::size_t want =
+                std::size_t(std::min<std::uint64_t>(target - pos_, scratch_.size()));
             const std::size_t got = produce(scratch_.data(), want);
             if (got == 0) return false;
         }
@@ -303,8 +303,8 @@ Volume readLayoutBrick(const SampleLayout& L, const Volume& whole, const glm::iv
     std::vector<float> row(nx);
     for (int k = flo.z; k < fhi.z; ++k)
         for (int j = flo.y; j < fhi.y; ++j) {
-            const std::uint64_t at =
-                std::uint64_t(k) * sliceBytes + std::uint64_t(j) * rowBytes + std::uint64_t(flo.x) * ss;
+            const std::uint64_t at = std::uint64_t(k) * sliceBytes + std::uint64_t(j) * rowBytes +
+                                     std::uint64_t(flo.x) * ss;
             if (!bytes.read(at, raw.size(), raw.data())) {
                 if (!bytes.compressed()) throw beyond(regularFileSize(L.file));
                 throw beyond(bytes.drain());
@@ -343,7 +343,8 @@ float layoutBackground(const SampleLayout& L, NonFinitePolicy policy) {
     };
     for (int k = 0; k < d.z; ++k)
         for (int j = 0; j < d.y; ++j) {
-            const std::uint64_t at = (std::uint64_t(k) * std::uint64_t(d.y) + std::uint64_t(j)) * rowBytes;
+            const std::uint64_t at =
+                (std::uint64_t(k) * std::uint64_t(d.y) + std::uint64_t(j)) * rowBytes;
             const bool wholeRow = k == 0 || k == d.z - 1 || j == 0 || j == d.y - 1;
             if (wholeRow || d.x <= 2) {
                 need(bytes.read(at, raw.size(), raw.data()));
@@ -383,9 +384,10 @@ SampleLayout rawSampleLayout(const fs::path& p, const RawOptions& options) {
     const glm::dvec3 s = options.spacing.value_or(glm::dvec3(1.0));
     L.M = glm::dmat3(s.x, 0, 0, 0, s.y, 0, 0, 0, s.z);
     L.name = L.fileName;
-    L.source = std::string("raw ") + sampleTypeName(R.type) +
-               (sampleSize(R.type) > 1 ? (options.bigEndian ? " big-endian" : " little-endian") : "") +
-               (gz ? " gzip" : "") + " (" + p.filename().string() + ")";
+    L.source =
+        std::string("raw ") + sampleTypeName(R.type) +
+        (sampleSize(R.type) > 1 ? (options.bigEndian ? " big-endian" : " little-endian") : "") +
+        (gz ? " gzip" : "") + " (" + p.filename().string() + ")";
     return L;
 }
 
