@@ -5,6 +5,7 @@ for 64-1024 ranks, and the plot (SVG) of the README.
 
     /usr/bin/python3 tools/bench/mpi_scaling.py [--splat build/bin/splat] [--out DIR]
         [--memory-volume synthetic:phantom:800] [--skip-memory]
+        [--memory-file /tmp/shell_820.nii [--memory-size 820] [--file-only]]
 
 Every figure is measured on this machine with `mpirun --oversubscribe` (ranks share its
 cores, so wall times are not a scaling result; the work per rank and the bytes exchanged
@@ -45,13 +46,64 @@ def bricked(splat, ranks, volume, out, extra, timed=False):
                                 r"splats, load ([\d.]+) ms, scene ([\d.]+) ms, render ([\d.]+) "
                                 r"ms, exchanged (\d+)", r.stdout)]
     comp = float(re.search(r"composite ([\d.]+) ms", r.stdout)[1])
+    est = re.search(r"memory estimate: ([\d.]+) MiB", r.stdout)
     peaks = [int(m) for m in re.findall(r"peak-kib (\d+)", r.stderr)]
-    return {"ranks": ranks, "per_rank": per, "composite_ms": comp, "peak_kib": peaks}
+    return {"ranks": ranks, "per_rank": per, "composite_ms": comp, "peak_kib": peaks,
+            "estimate_mib": float(est[1]) if est else 0.0}
 
 
 def compare(splat, a, b):
     r = run([splat, "compare", a, b])
     return float(re.search(r"max abs\s+([\d.e+-]+)", r.stdout)[1])
+
+
+def write_shell(path, n):
+    """A float32 NIfTI of n^3 samples, written slab by slab: 0 around a shell of 2.0 (the
+    phantom's skull) of radius 0.4 n and thickness 0.03 n, with a little texture."""
+    import nibabel as nib
+    import numpy as np
+    hdr = nib.Nifti1Header()
+    hdr.set_data_shape((n, n, n))
+    hdr.set_data_dtype(np.float32)
+    hdr.set_sform(np.diag([1.0, 1.0, 1.0, 1.0]), code=1)
+    hdr.set_qform(np.diag([1.0, 1.0, 1.0, 1.0]), code=1)
+    hdr["vox_offset"] = 352
+    c = (n - 1) / 2
+    y, x = np.mgrid[0:n, 0:n].astype(np.float32)
+    with open(path + ".part", "wb") as f:
+        f.write(hdr.binaryblock)
+        f.write(b"\0" * 4)
+        for k in range(n):
+            r = np.sqrt((x - c) ** 2 + (y - c) ** 2 + (k - c) ** 2) / n
+            slab = np.where(np.abs(r - 0.4) < 0.015, 2.0, 0.0).astype(np.float32)
+            slab += (0.1 * np.sin(x * 0.3 + k * 0.2)).astype(np.float32) * (slab > 0)
+            f.write(slab.astype("<f4").tobytes(order="C"))  # slab[y, x]: x fastest
+    os.replace(path + ".part", path)
+
+
+def memory_file(a, common):
+    """Peak RSS per rank reading a >= 2 GiB float NIfTI from disk with K = 1, 2, 4, 8
+    ranks (each reads its brick by byte ranges and the outer faces), against one process
+    loading it whole."""
+    if not os.path.exists(a.memory_file):
+        write_shell(a.memory_file, a.memory_size)
+    one = os.path.join(a.out, "file_one.exr")
+    r = run(["/usr/bin/time", "-f", "peak-kib %M", a.splat, "render", a.memory_file, "-o", one]
+            + common)
+    mem = {"file": a.memory_file, "bytes": os.path.getsize(a.memory_file),
+           "one_process_kib": int(re.findall(r"peak-kib (\d+)", r.stderr)[-1]), "runs": []}
+    print(f"file {a.memory_file}: one process {mem['one_process_kib'] / 1024:.0f} MiB", flush=True)
+    for k in (1, 2, 4, 8):
+        out = os.path.join(a.out, f"file{k}.exr")
+        m = bricked(a.splat, k, a.memory_file, out, common, timed=True)
+        m["max_abs_vs_one_process"] = compare(a.splat, out, one)
+        mem["runs"].append(m)
+        print(f"file K={k}: peak per rank {max(m['peak_kib']) / 1024:.0f} MiB (all: "
+              f"{[p // 1024 for p in m['peak_kib']]}), estimate {m.get('estimate_mib', 0):.0f} "
+              f"MiB, load {max(p['load_ms'] for p in m['per_rank']):.0f} ms, max abs vs one "
+              f"process {m['max_abs_vs_one_process']:.3g}", flush=True)
+    with open(os.path.join(a.out, "memory_file.json"), "w") as f:
+        json.dump(mem, f, indent=1)
 
 
 def main():
@@ -60,6 +112,10 @@ def main():
     ap.add_argument("--out", default="build/mpi_scaling")
     ap.add_argument("--memory-volume", default="synthetic:phantom:800")
     ap.add_argument("--skip-memory", action="store_true")
+    ap.add_argument("--memory-file", help="also measure memory per rank on this float NIfTI "
+                    "(written first when missing: a skull-like shell, N^3 float32)")
+    ap.add_argument("--memory-size", type=int, default=820)
+    ap.add_argument("--file-only", action="store_true", help="only the --memory-file runs")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     tf = os.path.join(a.out, "skull.json")
@@ -68,6 +124,10 @@ def main():
     common = ["--renderer", "axis", "--tf", tf, "--size", "256x256", "--azimuth", "30",
               "--elevation", "15", "--early-termination", "0"]
     results = {}
+    if a.memory_file:
+        memory_file(a, common)
+        if a.file_only:
+            return
 
     # Strong scaling: one volume, K = 1..8 bricks on K ranks.
     strong = [bricked(a.splat, k, "synthetic:phantom:256", os.path.join(a.out, f"strong{k}.exr"),

@@ -5,33 +5,64 @@
 #include <filesystem>
 
 #include "diagnostics.h"
+#include "footprint/kernel.h"
 #include "parallel.h"
 #include "scene_file.h"
 #include "splat/atomic_file.h"
+#include "splat/brick_budget.h"
 #include "splat/bricks.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
 
 namespace splat::cli {
 
+namespace {
+
+/// K from the budget per process (README "Beyond one machine"), said on rank 0.
+int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int ranks,
+                     std::uint64_t rankBytes) {
+    const footprint::Kernel kernel =
+        footprint::Kernel::fromName(settings.kernel, settings.kernelSigma, settings.kernelRadius);
+    BrickBudget budget;
+    budget.rankBytes = rankBytes ? rankBytes : defaultRankBytes(ranks);
+    budget.ranks = ranks;
+    budget.width = settings.camera.width;
+    budget.height = settings.camera.height;
+    budget.ghost = ghostLayers(kernel.radius(), geometry.spacing);
+    const BrickChoice c = chooseBricks(geometry.dims, budget);
+    if (!workerProcess()) {
+        const double mib = 1048576.0;
+        std::printf(
+            "bricks: %d (%d per process) for a budget of %.1f MiB per process%s: estimated "
+            "%.1f MiB for the busiest (largest brick %llu samples); the whole volume %s\n",
+            c.bricks, (c.bricks + ranks - 1) / ranks, double(budget.rankBytes) / mib,
+            rankBytes ? " (--rank-memory)" : " (80% of physical memory / processes on the node)",
+            double(c.rankBytes) / mib, static_cast<unsigned long long>(c.largestBrick),
+            c.wholeFits ? "fits one process" : "does not fit one process");
+        if (!c.withinBudget && !c.wholeFits)
+            warn("even " + std::to_string(c.bricks) +
+                 " bricks exceed the budget per process by the estimate; rendering anyway");
+    }
+    return c.bricks;
+}
+
+}  // namespace
+
 void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
-                         RenderSettings settings, int bricks, const std::string& output,
-                         BrickComposite composite) {
+                         RenderSettings settings, int bricks, std::uint64_t rankBytes,
+                         const std::string& output, BrickComposite composite) {
     const LoadOptions options = loadOptionsFromArgs(volume);
+    const bool given = !volume.backgroundValue.empty() && volume.backgroundValue != "auto";
     bool alone = false;
-    Volume geometry = volumeGeometry(volume.spec, options, &alone);
-    if (!volume.backgroundValue.empty() && volume.backgroundValue != "auto") {
+    Volume geometry = volumeGeometry(volume.spec, options, &alone, !given);
+    if (given) {
         geometry.background = std::stof(volume.backgroundValue);
         geometry.backgroundSource = "--background-value";
-    } else if (alone && volume.spec.rfind("synthetic:", 0) != 0) {
-        throw Error(volume.spec +
-                    ": --bricks reads only each brick, and the background value is the median "
-                    "of the whole volume's outer faces: give it with --background-value");
     }
     if (!alone)
         warn(volume.spec +
-             ": its samples are not read by byte ranges (compressed, or not a .raw file): every "
-             "rank loads the whole volume once and keeps its brick");
+             ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, an "
+             "ANALYZE pair): every rank loads the whole volume once and keeps its brick");
     if (settings.renderer == RendererKind::Sheet && composite == BrickComposite::Fast)
         warn(
             "--renderer sheet with --brick-composite fast is approximate where its slabs cross a "
@@ -42,6 +73,7 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
         {"splat:background_value", std::string(b) + " (" + geometry.backgroundSource + ")"});
     settings = withFreeCameraTarget(settings, geometry);
     const std::unique_ptr<BrickGroup> group = brickGroup();
+    if (bricks == 0) bricks = bricksFromBudget(geometry, settings, group->size(), rankBytes);
     if (bricks > int(std::min<std::size_t>(geometry.voxelCount(), 1 << 20)))
         throw UsageError("--bricks " + std::to_string(bricks) + " is more than the volume's " +
                          std::to_string(geometry.voxelCount()) + " samples");
@@ -61,6 +93,19 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
         "processes, composite %.1f ms\n",
         output.c_str(), image.width, image.height, toString(settings.renderer),
         toString(settings.mode), st.bricks, group->size(), st.compositeMs);
+    {
+        // splat/brick_budget.h's estimate for the busiest process, beside its peak RSS.
+        std::size_t largest = 0;
+        int held = 0;
+        for (const BrickStats& r : all) {
+            largest = std::max(largest, r.samplesLoaded);
+            held = std::max(held, r.rendered);
+        }
+        std::printf(
+            "memory estimate: %.0f MiB for the busiest process (%zu samples, %d images)\n",
+            double(brickMemoryEstimate(largest, image.width, image.height, held, 0.25)) / 1048576.0,
+            largest, held);
+    }
     for (std::size_t r = 0; r < all.size(); ++r)
         std::printf(
             "rank %zu: %d bricks, largest %zu samples (%.1f MiB), %zu splats, load %.1f ms, "

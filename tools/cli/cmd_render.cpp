@@ -22,6 +22,7 @@ struct RenderCommand {
     std::string output;
     int bricks = 0;
     std::string brickComposite = "exact";
+    double rankMemory = 0;  ///< MiB; 0: the default under mpirun, off otherwise
 };
 }  // namespace
 
@@ -35,7 +36,12 @@ void registerRender(CLI::App& app) {
               "Output", PathKind::Output);
     addOption(*cmd, "--bricks", args->bricks,
               "sort-last: cut the volume into K bricks, each loaded alone, rendered and "
-              "composited (0: off; under mpirun one per process)",
+              "composited (0: off; under mpirun chosen from --rank-memory)",
+              "Output");
+    addOption(*cmd, "--rank-memory", args->rankMemory,
+              "bricks: memory per process in MiB; the fewest bricks, a multiple of the "
+              "processes, whose estimate fits it (default under mpirun: 80% of the physical "
+              "memory / processes on the node)",
               "Output");
     addOption(*cmd, "--brick-composite", args->brickComposite,
               "bricks of --renderer sheet: exact (every slab's sheets summed across bricks, the "
@@ -60,17 +66,20 @@ void registerRender(CLI::App& app) {
         if (args->brickComposite != "exact" && args->brickComposite != "fast")
             throw UsageError("--brick-composite must be exact or fast (got '" +
                              args->brickComposite + "')");
-        const bool bricked = args->bricks > 0 || processCount() > 1;
+        if (!(args->rankMemory >= 0 && args->rankMemory <= 1e9))
+            throw UsageError("--rank-memory must be between 0 and 1e9 MiB");
+        const bool bricked = args->bricks > 0 || args->rankMemory > 0 || processCount() > 1;
         if (given(*cmd, "brick-composite") && !fromScene(*cmd, "brick-composite") &&
             (!bricked || settings.renderer != RendererKind::Sheet))
             warn(
                 "--brick-composite applies to bricked renders (--bricks or mpirun) of "
                 "--renderer sheet: ignored");
-        if (bricked) {  // README "Beyond one machine"
+        // README "Beyond one machine": bricks when asked, or chosen from the budget.
+        if (bricked) {
             if (!workerProcess()) beginRun(*cmd);
             renderBrickedToFile(
-                args->volume, args->render, settings,
-                args->bricks > 0 ? args->bricks : processCount(), args->output,
+                args->volume, args->render, settings, args->bricks,
+                std::uint64_t(args->rankMemory * 1048576.0), args->output,
                 args->brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
             if (!workerProcess()) finishRun(*cmd);
             return;

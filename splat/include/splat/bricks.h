@@ -52,9 +52,10 @@ struct BrickLayout {
 /// samples in that ratio. Ghost layers: `ghost` samples on every inner face.
 BrickLayout splitBricks(const glm::ivec3& dims, int count, int ghost);
 
-/// Ghost layers a kernel of support radius `radius` (in units of the smallest spacing)
-/// needs on a grid of `spacing`: every sample whose kernel reaches the owned box, plus one
-/// layer for the central-difference gradients.
+/// Ghost layers a kernel of support radius `radius` (index units) needs on a grid of
+/// `spacing`: every sample whose kernel a sheet pixel of the owned box sees, up to
+/// R sqrt 2 + 1/2 samples beyond a face (the axis-aligned sheets hold whole kernels, cut
+/// along oblique rays), plus one layer for the central-difference gradients: 5 for R = 2.
 int ghostLayers(double radius, const glm::dvec3& spacing);
 
 /// The bricks of `layout` front to back as seen by `camera` of a volume of geometry `whole`
@@ -86,14 +87,20 @@ struct LoadOptions;
 
 /// The geometry of the volume `spec` names (dims, spacing, origin, background and its
 /// source, the source's description; no samples). `alone` says whether loadVolumeBrick
-/// reads a brick's samples alone: synthetic volumes (only the brick is computed) and
-/// uncompressed .raw files (byte ranges, one read per row of the brick). Any other file
-/// (compressed, or a format whose samples are not read by range yet) is loaded whole here
-/// and by loadVolumeBrick, which keeps the brick.
-Volume volumeGeometry(const std::string& spec, const LoadOptions& options, bool* alone);
+/// reads a brick's samples alone: synthetic volumes (only the brick is computed), NIfTI
+/// (.nii, .nii.gz), NRRD (raw, gzip, bzip2) and MetaImage files and .raw/.raw.gz (the rows of
+/// the brick by byte ranges; a compressed file's stream is decompressed from its start and
+/// only the brick's bytes kept). The background value follows loadVolume's rule, from the
+/// file's outer faces alone (read by byte ranges: equal to the one-process value);
+/// `background` false skips that read (b = 0, for a caller that sets it). Any other volume
+/// (DICOM, slice folders, NRRD text/hex, ANALYZE pairs) is loaded whole here and by
+/// loadVolumeBrick, which keeps the brick.
+Volume volumeGeometry(const std::string& spec, const LoadOptions& options, bool* alone,
+                      bool background = true);
 
-/// The samples [lo, hi) of the volume `spec` names, origin at sample lo; a brick beyond the
-/// end of a truncated file throws splat::Error naming the file and the bytes missing.
+/// The samples [lo, hi) of the volume `spec` names, origin at sample lo: bit for bit the
+/// crop of loadVolume's volume; a brick beyond the end of a truncated file throws
+/// splat::Error naming the file and the bytes missing.
 Volume loadVolumeBrick(const std::string& spec, const LoadOptions& options, const glm::ivec3& lo,
                        const glm::ivec3& hi);
 

@@ -74,6 +74,11 @@ struct ClassifyOptions {
     bool gradients = false;  ///< gx, gy, gz; voxels with d == 0 but a gradient are kept
     EdgeEnhancement edges;   ///< pre-classified dvr: rho and e scaled per voxel
     Clipping clipping;       ///< voxels outside are dropped
+    /// Voxels farther than this (index units) from the kept region are dropped; 0: the
+    /// kernel radius (what a renderer that cuts the field along the ray needs). The
+    /// axis-aligned splatter, whose sheets hold whole kernels, needs clipReach(radius)
+    /// (model/clip_region.h).
+    double clipMargin = 0;
     /// Labels (enabled): voxels within the kernel radius of a shown label become splats
     /// carrying their label (so the background competes at region borders); without a label
     /// volume the scene volume holds the labels and has no intensity part.

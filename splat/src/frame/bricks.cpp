@@ -70,10 +70,12 @@ BrickLayout splitBricks(const glm::ivec3& dims, int count, int ghost) {
 }
 
 int ghostLayers(double radius, const glm::dvec3& spacing) {
-    // radius is in units of the smallest spacing, so no axis has more than ceil(radius)
-    // samples within it of the owned box.
+    // Every sample whose kernel a sheet pixel of the owned box can see: along the normal of
+    // a brick face, R sqrt 2 + 1/2 index units (model/clip_region.h, clipReach), plus one
+    // layer for the central-difference gradients. The kernel's radius is in index units, so
+    // the spacing does not enter.
     (void)spacing;
-    return int(std::ceil(radius)) + 1;
+    return int(std::ceil(radius * std::sqrt(2.0) + 0.5)) + 1;
 }
 
 std::vector<int> visibilityOrder(const BrickLayout& layout, const Volume& whole,

@@ -15,6 +15,7 @@
 #include <map>
 #include <sstream>
 
+#include "sample_layout.h"
 #include "splat/error.h"
 #include "volume_detail.h"
 
@@ -63,16 +64,17 @@ bool isTrue(const std::string& s) {
     return l == "true" || l == "1" || l == "yes";
 }
 
-}  // namespace
-
-Volume loadMetaImage(const fs::path& p, const LoadOptions& options) {
-    const std::string name = displayName(p);
-    std::vector<unsigned char> file = readFileBytes(p);
-
+/// The header's keys (lower case) up to ElementDataFile, the last one.
+struct MetaHeader {
     std::map<std::string, std::string> keys;
-    std::size_t pos = 0;
+    std::size_t pos = 0;  ///< first byte after the header
     bool sawDataFile = false;
-    while (pos < file.size() && !sawDataFile) {
+};
+
+MetaHeader parseMetaHeader(const std::vector<unsigned char>& file, const std::string& name) {
+    MetaHeader h;
+    std::size_t& pos = h.pos;
+    while (pos < file.size() && !h.sawDataFile) {
         std::size_t eol = pos;
         while (eol < file.size() && file[eol] != '\n') ++eol;
         std::string line(file.begin() + std::ptrdiff_t(pos), file.begin() + std::ptrdiff_t(eol));
@@ -83,9 +85,26 @@ Volume loadMetaImage(const fs::path& p, const LoadOptions& options) {
         if (eq == std::string::npos)
             throw Error(name + ": bad MetaImage header line '" + line.substr(0, 60) + "'");
         std::string key = toLower(trim(line.substr(0, eq)));
-        keys[key] = trim(line.substr(eq + 1));
-        if (key == "elementdatafile") sawDataFile = true;
+        h.keys[key] = trim(line.substr(eq + 1));
+        if (key == "elementdatafile") h.sawDataFile = true;
     }
+    return h;
+}
+
+/// What the header says, and where the data is (`dataFile` empty: LOCAL, after the header).
+struct MetaParsed {
+    SampleLayout layout;  ///< file, start and codec not set
+    std::size_t expected = 0;
+    bool compressed = false;
+    std::optional<fs::path> dataFile;
+    long long headerSize = 0;
+    std::optional<std::size_t> compressedSize;
+};
+
+MetaParsed metaParse(const fs::path& p, const LoadOptions& options, const MetaHeader& header) {
+    const std::string name = displayName(p);
+    const std::map<std::string, std::string>& keys = header.keys;
+    const bool sawDataFile = header.sawDataFile;
     auto get = [&](const char* k) {
         auto it = keys.find(k);
         return it == keys.end() ? std::string() : it->second;
@@ -177,33 +196,116 @@ Volume loadMetaImage(const fs::path& p, const LoadOptions& options) {
     }
 
     // Data.
+    MetaParsed P;
     std::string byteOrder = get("binarydatabyteordermsb");
     if (byteOrder.empty()) byteOrder = get("elementbyteordermsb");
-    bool bigEndian = isTrue(byteOrder);
-    bool compressed = isTrue(get("compresseddata"));
+    const bool bigEndian = isTrue(byteOrder);
+    P.compressed = isTrue(get("compresseddata"));
     std::string dataFile = get("elementdatafile");
-    std::vector<unsigned char> separate;
-    const unsigned char* data;
-    std::size_t dataSize;
-    std::string dataName = name;
-    if (toLower(dataFile) == "local") {
-        data = file.data() + pos;
-        dataSize = file.size() - pos;
-    } else {
+    if (toLower(dataFile) != "local") {
         if (toLower(dataFile).rfind("list", 0) == 0 || dataFile.find('%') != std::string::npos)
             throw Error(name + ": multi-file MetaImage data ('" + dataFile + "') is not supported");
-        fs::path dp = resolveDataFile(p, dataFile, options.allowOutsideDataFiles);
-        dataName = displayName(dp);
-        separate = readFileBytes(dp);
-        data = separate.data();
-        dataSize = separate.size();
-        long long headerSize = 0;
+        P.dataFile = resolveDataFile(p, dataFile, options.allowOutsideDataFiles);
         if (!get("headersize").empty()) {
             auto h = numbers(get("headersize"), name, "HeaderSize");
             if (h.size() != 1 || !(h[0] >= -1 && h[0] <= 9.0e15) || h[0] != std::floor(h[0]))
                 throw Error(name + ": bad MetaImage HeaderSize '" + get("headersize") + "'");
-            headerSize = (long long)h[0];
+            P.headerSize = (long long)h[0];
         }
+    }
+    if (P.compressed) {
+        std::string csize = get("compresseddatasize");
+        if (!csize.empty()) {
+            auto c = numbers(csize, name, "CompressedDataSize");
+            if (c.size() != 1 || !(c[0] >= 0 && c[0] <= 9.0e15) || c[0] != std::floor(c[0]))
+                throw Error(name + ": bad MetaImage CompressedDataSize '" + csize + "'");
+            P.compressedSize = std::size_t(c[0]);
+        }
+    }
+    P.expected = expected;
+    SampleLayout& L = P.layout;
+    L.dims = dims;
+    L.type = *type;
+    L.bigEndian = bigEndian;
+    L.exact = true;
+    L.M = M;
+    L.t = lpsToRas * origin;
+    L.orientation = "TransformMatrix";
+    L.name = name;
+    L.source = std::string("MetaImage ") + sampleTypeName(*type) +
+               (P.compressed ? " compressed" : "") + " (" + p.filename().string() + ")";
+    L.notes = notes;
+    return P;
+}
+
+/// The header of `p` (read whole: a .mhd is small, a .mha's data follows it).
+MetaHeader readMetaHeader(const fs::path& p, const std::vector<unsigned char>* whole) {
+    const std::string name = displayName(p);
+    if (whole) return parseMetaHeader(*whole, name);
+    const std::uint64_t size = regularFileSize(p);
+    for (std::uint64_t n = std::min<std::uint64_t>(size, 1 << 16);; n = std::min(size, 4 * n)) {
+        std::vector<unsigned char> prefix = readFileRange(p, 0, n);
+        if (n < size) {  // whole lines only
+            std::size_t end = prefix.size();
+            while (end > 0 && prefix[end - 1] != '\n') --end;
+            prefix.resize(end);
+        }
+        MetaHeader h = parseMetaHeader(prefix, name);
+        if (h.sawDataFile || n == size) return h;
+    }
+}
+
+}  // namespace
+
+std::optional<SampleLayout> metaImageLayout(const fs::path& p, const LoadOptions& options) {
+    const MetaHeader header = readMetaHeader(p, nullptr);
+    const MetaParsed P = metaParse(p, options, header);
+    SampleLayout L = P.layout;
+    L.file = P.dataFile ? *P.dataFile : p;
+    L.fileName = displayName(L.file);
+    const std::uint64_t size = regularFileSize(L.file);
+    const std::uint64_t dataStart = P.dataFile ? 0 : header.pos;
+    const std::uint64_t available = size - std::min(size, dataStart);
+    if (P.compressed) {
+        L.codec = SampleLayout::Codec::Gzip;
+        L.start = dataStart;
+        if (P.compressedSize) {
+            checkDataLength(*P.compressedSize, std::size_t(available), L.fileName, false);
+            L.streamBytes = *P.compressedSize;
+        }
+    } else if (P.headerSize > 0) {
+        checkDataLength(std::size_t(P.headerSize), std::size_t(available), L.fileName, false);
+        L.start = dataStart + std::uint64_t(P.headerSize);
+    } else if (P.headerSize == -1) {
+        checkDataLength(P.expected, std::size_t(available), L.fileName, false);
+        L.start = size - P.expected;
+    } else {
+        L.start = dataStart;
+    }
+    return L;
+}
+
+Volume loadMetaImage(const fs::path& p, const LoadOptions& options) {
+    const std::string name = displayName(p);
+    std::vector<unsigned char> file = readFileBytes(p);
+    const MetaHeader header = readMetaHeader(p, &file);
+    const MetaParsed P = metaParse(p, options, header);
+    const std::size_t expected = P.expected;
+    const bool compressed = P.compressed;
+    const SampleLayout& L = P.layout;
+    std::vector<unsigned char> separate;
+    const unsigned char* data;
+    std::size_t dataSize;
+    std::string dataName = name;
+    if (!P.dataFile) {
+        data = file.data() + header.pos;
+        dataSize = file.size() - header.pos;
+    } else {
+        dataName = displayName(*P.dataFile);
+        separate = readFileBytes(*P.dataFile);
+        data = separate.data();
+        dataSize = separate.size();
+        const long long headerSize = P.headerSize;
         if (headerSize > 0 && !compressed) {
             checkDataLength(std::size_t(headerSize), dataSize, dataName, false);
             data += headerSize;
@@ -216,27 +318,20 @@ Volume loadMetaImage(const fs::path& p, const LoadOptions& options) {
     }
     std::vector<unsigned char> inflated;
     if (compressed) {
-        std::string csize = get("compresseddatasize");
-        if (!csize.empty()) {
-            auto c = numbers(csize, name, "CompressedDataSize");
-            if (c.size() != 1 || !(c[0] >= 0 && c[0] <= 9.0e15) || c[0] != std::floor(c[0]))
-                throw Error(name + ": bad MetaImage CompressedDataSize '" + csize + "'");
-            std::size_t n = std::size_t(c[0]);
-            checkDataLength(n, dataSize, dataName, false);
-            dataSize = n;
+        if (P.compressedSize) {
+            checkDataLength(*P.compressedSize, dataSize, dataName, false);
+            dataSize = *P.compressedSize;
         }
         inflated = inflateAll(data, dataSize, dataName, expected);
         data = inflated.data();
         dataSize = inflated.size();
     }
     checkDataLength(expected, dataSize, dataName, true);
-    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
-    decodeSamples(data, v.voxelCount(), *type, bigEndian, v.data.data());
-
-    v.source = std::string("MetaImage ") + sampleTypeName(*type) +
-               (compressed ? " compressed" : "") + " (" + p.filename().string() + ")";
-    applyOrientation(v, M, lpsToRas * origin, "TransformMatrix");
-    for (const std::string& n : notes) addNote(v, n);
+    Volume v = makeVolume(L.dims, glm::dvec3(1.0), name);
+    decodeSamples(data, v.voxelCount(), L.type, L.bigEndian, v.data.data());
+    v.source = L.source;
+    applyOrientation(v, L.M, L.t, L.orientation);
+    for (const std::string& n : L.notes) addNote(v, n);
     return v;
 }
 

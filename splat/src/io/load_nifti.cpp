@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "sample_layout.h"
 #include "splat/error.h"
 #include "volume_detail.h"
 
@@ -171,10 +172,10 @@ Header parseHeader(const std::string& bytes, const std::string& name) {
         if (std::isfinite(f1) && f1 != 0) {
             h.sclSlope = f1;
             h.sclInter = std::isfinite(f2) ? f2 : 0.0;
-        } else if (n1.glmax != n1.glmin && n1.cal_max != n1.cal_min &&
-                   std::isfinite(n1.cal_max) && std::isfinite(n1.cal_min)) {
-            h.sclSlope = (double(n1.cal_max) - double(n1.cal_min)) /
-                         (double(n1.glmax) - double(n1.glmin));
+        } else if (n1.glmax != n1.glmin && n1.cal_max != n1.cal_min && std::isfinite(n1.cal_max) &&
+                   std::isfinite(n1.cal_min)) {
+            h.sclSlope =
+                (double(n1.cal_max) - double(n1.cal_min)) / (double(n1.glmax) - double(n1.glmin));
             h.sclInter = double(n1.cal_min) - h.sclSlope * double(n1.glmin);
         }
     }
@@ -243,7 +244,11 @@ bool allFinite(const double* v, int n) {
 
 }  // namespace
 
-Volume loadNifti(const fs::path& given) {
+namespace {
+
+/// The header of `given` parsed and checked: where the first volume's samples are and how
+/// they become the model's volume.
+SampleLayout niftiParse(const fs::path& given) {
     std::string ext = toLower(given.extension().string());
     if (ext == ".gz") ext = toLower(given.stem().extension().string());
     // An .img names the pair's header; the header is where everything starts.
@@ -364,21 +369,52 @@ Volume loadNifti(const fs::path& given) {
         }
     }
 
-    std::vector<unsigned char> data = readData(dataPath, offset, bytes);
-    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
+    SampleLayout L;
+    L.file = dataPath;
+    L.fileName = displayName(dataPath);
+    if (isGz(dataPath)) {
+        L.codec = SampleLayout::Codec::Gzip;
+        L.skip = offset;
+    } else {
+        L.start = offset;
+    }
+    L.dims = dims;
+    L.type = *type;
     // Host byte order is little-endian (volume_decode.cpp): a swapped header means the
     // samples are big-endian.
-    decodeSamples(data.data(), v.voxelCount(), *type, h.swapped, v.data.data());
-    if (std::isfinite(slope) && slope != 0.0 && (slope != 1.0 || inter != 0.0))
-        for (float& s : v.data) s = float(slope * s + inter);
-
-    v.source =
+    L.bigEndian = h.swapped;
+    if (std::isfinite(slope) && slope != 0.0 && (slope != 1.0 || inter != 0.0)) {
+        L.slope = slope;
+        L.inter = inter;
+    }
+    L.M = M;
+    L.t = t;
+    L.orientation = what;
+    L.name = name;
+    L.source =
         std::string(format) + " " + sampleTypeName(*type) + " (" + p.filename().string() + ")";
     if (volumes > 1)
         notes.insert(notes.begin(), "4D file: only the first of " + std::to_string(volumes) +
                                         " volumes was loaded");
-    applyOrientation(v, M, t, what);
-    for (const std::string& n : notes) addNote(v, n);
+    L.notes = notes;
+    return L;
+}
+
+}  // namespace
+
+std::optional<SampleLayout> niftiLayout(const fs::path& p) { return niftiParse(p); }
+
+Volume loadNifti(const fs::path& given) {
+    const SampleLayout L = niftiParse(given);
+    std::vector<unsigned char> data =
+        readData(L.file, L.codec == SampleLayout::Codec::Gzip ? L.skip : L.start, L.sampleBytes());
+    Volume v = makeVolume(L.dims, glm::dvec3(1.0), L.name);
+    decodeSamples(data.data(), v.voxelCount(), L.type, L.bigEndian, v.data.data());
+    if (L.scaled())
+        for (float& s : v.data) s = float(L.slope * s + L.inter);
+    v.source = L.source;
+    applyOrientation(v, L.M, L.t, L.orientation);
+    for (const std::string& n : L.notes) addNote(v, n);
     return v;
 }
 

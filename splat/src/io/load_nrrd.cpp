@@ -15,6 +15,7 @@
 #include <optional>
 #include <sstream>
 
+#include "sample_layout.h"
 #include "splat/error.h"
 #include "volume_detail.h"
 
@@ -180,17 +181,22 @@ std::vector<double> parseNumbers(const std::string& s, const std::string& what,
 
 }  // namespace
 
-Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
-    const std::string name = displayName(p);
-    std::vector<unsigned char> file = readFileBytes(p);
+namespace {
+
+/// The header's fields, up to the first blank line (or the end of a detached header).
+struct NrrdHeader {
+    std::map<std::string, std::string> fields;
+    std::size_t pos = 0;  ///< first byte after the header
+    bool blankSeen = false;
+};
+
+NrrdHeader parseNrrdHeader(const std::vector<unsigned char>& file, const std::string& name) {
     const std::string magic(file.begin(), file.begin() + std::min<std::size_t>(file.size(), 7));
     if (magic.size() < 7 || magic.compare(0, 4, "NRRD") != 0)
         throw Error(name + ": not a NRRD file (missing NRRD000N magic line)");
-
-    // Header lines up to the first blank line (or the end of a detached header).
-    std::map<std::string, std::string> fields;
-    std::size_t pos = 0;
-    bool first = true, blankSeen = false;
+    NrrdHeader h;
+    std::size_t& pos = h.pos;
+    bool first = true;
     while (pos < file.size()) {
         std::size_t eol = pos;
         while (eol < file.size() && file[eol] != '\n') ++eol;
@@ -202,15 +208,31 @@ Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
             continue;
         }
         if (line.empty()) {
-            blankSeen = true;
+            h.blankSeen = true;
             break;
         }
         if (line[0] == '#') continue;
         if (line.find(":=") != std::string::npos) continue;  // key/value pair
         std::size_t colon = line.find(": ");
         if (colon == std::string::npos) throw Error(name + ": bad NRRD header line '" + line + "'");
-        fields[toLower(trim(line.substr(0, colon)))] = trim(line.substr(colon + 2));
+        h.fields[toLower(trim(line.substr(0, colon)))] = trim(line.substr(colon + 2));
     }
+    return h;
+}
+
+/// What the header says: the samples' type, size, orientation, encoding and where they are.
+struct NrrdParsed {
+    SampleLayout layout;  ///< file, start and codec not set
+    std::size_t expected = 0;
+    bool gzip = false, bzip2 = false, text = false, hex = false;
+    std::string encoding;
+    long long byteSkip = 0, lineSkip = 0;
+    std::optional<fs::path> dataFile;  ///< detached data
+};
+
+NrrdParsed nrrdParse(const fs::path& p, const LoadOptions& options, const NrrdHeader& header) {
+    const std::string name = displayName(p);
+    const std::map<std::string, std::string>& fields = header.fields;
     auto field = [&](const char* key) -> std::string {
         auto it = fields.find(key);
         return it == fields.end() ? std::string() : it->second;
@@ -349,26 +371,120 @@ Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
     }
 
     // Where the data is.
+    NrrdParsed P;
     std::string dataFile = field("data file");
     if (dataFile.empty()) dataFile = field("datafile");
-    std::vector<unsigned char> detached;
-    const unsigned char* data = nullptr;
-    std::size_t dataSize = 0;
-    std::string dataName = name;
     if (!dataFile.empty()) {
         if (dataFile.rfind("LIST", 0) == 0 || dataFile.find('%') != std::string::npos)
             throw Error(name + ": multi-file NRRD data ('data file: " + dataFile +
                         "') is not supported");
-        fs::path dp = resolveDataFile(p, dataFile, options.allowOutsideDataFiles);
-        dataName = displayName(dp);
-        detached = readFileBytes(dp);
+        P.dataFile = resolveDataFile(p, dataFile, options.allowOutsideDataFiles);
+    } else if (!header.blankSeen) {
+        throw Error(name + ": NRRD header has no data (no blank line, no 'data file')");
+    }
+    P.expected = expected;
+    P.gzip = gzip;
+    P.bzip2 = bzip2;
+    P.text = text;
+    P.hex = hex;
+    P.encoding = encoding;
+    P.byteSkip = byteSkip;
+    P.lineSkip = lineSkip;
+    SampleLayout& L = P.layout;
+    L.dims = dims;
+    L.type = *type;
+    L.bigEndian = bigEndian;
+    L.exact = true;
+    L.M = M;
+    L.t = t;
+    L.orientation = oriented ? "space directions" : "spacings";
+    L.name = name;
+    L.source = std::string("NRRD ") + sampleTypeName(*type) + " " + encoding + " (" +
+               p.filename().string() + ")";
+    L.notes = notes;
+    return P;
+}
+
+/// The first byte after `lines` lines of `p` from byte `from` (NRRD line skip), read in chunks.
+std::uint64_t afterLines(const fs::path& p, std::uint64_t from, long long lines) {
+    if (lines <= 0) return from;
+    const std::uint64_t size = regularFileSize(p);
+    std::uint64_t at = from;
+    long long seen = 0;
+    while (at < size) {
+        const std::uint64_t n = std::min<std::uint64_t>(size - at, 1 << 16);
+        const std::vector<unsigned char> chunk = readFileRange(p, at, n);
+        for (std::size_t i = 0; i < chunk.size(); ++i)
+            if (chunk[i] == '\n' && ++seen == lines) return at + i + 1;
+        at += n;
+    }
+    return size;
+}
+
+}  // namespace
+
+std::optional<SampleLayout> nrrdLayout(const fs::path& p, const LoadOptions& options) {
+    const std::string name = displayName(p);
+    // The header alone: read until its blank line (a detached header is read whole).
+    const std::uint64_t headerFileSize = regularFileSize(p);
+    NrrdHeader header;
+    for (std::uint64_t n = std::min<std::uint64_t>(headerFileSize, 1 << 16);;
+         n = std::min(headerFileSize, 4 * n)) {
+        std::vector<unsigned char> prefix = readFileRange(p, 0, n);
+        if (n < headerFileSize) {  // whole lines only
+            std::size_t end = prefix.size();
+            while (end > 0 && prefix[end - 1] != '\n') --end;
+            prefix.resize(end);
+        }
+        header = parseNrrdHeader(prefix, name);
+        if (header.blankSeen || n == headerFileSize) break;
+    }
+    NrrdParsed P = nrrdParse(p, options, header);
+    if (P.text || P.hex) return std::nullopt;
+    SampleLayout L = P.layout;
+    L.file = P.dataFile ? *P.dataFile : p;
+    L.fileName = displayName(L.file);
+    const std::uint64_t dataStart = afterLines(L.file, P.dataFile ? 0 : header.pos, P.lineSkip);
+    const std::uint64_t size = regularFileSize(L.file);
+    if (P.gzip || P.bzip2) {
+        L.codec = P.gzip ? SampleLayout::Codec::Gzip : SampleLayout::Codec::Bzip2;
+        L.start = dataStart;
+        L.skip = std::uint64_t(std::max(0LL, P.byteSkip));
+    } else if (P.byteSkip == -1) {
+        // "-1": the data is the last `expected` bytes of the file.
+        checkDataLength(P.expected, std::size_t(size - std::min(size, dataStart)), L.fileName,
+                        false);
+        L.start = size - P.expected;
+    } else {
+        checkDataLength(std::size_t(P.byteSkip), std::size_t(size - std::min(size, dataStart)),
+                        L.fileName, false);
+        L.start = dataStart + std::uint64_t(P.byteSkip);
+    }
+    return L;
+}
+
+Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
+    const std::string name = displayName(p);
+    std::vector<unsigned char> file = readFileBytes(p);
+    const NrrdHeader header = parseNrrdHeader(file, name);
+    const NrrdParsed P = nrrdParse(p, options, header);
+    const std::size_t expected = P.expected;
+    const bool gzip = P.gzip, bzip2 = P.bzip2, text = P.text, hex = P.hex;
+    const std::string& encoding = P.encoding;
+    const long long byteSkip = P.byteSkip, lineSkip = P.lineSkip;
+    const SampleLayout& L = P.layout;
+    std::vector<unsigned char> detached;
+    const unsigned char* data = nullptr;
+    std::size_t dataSize = 0;
+    std::string dataName = name;
+    if (P.dataFile) {
+        dataName = displayName(*P.dataFile);
+        detached = readFileBytes(*P.dataFile);
         data = detached.data();
         dataSize = detached.size();
     } else {
-        if (!blankSeen)
-            throw Error(name + ": NRRD header has no data (no blank line, no 'data file')");
-        data = file.data() + pos;
-        dataSize = file.size() - pos;
+        data = file.data() + header.pos;
+        dataSize = file.size() - header.pos;
     }
     // line skip: lines of text to skip before byte skip.
     std::size_t skipPos = 0;
@@ -410,24 +526,23 @@ Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
         dataSize = decoded.size();
     } else {
         // Text: n numbers take at least 2n - 1 characters (digits and separators).
-        const std::size_t count = expected / sampleSize(*type);
+        const std::size_t count = expected / sampleSize(L.type);
         if (dataSize < 2 * count - 1)
             throw Error(dataName + ": truncated data: " + std::to_string(count) +
                         " numbers need at least " + std::to_string(2 * count - 1) +
                         " characters of text, found " + std::to_string(dataSize));
     }
-    Volume v = makeVolume(dims, glm::dvec3(1.0), name);
+    Volume v = makeVolume(L.dims, glm::dvec3(1.0), name);
     if (text) {
-        decodeText(std::string(data, data + dataSize), v.voxelCount(), *type, v.data.data(),
+        decodeText(std::string(data, data + dataSize), v.voxelCount(), L.type, v.data.data(),
                    dataName);
     } else {
-        decodeSamples(data, v.voxelCount(), *type, bigEndian, v.data.data());
+        decodeSamples(data, v.voxelCount(), L.type, L.bigEndian, v.data.data());
     }
 
-    v.source = std::string("NRRD ") + sampleTypeName(*type) + " " + encoding + " (" +
-               p.filename().string() + ")";
-    applyOrientation(v, M, t, oriented ? "space directions" : "spacings");
-    for (const std::string& n : notes) addNote(v, n);
+    v.source = L.source;
+    applyOrientation(v, L.M, L.t, L.orientation);
+    for (const std::string& n : L.notes) addNote(v, n);
     return v;
 }
 

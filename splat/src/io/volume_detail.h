@@ -6,6 +6,7 @@
 // order into float, and turn the file's index-to-world matrix into the axis-aligned
 // model of splat/DESIGN.md (flips and permutations applied to the data, oblique rest
 // reported). Those pieces live here so no loader has its own copy.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -104,6 +105,18 @@ std::string trim(const std::string& s);
 /// replaced by the nearest rotation with a warning in v.note. `what` names the matrix's
 /// origin ("sform", "space directions").
 void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t, const std::string& what);
+
+/// The signed axis permutation applyOrientation applies: file index axis a runs along the
+/// model's axis `axis[a]`, reversed when sign[a] < 0; length[a] = |M column a| (the spacing).
+struct AxisMap {
+    std::array<int, 3> axis{0, 1, 2};
+    int sign[3] = {1, 1, 1};
+    double length[3] = {1, 1, 1};
+};
+AxisMap axisMapOf(const glm::dmat3& M, const std::string& source, const std::string& what);
+
+/// The NaN/Inf policy of loadVolume (an error naming the first such voxel, or 0 for each).
+void applyNonFinitePolicy(Volume& v, NonFinitePolicy policy, const std::string& what);
 
 // ---- the loaders (one per file) --------------------------------------------------
 

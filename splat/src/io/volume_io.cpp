@@ -35,7 +35,9 @@ std::string sniff(const fs::path& p) {
     return "";
 }
 
-void applyNonFinitePolicy(Volume& v, NonFinitePolicy policy, const std::string& what) {
+}  // namespace
+
+void detail::applyNonFinitePolicy(Volume& v, NonFinitePolicy policy, const std::string& what) {
     std::size_t count = 0, first = 0;
     for (std::size_t i = 0; i < v.data.size(); ++i)
         if (!std::isfinite(v.data[i])) {
@@ -53,6 +55,8 @@ void applyNonFinitePolicy(Volume& v, NonFinitePolicy policy, const std::string& 
     if (!v.note.empty()) v.note += "; ";
     v.note += std::to_string(count) + " NaN/Inf samples replaced by 0";
 }
+
+namespace {
 
 Volume loadByType(const fs::path& p, const std::string& ext, const LoadOptions& options) {
     if (ext == ".nii" || ext == ".nii.gz" || ext == ".hdr" || ext == ".img")
@@ -119,7 +123,7 @@ Volume loadVolume(const std::string& spec, const LoadOptions& options) {
             }
         }
     }
-    applyNonFinitePolicy(v, options.nonFinite, spec);
+    detail::applyNonFinitePolicy(v, options.nonFinite, spec);
     // Background value b (issue 21): a loader that read it from the file said so; otherwise
     // the common rule, and synthetic volumes (made around an empty 0) keep 0.
     if (v.backgroundSource == Volume{}.backgroundSource) {

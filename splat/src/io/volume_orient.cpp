@@ -38,34 +38,37 @@ glm::dmat3 nearestRotation(const glm::dmat3& A) {
 
 }  // namespace
 
-void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
-                      const std::string& what) {
+AxisMap axisMapOf(const glm::dmat3& M, const std::string& source, const std::string& what) {
+    AxisMap m;
     glm::dvec3 u[3];
-    double len[3];
     for (int a = 0; a < 3; ++a) {
-        len[a] = glm::length(M[a]);
-        if (!std::isfinite(len[a]) || len[a] <= 0)
-            throw Error(v.source + ": " + what + " has a zero or invalid direction for axis " +
+        m.length[a] = glm::length(M[a]);
+        if (!std::isfinite(m.length[a]) || m.length[a] <= 0)
+            throw Error(source + ": " + what + " has a zero or invalid direction for axis " +
                         std::to_string(a));
-        u[a] = M[a] / len[a];
+        u[a] = M[a] / m.length[a];
     }
     // Best of the six permutations: perm[a] is the world axis of file axis a.
-    std::array<int, 3> perm{0, 1, 2}, best = perm;
+    std::array<int, 3> perm{0, 1, 2};
     double bestScore = -1;
     do {
         double score = 0;
         for (int a = 0; a < 3; ++a) score += std::abs(u[a][perm[a]]);
         if (score > bestScore + 1e-12) {
             bestScore = score;
-            best = perm;
+            m.axis = perm;
         }
     } while (std::next_permutation(perm.begin(), perm.end()));
+    for (int a = 0; a < 3; ++a) m.sign[a] = u[a][m.axis[a]] < 0 ? -1 : 1;
+    return m;
+}
 
-    int sign[3];
-    for (int a = 0; a < 3; ++a) {
-        double c = u[a][best[a]];
-        sign[a] = c < 0 ? -1 : 1;
-    }
+void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
+                      const std::string& what) {
+    const AxisMap map = axisMapOf(M, v.source, what);
+    const std::array<int, 3>& best = map.axis;
+    const int* sign = map.sign;
+    const double* len = map.length;
 
     const glm::ivec3 fileDims = v.dims;
     glm::ivec3 dims;
@@ -79,7 +82,7 @@ void applyOrientation(Volume& v, const glm::dmat3& M, const glm::dvec3& t,
 
     bool identity =
         best == std::array<int, 3>{0, 1, 2} && sign[0] > 0 && sign[1] > 0 && sign[2] > 0;
-    if (!identity) {
+    if (!identity && !v.data.empty()) {  // no samples: the geometry alone
         std::vector<float> out(v.data.size());
         const std::size_t nx = std::size_t(dims.x), ny = std::size_t(dims.y);
         // Destination index step (in samples) and start for one step along each file axis.

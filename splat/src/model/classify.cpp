@@ -212,7 +212,8 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                           float(glm::length(gradientAt(volume, i, j, k))) * invMaxGradient);
     };
     const bool clips = options.clipping.enabled();
-    const glm::dvec3 clipMargin = radius * volume.spacing;
+    const glm::dvec3 clipMargin =
+        (options.clipMargin > 0 ? options.clipMargin : radius) * volume.spacing;
     const bool labelled = options.labels && options.labels->enabled;
     const bool intensity = !labelled || options.labels->volume != nullptr;
     std::vector<std::uint16_t> shown;

@@ -18,6 +18,8 @@ bool keepsNear(const Clipping& c, const glm::dvec3& x, const glm::dvec3& margin)
     return true;
 }
 
+double clipReach(double radius) { return std::sqrt(3.0) * (radius + 0.5); }
+
 bool containsBox(const Clipping& c, const glm::dvec3& lo, const glm::dvec3& hi) {
     for (int n = 0; n < 8; ++n) {
         const glm::dvec3 corner(n & 1 ? hi.x : lo.x, n & 2 ? hi.y : lo.y, n & 4 ? hi.z : lo.z);

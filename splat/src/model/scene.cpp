@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "frame/frame.h"
+#include "model/clip_region.h"
 #include "model/level_of_detail.h"
 #include "model/scene_impl.h"
 #include "reference/field.h"
@@ -194,6 +195,10 @@ Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
     options.gradients = needsGradients();
     if (s.mode == RenderMode::Dvr) options.edges = s.edges;
     options.clipping = s.clipping;
+    // The axis-aligned sheets hold whole kernels: every voxel a kept sheet pixel sees
+    // (model/clip_region.h); the image-aligned slabs and the reference cut the field along
+    // the ray, where a kernel farther than R from the region adds nothing kept.
+    if (s.renderer == RendererKind::Axis) options.clipMargin = clipReach(kernel.radius());
     options.compactEmission = true;
     if (s.labels.enabled) {
         if (s.mode != RenderMode::Dvr || s.classification != Classification::Pre)
