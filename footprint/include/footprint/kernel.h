@@ -72,6 +72,12 @@ class Kernel {
     /// Normalised kernel value at distance u (voxels); 0 for |u| >= R (and for NaN).
     double operator()(double u) const;
 
+    /// The kernel's second moment along one axis, integral of u_x^2 h(u) over R^3 (voxels^2):
+    /// the variance of its footprint along any screen direction (Gaussian: sigma^2 less the
+    /// taper's share, 0.3834 for the defaults; B-spline of scale s: 0.2444 s^2... see tests).
+    /// EWA resampling (ellipse.h, ewaFootprint) widens footprints by this variance.
+    double variance() const;
+
     /// max |sum_i h(p - p_i) - 1| over p in a unit cell of the integer lattice, sampled
     /// on a `samples`^3 grid over [0, 1/2]^3 (by the lattice's reflection symmetry this
     /// covers the whole cell, corners and centre included): the partition-of-unity ripple.

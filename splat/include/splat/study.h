@@ -10,7 +10,8 @@
 //
 // Knobs (names as on the command line, `--sweep NAME=V1,V2,...`):
 //   per frame (one Scene serves them):  renderer, slab, early-termination, size (WxH or N),
-//                                       order, lod
+//                                       order, lod, ewa (off|on|auto), pixel-filter (the
+//                                       reference is filtered through it too)
 //   per Scene (a new Scene per value):  classify, kernel, sigma, radius, footprint-res,
 //                                       slab-radial-res, slab-depth-res, poly-tol
 #include <cmath>

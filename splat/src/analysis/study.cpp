@@ -111,6 +111,8 @@ std::string referenceKey(const RenderSettings& s, const StudyOptions& o) {
       << '|' << s.camera.fovDeg << '|' << s.camera.distance << '|' << o.referenceStep << '|'
       << o.referenceTolerance << '|' << s.background.r << ',' << s.background.g << ','
       << s.background.b << ',' << s.background.a;
+    if (s.quality.pixelFilter > 0)
+        k << "|pixel-filter " << s.quality.pixelFilter << ',' << s.quality.pixelFilterTolerance;
     return k.str();
 }
 
@@ -181,7 +183,9 @@ std::vector<std::string> studyKnobNames() {
             "slab-radial-res",
             "slab-depth-res",
             "poly-tol",
-            "lod"};
+            "lod",
+            "ewa",
+            "pixel-filter"};
 }
 
 bool isSceneKnob(const std::string& n) {
@@ -229,6 +233,10 @@ void applyKnob(RenderSettings& s, const std::string& n, const std::string& v) {
         q.polynomialTolerance = parseNumber(n, v);
     else if (n == "lod")
         q.lod = parseNumber(n, v);
+    else if (n == "ewa")
+        q.ewa = parseEwa(v);
+    else if (n == "pixel-filter")
+        q.pixelFilter = parseNumber(n, v);
     else {
         std::string all;
         for (const auto& k : studyKnobNames()) all += (all.empty() ? "" : ", ") + k;
@@ -371,6 +379,9 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         r.camera = frame.camera;
         r.quality.referenceStep = options.referenceStep;
         r.quality.referenceTolerance = options.referenceTolerance;
+        // The reference is filtered through the frame's pixel filter (a swept one as well).
+        r.quality.pixelFilter = frame.quality.pixelFilter;
+        r.quality.pixelFilterTolerance = frame.quality.pixelFilterTolerance;
         const std::string key = referenceKey(r, options);
         auto it = references.find(key);
         if (it != references.end()) return it->second;
@@ -453,6 +464,9 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         frame.quality.referenceTolerance = s.quality.referenceTolerance;
         frame.quality.tileSize = s.quality.tileSize;
         frame.quality.lod = s.quality.lod;
+        frame.quality.ewa = s.quality.ewa;
+        frame.quality.pixelFilter = s.quality.pixelFilter;
+        frame.quality.pixelFilterTolerance = s.quality.pixelFilterTolerance;
         point.settings = frame;
         if (auto done = journaled.find(point.label()); done != journaled.end()) {
             // Measured by an interrupted run: its figures are kept, and its references
