@@ -125,6 +125,13 @@ TEST_CASE("pixel filter: the filtered image converges as the rays per pixel doub
     CHECK(compareImages(im, filtered[3]).rmse < 1e-6);
 }
 
+TEST_CASE("kernel: the per-axis variance of the kernels", "[ewa][kernel]") {
+    CHECK(footprint::Kernel::defaultKernel().variance() == Approx(0.32789).epsilon(1e-4));
+    CHECK(footprint::Kernel::cubicBSpline(1.0).variance() == Approx(0.3).epsilon(1e-6));
+    CHECK(footprint::Kernel::cubicBSpline(2.0).variance() == Approx(1.2).epsilon(1e-6));
+    CHECK(footprint::Kernel::gaussian(1.0, 6.0).variance() == Approx(1.0).epsilon(1e-5));
+}
+
 TEST_CASE("ewa: footprint parameters are the Gaussian convolved with the low-pass",
           "[ewa][footprint]") {
     // A sheared, anisotropic footprint; the model: the kernel as a Gaussian of variance k2.

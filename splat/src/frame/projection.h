@@ -47,11 +47,12 @@ struct FootprintFilter {
     }
 };
 
-/// The frame's footprint filter from Quality::ewa and Quality::pixelFilter: on, or (auto)
-/// while a voxel of `volume` (the grid of the splats: a level of detail's) covers fewer than
-/// Quality::kEwaAutoPixels pixels (voxelPixels, model/level_of_detail.h).
+/// The frame's footprint filter from Quality::ewa and Quality::pixelFilter: on, or (auto) in
+/// the modes where it was measured to lower the error against the pixel-filtered reference
+/// (ewaAutoApplies) while a voxel of `volume` (the grid of the splats: a level of detail's)
+/// covers fewer than Quality::kEwaAutoPixels pixels (voxelPixels, model/level_of_detail.h).
 FootprintFilter footprintFilter(const footprint::Kernel& kernel, const Quality& quality,
-                                const Camera& camera, const Volume& volume);
+                                RenderMode mode, const Camera& camera, const Volume& volume);
 
 struct ProjectedSplats {
     std::vector<float> sx, sy;  ///< continuous pixel position of the centre

@@ -50,10 +50,10 @@ Emission shade(const Scene::Impl& scene, const Camera& camera, FrameWorkspace& w
 
 /// Stage "project": screen positions, depths and footprint ellipses of every splat.
 void project(const Scene::Impl& scene, const Camera& camera, const Quality& quality,
-             FrameWorkspace& work, RenderStats& stats) {
+             RenderMode mode, FrameWorkspace& work, RenderStats& stats) {
     const auto start = Clock::now();
     projectSplats(scene.splats, camera, scene.volume->spacing, scene.kernel.radius(), work.proj,
-                  footprintFilter(scene.kernel, quality, camera, *scene.volume));
+                  footprintFilter(scene.kernel, quality, mode, camera, *scene.volume));
     stats.projectMs = msSince(start);
 }
 
@@ -128,9 +128,9 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
     const Splatter& splatter =
         s.renderer == RendererKind::Axis ? axisAlignedSplatter() : imageAlignedSplatter();
     const WorkspaceLease work(scene);
-    stats.ewaSigma = footprintFilter(scene.kernel, s.quality, camera, *scene.volume).lowPass;
+    stats.ewaSigma = footprintFilter(scene.kernel, s.quality, s.mode, camera, *scene.volume).lowPass;
     const Emission e = shade(scene, camera, *work, stats);
-    if (!splatter.streams()) project(scene, camera, s.quality, *work, stats);
+    if (!splatter.streams()) project(scene, camera, s.quality, s.mode, *work, stats);
     const SheetPlan plan = order(splatter, scene, camera, s, *work, stats);
     if (!splatter.streams()) bin(camera, s, *work, stats);
     PolicyContext ctx = policyContext(scene, camera, s);
