@@ -73,8 +73,8 @@ class Kernel {
     double operator()(double u) const;
 
     /// The kernel's second moment along one axis, integral of u_x^2 h(u) over R^3 (voxels^2):
-    /// the variance of its footprint along any screen direction (Gaussian: sigma^2 less the
-    /// taper's share, 0.3834 for the defaults; B-spline of scale s: 0.2444 s^2... see tests).
+    /// the variance of its footprint along any screen direction (default Gaussian: 0.3279,
+    /// sigma^2 = 0.4225 less the taper's share; B-spline of scale s: 0.3 s^2; tests/test_ewa).
     /// EWA resampling (ellipse.h, ewaFootprint) widens footprints by this variance.
     double variance() const;
 

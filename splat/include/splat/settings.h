@@ -32,8 +32,8 @@ enum class RendererKind { Axis, Sheet, Reference };
 enum class RenderMode { Dvr, Mip, Xray, Iso };
 enum class Classification { Pre, Post };
 enum class CompositeOrder { FrontToBack, BackToFront };
-/// EWA resampling in the splatters (Quality::ewa): off, on, or on while a voxel covers fewer
-/// than Quality::kEwaAutoPixels pixels.
+/// EWA resampling in the splatters (Quality::ewa): off, on, or (auto) on in xray while a
+/// voxel covers fewer than Quality::kEwaAutoPixels pixels.
 enum class Ewa { Off, On, Auto };
 
 /// Blinn-Phong shading, one model for every renderer and mode (splat/DESIGN.md "Shading"):
@@ -121,12 +121,15 @@ struct Quality {
     /// Pixel filter, a Gaussian of this standard deviation in pixels truncated at 4 sigma
     /// (README "Aliasing and EWA"). Reference ray caster: 0 samples each pixel at its centre;
     /// > 0 supersamples s x s rays per pixel (s = 2, 4, 8, 16) and filters, doubling s until
-    /// the filtered image's RMS change is below pixelFilterTolerance. Splatters: the EWA
-    /// low-pass (0: kEwaDefaultSigma). 0..4.
+    /// the filtered image's RMS change, relative to its largest value, is below
+    /// pixelFilterTolerance. Splatters: the EWA low-pass (0: kEwaDefaultSigma). 0..4.
     double pixelFilter = 0;
     double pixelFilterTolerance = 2e-4;
     /// EWA resampling in the splatters (Zwicker et al. 2001): each footprint convolved with
-    /// the Gaussian pixel filter, energy kept (footprint/ellipse.h, ewaFootprint).
+    /// the Gaussian pixel filter, energy kept (footprint/ellipse.h, ewaFootprint). Auto: on in
+    /// xray while a voxel covers fewer than kEwaAutoPixels pixels (measured to lower the error
+    /// against the filtered reference there, and to raise it in dvr). The command line's
+    /// default is auto; the library's stays off.
     Ewa ewa = Ewa::Off;
     /// The EWA low-pass when pixelFilter is 0, pixels (pbrt-v4's Gaussian pixel filter).
     static constexpr double kEwaDefaultSigma = 0.5;
@@ -196,7 +199,8 @@ struct RenderStats {
     int lodLevel = 0;
     std::size_t lodSplats = 0;
     /// Reference with a pixel filter (Quality::pixelFilter): rays per pixel along each axis
-    /// of the last pass, and the RMS change of the filtered image from the pass before.
+    /// of the last pass, and the RMS change of the filtered image from the pass before,
+    /// relative to its largest value.
     int pixelSamples = 0;
     double pixelFilterChange = 0;
     /// Splatters: the EWA low-pass sigma the footprints were convolved with (0: off).
