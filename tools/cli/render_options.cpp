@@ -78,7 +78,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool imageOutput) {
               q);
     addOption(cmd, "--ewa", a.ewa,
               "splatters: EWA resampling, footprints convolved with the pixel filter: off | on | "
-              "auto (the default: on in xray while a voxel covers fewer than 1 pixel)",
+              "auto (on in xray while a voxel covers fewer than 1 pixel); default off",
               q);
     addTechniqueOptions(cmd, a.technique, imageOutput);
     if (imageOutput)

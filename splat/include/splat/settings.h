@@ -128,8 +128,8 @@ struct Quality {
     /// EWA resampling in the splatters (Zwicker et al. 2001): each footprint convolved with
     /// the Gaussian pixel filter, energy kept (footprint/ellipse.h, ewaFootprint). Auto: on in
     /// xray while a voxel covers fewer than kEwaAutoPixels pixels (measured to lower the error
-    /// against the filtered reference there, and to raise it in dvr). The command line's
-    /// default is auto; the library's stays off.
+    /// against the filtered reference there, and to raise it in dvr). Default off (README
+    /// "Aliasing and EWA").
     Ewa ewa = Ewa::Off;
     /// The EWA low-pass when pixelFilter is 0, pixels (pbrt-v4's Gaussian pixel filter).
     static constexpr double kEwaDefaultSigma = 0.5;
