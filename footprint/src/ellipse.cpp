@@ -82,4 +82,43 @@ EllipticalFootprint perspectiveFootprint(const glm::dvec3& spacing, const glm::d
     return ellipticalFootprint(spacing, axisX, axisY, w, radius);
 }
 
+EllipticalFootprint ewaFootprint(const EllipticalFootprint& e, double kernelVariance,
+                                 double lowPass, double radius) {
+    if (!(kernelVariance > 0) || !std::isfinite(kernelVariance))
+        throw std::invalid_argument("ewaFootprint: kernel variance must be positive");
+    if (!(lowPass >= 0) || !std::isfinite(lowPass) || !(radius > 0) || !std::isfinite(radius))
+        throw std::invalid_argument("ewaFootprint: low-pass and radius must be finite, >= 0");
+    if (lowPass == 0 || e.scale == 0) return e;
+    const double k2 = kernelVariance, l2 = lowPass * lowPass;
+    const double a = e.a, b = e.b, c = e.c;
+    const double det = a * double(e.gamma);  // a c - b^2 without cancellation
+    // Sigma = k^2 M^-1, Sigma' = Sigma + l^2 I.
+    const double sxx = k2 * c / det, syy = k2 * a / det, sxy = -k2 * b / det;
+    const double pxx = sxx + l2, pyy = syy + l2;
+    const double detS = k2 * k2 / det;
+    const double detP = pxx * pyy - sxy * sxy;  // >= detS > 0 (all terms added are positive)
+    EllipticalFootprint w = e;
+    // M' = k^2 Sigma'^-1.
+    w.a = float(k2 * pyy / detP);
+    w.b = float(-k2 * sxy / detP);
+    w.c = float(k2 * pxx / detP);
+    w.beta = float(-sxy / pyy);
+    w.gamma = float(k2 / pyy);
+    w.scale = float(double(e.scale) * std::sqrt(detS / detP));
+    // halfWidth = R sqrt(c' / det') = R sqrt(Sigma'_xx) / k.
+    const double k = std::sqrt(k2);
+    w.halfWidth = float(radius * std::sqrt(pxx) / k);
+    w.halfHeight = float(radius * std::sqrt(pyy) / k);
+    // Depth: u = Sigma g^T, g' = u^T Sigma'^-1, conditional variance as in the header.
+    const double gx = e.tx, gy = e.ty;
+    const double ux = sxx * gx + sxy * gy, uy = sxy * gx + syy * gy;
+    const double qx = (pyy * ux - sxy * uy) / detP, qy = (pxx * uy - sxy * ux) / detP;
+    const double ds = e.depthScale;
+    const double var = k2 / (ds * ds) + (gx * ux + gy * uy) - (ux * qx + uy * qy);
+    w.tx = float(qx);
+    w.ty = float(qy);
+    w.depthScale = float(k / std::sqrt(var));
+    return w;
+}
+
 }  // namespace footprint

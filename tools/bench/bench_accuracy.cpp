@@ -2,7 +2,7 @@
 //
 //   bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] [--classify pre|post]
 //                  [--azimuths 0,30,45] [--elevation E] [--early-termination EPS]
-//                  [--lod L] [--supersample N]
+//                  [--lod L] [--supersample N] [--pixel-filter SIGMA] [--ewa]
 //
 // VOLUME defaults to synthetic:phantom:64, TF to ct-soft. For each azimuth renders the
 // reference, the axis-aligned splatter and the image-aligned splatter with slabs of 1, 0.5
@@ -14,6 +14,13 @@
 // (Quality::lod) and their level. --supersample N renders the reference with N x N rays per
 // pixel (at N times the size) and box-filters it: the pixel's area average rather than its
 // centre's value.
+//
+// --pixel-filter SIGMA also renders the pixel-filtered reference (Quality::pixelFilter: s x s
+// rays per pixel through a Gaussian of SIGMA pixels, converged; README "Aliasing and EWA") and
+// gives every row two sets of columns: RMSE against the point-sampled reference (one ray at
+// each pixel centre, the columns above) and RMSE, PSNR and max abs against the filtered one.
+// The splatters' rows are without EWA (Quality::ewa off); --ewa adds the axis-aligned and
+// slab-1 image-aligned splatters with EWA on (low-pass SIGMA, or 0.5 pixels).
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -36,6 +43,7 @@ struct Config {
     RendererKind kind;
     double slab;
     double lod = 0;
+    Ewa ewa = Ewa::Off;
 };
 
 std::vector<double> parseList(const std::string& s) {
@@ -50,7 +58,8 @@ void usage() {
     std::fprintf(stderr,
                  "usage: bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] "
                  "[--classify pre|post] [--azimuths 0,30,45] [--elevation E] "
-                 "[--early-termination EPS] [--lod L] [--supersample N]\n");
+                 "[--early-termination EPS] [--lod L] [--supersample N] [--pixel-filter SIGMA] "
+                 "[--ewa]\n");
 }
 
 }  // namespace
@@ -60,7 +69,8 @@ int main(int argc, char** argv) {
         std::string volumeSpec = "synthetic:phantom:64", tf = "ct-soft", mode = "dvr",
                     classify = "pre";
         int size = 256, supersample = 1;
-        double earlyTermination = -1, lod = 0, elevation = 0;
+        double earlyTermination = -1, lod = 0, elevation = 0, pixelFilter = 0;
+        bool ewa = false;
         std::vector<double> azimuths = {0, 30, 45};
         std::vector<std::string> positional;
         for (int a = 1; a < argc; ++a) {
@@ -85,6 +95,10 @@ int main(int argc, char** argv) {
                 lod = std::stod(value());
             else if (arg == "--elevation")
                 elevation = std::stod(value());
+            else if (arg == "--pixel-filter")
+                pixelFilter = std::stod(value());
+            else if (arg == "--ewa")
+                ewa = true;
             else if (arg == "-h" || arg == "--help") {
                 usage();
                 return 0;
@@ -103,6 +117,8 @@ int main(int argc, char** argv) {
         if (size < 1) throw std::runtime_error("--size must be >= 1");
         if (supersample < 1 || supersample > 16)
             throw std::runtime_error("--supersample must be between 1 and 16");
+        if (!(pixelFilter >= 0 && pixelFilter <= 4))
+            throw std::runtime_error("--pixel-filter must be between 0 and 4 pixels");
 
         const Volume volume = loadVolume(volumeSpec);
         const VolumeStats vs = volumeStats(volume);
@@ -115,6 +131,8 @@ int main(int argc, char** argv) {
         base.camera.width = base.camera.height = size;
         base.camera.elevationDeg = elevation;
         if (earlyTermination >= 0) base.quality.earlyTermination = earlyTermination;
+        base.quality.pixelFilter = pixelFilter;
+        base.quality.ewa = Ewa::Off;
 
         std::vector<Config> configs = {{"axis", RendererKind::Axis, 1.0},
                                        {"sheet, slab 1", RendererKind::Sheet, 1.0},
@@ -127,6 +145,11 @@ int main(int argc, char** argv) {
             std::snprintf(label, sizeof label, "sheet, slab 1, lod %g", lod);
             configs.insert(configs.begin() + 3, {label, RendererKind::Sheet, 1.0, lod});
         }
+        if (ewa) {
+            configs.insert(configs.begin() + 1, {"axis, EWA", RendererKind::Axis, 1.0, 0, Ewa::On});
+            configs.insert(configs.begin() + 3,
+                           {"sheet, slab 1, EWA", RendererKind::Sheet, 1.0, 0, Ewa::On});
+        }
         std::printf(
             "Accuracy against the reference ray caster: %s, %dx%d, %s %s, transfer "
             "function %s, default kernel and reference settings (step %g voxels, "
@@ -135,12 +158,25 @@ int main(int argc, char** argv) {
             volumeSpec.c_str(), size, size, mode.c_str(), classify.c_str(), tf.c_str(),
             base.quality.referenceStep, base.quality.referenceTolerance, supersample, supersample,
             base.quality.earlyTermination);
-        std::printf("| azimuth | renderer | RMSE | PSNR (dB) | max abs | ms/frame |\n");
-        std::printf("|---:|---|---:|---:|---:|---:|\n");
+        if (pixelFilter > 0) {
+            std::printf(
+                "Columns 'point': against the point-sampled reference (one ray per pixel "
+                "centre); 'filtered': against the reference through a Gaussian pixel filter of "
+                "sigma %g pixels (tolerance %g).\n\n",
+                pixelFilter, base.quality.pixelFilterTolerance);
+            std::printf(
+                "| azimuth | renderer | RMSE point | RMSE filtered | PSNR filtered (dB) | max abs "
+                "filtered | ms/frame |\n");
+            std::printf("|---:|---|---:|---:|---:|---:|---:|\n");
+        } else {
+            std::printf("| azimuth | renderer | RMSE | PSNR (dB) | max abs | ms/frame |\n");
+            std::printf("|---:|---|---:|---:|---:|---:|\n");
+        }
         for (double az : azimuths) {
             RenderSettings rs = base;
             rs.renderer = RendererKind::Reference;
             rs.camera.azimuthDeg = az;
+            rs.quality.pixelFilter = 0;
             RenderStats refStats;
             const int n = supersample;
             if (n > 1) {  // N x N rays per pixel: the same view at N times the size
@@ -161,14 +197,35 @@ int main(int argc, char** argv) {
             const double refMs =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count();
-            std::printf("| %g | reference (final step %g) | – | – | – | %.0f |\n", az,
-                        refStats.referenceStep, refMs);
+            Image filtered;
+            if (pixelFilter > 0) {
+                RenderSettings fs = base;
+                fs.renderer = RendererKind::Reference;
+                fs.camera.azimuthDeg = az;
+                RenderStats fst;
+                const auto f0 = std::chrono::steady_clock::now();
+                filtered = Renderer(volume, fs).render(&fst);
+                const double fMs = std::chrono::duration<double, std::milli>(
+                                       std::chrono::steady_clock::now() - f0)
+                                       .count();
+                std::printf("| %g | reference (final step %g) | – | – | – | – | %.0f |\n", az,
+                            refStats.referenceStep, refMs);
+                const ImageMetrics fm = compareImages(ref, filtered);
+                std::printf(
+                    "| %g | filtered reference (%d x %d rays per pixel, last change %.2g) | – | "
+                    "%.3g | %.1f | %.3g | %.0f |\n",
+                    az, fst.pixelSamples, fst.pixelSamples, fst.pixelFilterChange, fm.rmse,
+                    fm.psnr, fm.maxAbs, fMs);
+            } else
+                std::printf("| %g | reference (final step %g) | – | – | – | %.0f |\n", az,
+                            refStats.referenceStep, refMs);
             std::fflush(stdout);
             for (const Config& c : configs) {
                 RenderSettings s = base;
                 s.renderer = c.kind;
                 s.quality.slab = c.slab;
                 s.quality.lod = c.lod;
+                s.quality.ewa = c.ewa;
                 s.camera.azimuthDeg = az;
                 const Renderer renderer(volume, s);
                 renderer.render();  // warm-up (first-touch allocations, the level of detail)
@@ -179,13 +236,17 @@ int main(int argc, char** argv) {
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a)
                         .count();
                 const ImageMetrics m = compareImages(im, ref);
-                std::printf(
-                    "| %g | %s | %.3g | %.1f | %.3g | %.1f |\n", az,
-                    (c.label + (st.lodLevel ? " (level " + std::to_string(st.lodLevel) + ", " +
-                                                  std::to_string(st.lodSplats) + " splats)"
-                                            : ""))
-                        .c_str(),
-                    m.rmse, m.psnr, m.maxAbs, ms);
+                const std::string label =
+                    c.label + (st.lodLevel ? " (level " + std::to_string(st.lodLevel) + ", " +
+                                                 std::to_string(st.lodSplats) + " splats)"
+                                           : "");
+                if (pixelFilter > 0) {
+                    const ImageMetrics f = compareImages(im, filtered);
+                    std::printf("| %g | %s | %.3g | %.3g | %.1f | %.3g | %.1f |\n", az,
+                                label.c_str(), m.rmse, f.rmse, f.psnr, f.maxAbs, ms);
+                } else
+                    std::printf("| %g | %s | %.3g | %.1f | %.3g | %.1f |\n", az, label.c_str(),
+                                m.rmse, m.psnr, m.maxAbs, ms);
                 std::fflush(stdout);
             }
         }

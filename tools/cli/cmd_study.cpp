@@ -79,7 +79,7 @@ void registerStudy(CLI::App& app) {
     addOption(*cmd, "--sweep", a->sweeps,
               "KNOB=V1,V2,... (repeatable): renderer, slab, early-termination, size, order, "
               "classify, kernel, sigma, radius, footprint-res, slab-radial-res, slab-depth-res, "
-              "poly-tol, lod",
+              "poly-tol, lod, ewa, pixel-filter",
               st);
     addOption(*cmd, "--repeats", a->repeats, "timed frames per setting and view", st);
     addOption(*cmd, "--warmup", a->warmup, "untimed frames before them", st);

@@ -47,6 +47,15 @@ void dropIgnoredOptions(RenderArgs& a, const RenderSettings& s, const RenderUse&
             drop("lod", a.lod != d.lod,
                  "--lod applies to the splatters, not to the reference renderer",
                  [&] { a.lod = d.lod; });
+            drop("ewa", a.ewa != d.ewa,
+                 "--ewa applies to the splatters, not to the reference renderer "
+                 "(use --pixel-filter)",
+                 [&] { a.ewa = d.ewa; });
+        } else if (s.quality.ewa == Ewa::Off) {
+            drop("pixel-filter", a.pixelFilter != d.pixelFilter,
+                 "--pixel-filter applies to the reference and to --ewa on|auto, not to " +
+                     renderer + " with --ewa off",
+                 [&] { a.pixelFilter = d.pixelFilter; });
         }
     }
     if (s.mode != RenderMode::Dvr)

@@ -71,6 +71,15 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool imageOutput) {
               "splatters: level of detail, pixels per voxel below which 2x2x2 voxels are "
               "merged into one splat of twice the size, repeatedly (0..64; 0 = off)",
               q);
+    addOption(cmd, "--pixel-filter", a.pixelFilter,
+              "Gaussian pixel filter sigma in pixels (0..4): the reference supersamples and "
+              "filters through it (0 = one ray at each pixel centre); the splatters' EWA "
+              "low-pass (0 = 0.5)",
+              q);
+    addOption(cmd, "--ewa", a.ewa,
+              "splatters: EWA resampling, footprints convolved with the pixel filter: off | on | "
+              "auto (on in xray while a voxel covers fewer than 1 pixel); default off",
+              q);
     addTechniqueOptions(cmd, a.technique, imageOutput);
     if (imageOutput)
         addOption(cmd, "--window", a.window,
@@ -189,6 +198,13 @@ RenderSettings parseSettings(const RenderArgs& a) {
     s.quality.tileSize = a.tileSize;
     requireIn(a.lod, 0, 64, "--lod (pixels per voxel; 0 = off)");
     s.quality.lod = a.lod;
+    requireIn(a.pixelFilter, 0, 4, "--pixel-filter (sigma in pixels; 0 = point sampling)");
+    s.quality.pixelFilter = a.pixelFilter;
+    try {
+        s.quality.ewa = parseEwa(a.ewa);
+    } catch (const Error& e) {
+        throw Error(std::string("--ewa: ") + e.what());
+    }
     requireIn(a.refStep, 1e-3, 64, "--ref-step (voxels)");
     if (!std::isfinite(a.refTolerance) || !(a.refTolerance > 0) || a.refTolerance > 1)
         throw Error("--ref-tolerance must be a finite number in (0, 1]");

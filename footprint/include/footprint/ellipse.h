@@ -28,6 +28,22 @@
 // with J axisX = (1, 0), J axisY = (0, 1). The centre pixel's value is then exact; the
 // error off-centre grows with the kernel's angular size (see tests/test_ellipse.cpp).
 //
+// EWA resampling (Zwicker, Pfister, van Baar, Gross 2001, section 5): when a voxel projects
+// to less than a pixel its footprint is narrower than the pixel spacing and the image,
+// sampled at pixel centres, aliases. The resampling filter is the footprint convolved with
+// a screen-space Gaussian low-pass of covariance l^2 I (pixels^2). Seeing the footprint as a
+// Gaussian of variance k^2 in kernel units (k^2 = Kernel::variance()), its screen covariance
+// is Sigma = k^2 M^-1, M = [[a, b], [b, c]]; the filter's is Sigma' = Sigma + l^2 I, and the
+// table is read through M' = k^2 Sigma'^-1 with the amplitude times sqrt(det Sigma / det
+// Sigma'), so the footprint's screen integral (its energy) is kept. For the Gaussian kernel
+// this is the exact convolution (up to its C1 taper: the tabulated profile is stretched, not
+// re-convolved); for other kernels it is the kernel's own profile stretched to the combined
+// covariance (variance exact, shape approximate). Slab sections: the kernel with the low-pass
+// added in the image plane is the Gaussian of covariance V + l^2 (screen axes), whose depth
+// given a screen offset has mean g Sigma Sigma'^-1 d (g = (tx, ty)) and variance
+// k^2 / depthScale^2 + g Sigma g^T - g Sigma Sigma'^-1 Sigma g^T: tx, ty and depthScale
+// become those (its depth extent along the view does not change).
+//
 // Numerics: for strongly anisotropic spacing (1:1000) the quadratic form is nearly
 // degenerate and a dx^2 + 2 b dx dy + c dy^2 in float loses up to (condition number) x
 // eps; r2() evaluates the completed square a (dx + beta dy)^2 + gamma dy^2 instead, whose
@@ -85,5 +101,13 @@ EllipticalFootprint perspectiveFootprint(const glm::dvec3& spacing, const glm::d
                                          const glm::dvec3& right, const glm::dvec3& up,
                                          const glm::dvec3& forward, double focal, double pixelSize,
                                          const glm::dvec3& centre, double radius);
+
+/// EWA resampling of footprint `e` (see above): the footprint of a kernel of per-axis
+/// variance `kernelVariance` (voxels^2, Kernel::variance()) convolved with a screen-space
+/// Gaussian low-pass of standard deviation `lowPass` (screen units). lowPass 0 returns `e`
+/// unchanged; an empty footprint (scale 0) stays empty. Throws std::invalid_argument on a
+/// non-positive variance or a negative or non-finite lowPass or radius.
+EllipticalFootprint ewaFootprint(const EllipticalFootprint& e, double kernelVariance,
+                                 double lowPass, double radius);
 
 }  // namespace footprint

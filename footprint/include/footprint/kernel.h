@@ -72,6 +72,12 @@ class Kernel {
     /// Normalised kernel value at distance u (voxels); 0 for |u| >= R (and for NaN).
     double operator()(double u) const;
 
+    /// The kernel's second moment along one axis, integral of u_x^2 h(u) over R^3 (voxels^2):
+    /// the variance of its footprint along any screen direction (default Gaussian: 0.3279,
+    /// sigma^2 = 0.4225 less the taper's share; B-spline of scale s: 0.3 s^2; tests/test_ewa).
+    /// EWA resampling (ellipse.h, ewaFootprint) widens footprints by this variance.
+    double variance() const;
+
     /// max |sum_i h(p - p_i) - 1| over p in a unit cell of the integer lattice, sampled
     /// on a `samples`^3 grid over [0, 1/2]^3 (by the lattice's reflection symmetry this
     /// covers the whole cell, corners and centre included): the partition-of-unity ripple.

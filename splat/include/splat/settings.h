@@ -32,6 +32,9 @@ enum class RendererKind { Axis, Sheet, Reference };
 enum class RenderMode { Dvr, Mip, Xray, Iso };
 enum class Classification { Pre, Post };
 enum class CompositeOrder { FrontToBack, BackToFront };
+/// EWA resampling in the splatters (Quality::ewa): off, on, or (auto) on in xray while a
+/// voxel covers fewer than Quality::kEwaAutoPixels pixels.
+enum class Ewa { Off, On, Auto };
 
 /// Blinn-Phong shading, one model for every renderer and mode (splat/DESIGN.md "Shading"):
 ///   c' = c (ambient + diffuse |n.l|) + specular |n.h|^shininess
@@ -115,6 +118,23 @@ struct Quality {
     /// of twice the size (Laur & Hanrahan). 0 = off: always the full-resolution list.
     /// 0..64.
     double lod = 0;
+    /// Pixel filter, a Gaussian of this standard deviation in pixels truncated at 4 sigma
+    /// (README "Aliasing and EWA"). Reference ray caster: 0 samples each pixel at its centre;
+    /// > 0 supersamples s x s rays per pixel (s = 2, 4, 8, 16) and filters, doubling s until
+    /// the filtered image's RMS change, relative to its largest value, is below
+    /// pixelFilterTolerance. Splatters: the EWA low-pass (0: kEwaDefaultSigma). 0..4.
+    double pixelFilter = 0;
+    double pixelFilterTolerance = 2e-4;
+    /// EWA resampling in the splatters (Zwicker et al. 2001): each footprint convolved with
+    /// the Gaussian pixel filter, energy kept (footprint/ellipse.h, ewaFootprint). Auto: on in
+    /// xray while a voxel covers fewer than kEwaAutoPixels pixels (measured to lower the error
+    /// against the filtered reference there, and to raise it in dvr). Default off (README
+    /// "Aliasing and EWA").
+    Ewa ewa = Ewa::Off;
+    /// The EWA low-pass when pixelFilter is 0, pixels (pbrt-v4's Gaussian pixel filter).
+    static constexpr double kEwaDefaultSigma = 0.5;
+    /// Ewa::Auto turns EWA on while a voxel covers fewer pixels than this (measured, README).
+    static constexpr double kEwaAutoPixels = 1.0;
 };
 
 struct RenderSettings {
@@ -178,6 +198,13 @@ struct RenderStats {
     /// level 0; 0 for frames of the reference ray caster).
     int lodLevel = 0;
     std::size_t lodSplats = 0;
+    /// Reference with a pixel filter (Quality::pixelFilter): rays per pixel along each axis
+    /// of the last pass, and the RMS change of the filtered image from the pass before,
+    /// relative to its largest value.
+    int pixelSamples = 0;
+    double pixelFilterChange = 0;
+    /// Splatters: the EWA low-pass sigma the footprints were convolved with (0: off).
+    double ewaSigma = 0;
 };
 
 /// The one enum <-> string table: names as used by the command line and scene files.
@@ -186,12 +213,14 @@ const char* toString(RenderMode);
 const char* toString(Classification);
 const char* toString(CompositeOrder);
 const char* toString(Projection);
+const char* toString(Ewa);
 /// Parse a name; throw splat::Error listing the accepted names otherwise.
 RendererKind parseRenderer(std::string_view);
 RenderMode parseMode(std::string_view);
 Classification parseClassification(std::string_view);
 CompositeOrder parseOrder(std::string_view);
 Projection parseProjection(std::string_view);
+Ewa parseEwa(std::string_view);
 
 /// One line per setting that does not apply to the chosen mode/classification (e.g.
 /// shading in xray): the command line prints them as warnings.

@@ -10,7 +10,8 @@
 //
 // Knobs (names as on the command line, `--sweep NAME=V1,V2,...`):
 //   per frame (one Scene serves them):  renderer, slab, early-termination, size (WxH or N),
-//                                       order, lod
+//                                       order, lod, ewa (off|on|auto), pixel-filter (the
+//                                       reference is filtered through it too)
 //   per Scene (a new Scene per value):  classify, kernel, sigma, radius, footprint-res,
 //                                       slab-radial-res, slab-depth-res, poly-tol
 #include <cmath>
@@ -100,10 +101,11 @@ struct StudyResult {
 };
 
 /// The settings of the study's reference frames: the base model (its scene knobs) with the
-/// reference ray caster at the options' step and tolerance, seen by `camera`. The processes
-/// of a frame farm (splat/frame_farm.h) render the references from a Scene of these.
+/// reference ray caster at the options' step and tolerance, seen by `camera`, filtered through
+/// `frame`'s pixel filter when given (else the base's). The processes of a frame farm
+/// (splat/frame_farm.h) render the references from a Scene of these.
 RenderSettings studyReferenceSettings(const RenderSettings& base, const StudyOptions& options,
-                                      const CameraParams& camera);
+                                      const CameraParams& camera, const Quality* frame = nullptr);
 
 /// Runs the study on `volume`. Throws splat::Error on bad knobs, splat::Cancelled when
 /// progress returns false. With a frame farm installed (splat/frame_farm.h, e.g. under

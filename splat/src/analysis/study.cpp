@@ -113,6 +113,8 @@ std::string referenceKey(const RenderSettings& s, const StudyOptions& o) {
       << '|' << s.camera.fovDeg << '|' << s.camera.distance << '|' << o.referenceStep << '|'
       << o.referenceTolerance << '|' << s.background.r << ',' << s.background.g << ','
       << s.background.b << ',' << s.background.a;
+    if (s.quality.pixelFilter > 0)
+        k << "|pixel-filter " << s.quality.pixelFilter << ',' << s.quality.pixelFilterTolerance;
     return k.str();
 }
 
@@ -183,7 +185,9 @@ std::vector<std::string> studyKnobNames() {
             "slab-radial-res",
             "slab-depth-res",
             "poly-tol",
-            "lod"};
+            "lod",
+            "ewa",
+            "pixel-filter"};
 }
 
 bool isSceneKnob(const std::string& n) {
@@ -231,6 +235,10 @@ void applyKnob(RenderSettings& s, const std::string& n, const std::string& v) {
         q.polynomialTolerance = parseNumber(n, v);
     else if (n == "lod")
         q.lod = parseNumber(n, v);
+    else if (n == "ewa")
+        q.ewa = parseEwa(v);
+    else if (n == "pixel-filter")
+        q.pixelFilter = parseNumber(n, v);
     else {
         std::string all;
         for (const auto& k : studyKnobNames()) all += (all.empty() ? "" : ", ") + k;
@@ -303,12 +311,16 @@ Image boxDownsample(const Image& img, int f) {
 }
 
 RenderSettings studyReferenceSettings(const RenderSettings& base, const StudyOptions& options,
-                                      const CameraParams& camera) {
+                                      const CameraParams& camera, const Quality* frame) {
     RenderSettings r = base;
     r.renderer = RendererKind::Reference;
     r.camera = camera;
     r.quality.referenceStep = options.referenceStep;
     r.quality.referenceTolerance = options.referenceTolerance;
+    if (frame) {  // the reference is filtered through the frame's pixel filter (a swept one too)
+        r.quality.pixelFilter = frame->pixelFilter;
+        r.quality.pixelFilterTolerance = frame->pixelFilterTolerance;
+    }
     return r;
 }
 
@@ -413,7 +425,8 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         return referenceScene->render(r);
     };
     auto referenceFor = [&](const RenderSettings& frame) -> const Image& {
-        const RenderSettings r = studyReferenceSettings(base, options, frame.camera);
+        const RenderSettings r =
+            studyReferenceSettings(base, options, frame.camera, &frame.quality);
         const std::string key = referenceKey(r, options);
         if (auto it = references.find(key); it != references.end()) return it->second;
         if (auto it = prefetched.find(key); it != prefetched.end()) {
@@ -438,7 +451,11 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
                 CameraParams c = view;
                 c.width = s.camera.width;
                 c.height = s.camera.height;
-                const RenderSettings r = studyReferenceSettings(base, options, c);
+                const RenderSettings r = studyReferenceSettings(base, options, c, &s.quality);
+                // The farm's Scenes render the base pixel filter; a swept one stays on rank 0.
+                if (r.quality.pixelFilter != base.quality.pixelFilter ||
+                    r.quality.pixelFilterTolerance != base.quality.pixelFilterTolerance)
+                    continue;
                 const std::string key = referenceKey(r, options);
                 if (prefetched.count(key)) continue;
                 if (std::optional<Image> img = cachedReference(r)) {
@@ -519,6 +536,9 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         frame.quality.referenceTolerance = s.quality.referenceTolerance;
         frame.quality.tileSize = s.quality.tileSize;
         frame.quality.lod = s.quality.lod;
+        frame.quality.ewa = s.quality.ewa;
+        frame.quality.pixelFilter = s.quality.pixelFilter;
+        frame.quality.pixelFilterTolerance = s.quality.pixelFilterTolerance;
         point.settings = frame;
         if (auto done = journaled.find(point.label()); done != journaled.end()) {
             // Measured by an interrupted run: its figures are kept, and its references

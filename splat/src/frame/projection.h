@@ -8,8 +8,10 @@
 #include <vector>
 
 #include "footprint/ellipse.h"
+#include "footprint/kernel.h"
 #include "splat/camera.h"
 #include "splat/classify.h"
+#include "splat/settings.h"
 
 namespace splat {
 
@@ -34,6 +36,24 @@ inline PixelRect footprintRect(float sx, float sy, const footprint::EllipticalFo
             int(std::min(fx1, float(width - 1))), int(std::min(fy1, float(height - 1)))};
 }
 
+/// EWA resampling of the footprints (footprint::ewaFootprint): the kernel's per-axis
+/// variance and the screen low-pass sigma in pixels; lowPass 0 leaves the footprints as they
+/// are (bit-identical to a frame without it).
+struct FootprintFilter {
+    double kernelVariance = 1, lowPass = 0;
+    footprint::EllipticalFootprint apply(const footprint::EllipticalFootprint& e,
+                                         double radius) const {
+        return lowPass > 0 ? footprint::ewaFootprint(e, kernelVariance, lowPass, radius) : e;
+    }
+};
+
+/// The frame's footprint filter from Quality::ewa and Quality::pixelFilter: on, or (auto) in
+/// the modes where it was measured to lower the error against the pixel-filtered reference
+/// (ewaAutoApplies) while a voxel of `volume` (the grid of the splats: a level of detail's)
+/// covers fewer than Quality::kEwaAutoPixels pixels (voxelPixels, model/level_of_detail.h).
+FootprintFilter footprintFilter(const footprint::Kernel& kernel, const Quality& quality,
+                                RenderMode mode, const Camera& camera, const Volume& volume);
+
 struct ProjectedSplats {
     std::vector<float> sx, sy;  ///< continuous pixel position of the centre
     std::vector<float> depth;   ///< world depth along the view direction
@@ -53,7 +73,7 @@ struct ProjectedSplats {
 /// allocate). Screen units are pixels: x right, y down. Splats behind a perspective eye get
 /// an empty rectangle.
 void projectSplats(const SplatList& splats, const Camera& camera, const glm::dvec3& spacing,
-                   double radius, ProjectedSplats& out);
+                   double radius, ProjectedSplats& out, const FootprintFilter& filter = {});
 
 /// Projects one splat at a time, for the splatters that project chunk by chunk (only the
 /// splats that are not hidden yet): the same screen positions and footprints as
@@ -61,7 +81,7 @@ void projectSplats(const SplatList& splats, const Camera& camera, const glm::dve
 class SplatProjector {
   public:
     SplatProjector(const SplatList& splats, const Camera& camera, const glm::dvec3& spacing,
-                   double radius);
+                   double radius, const FootprintFilter& filter = {});
     bool perspective() const { return perspective_; }
     /// The footprint every splat shares (orthographic views).
     const footprint::EllipticalFootprint& shared() const { return shared_; }
@@ -133,6 +153,7 @@ class SplatProjector {
     const Camera& camera_;
     glm::dvec3 spacing_;
     double radius_;
+    FootprintFilter filter_;
     bool perspective_;
     int width_, height_;
     double cx_, cy_;

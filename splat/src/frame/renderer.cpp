@@ -16,6 +16,7 @@
 #include "frame/projection.h"
 #include "frame/tile_binning.h"
 #include "model/level_of_detail.h"
+#include "reference/pixel_filter.h"
 #include "reference/reference_frame.h"
 #include "splat/error.h"
 #include "splatters/splatter.h"
@@ -48,10 +49,11 @@ Emission shade(const Scene::Impl& scene, const Camera& camera, FrameWorkspace& w
 }
 
 /// Stage "project": screen positions, depths and footprint ellipses of every splat.
-void project(const Scene::Impl& scene, const Camera& camera, FrameWorkspace& work,
-             RenderStats& stats) {
+void project(const Scene::Impl& scene, const Camera& camera, const Quality& quality,
+             RenderMode mode, FrameWorkspace& work, RenderStats& stats) {
     const auto start = Clock::now();
-    projectSplats(scene.splats, camera, scene.volume->spacing, scene.kernel.radius(), work.proj);
+    projectSplats(scene.splats, camera, scene.volume->spacing, scene.kernel.radius(), work.proj,
+                  footprintFilter(scene.kernel, quality, mode, camera, *scene.volume));
     stats.projectMs = msSince(start);
 }
 
@@ -129,8 +131,9 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
     const Splatter& splatter =
         s.renderer == RendererKind::Axis ? axisAlignedSplatter() : imageAlignedSplatter();
     const WorkspaceLease work(scene);
+    stats.ewaSigma = footprintFilter(scene.kernel, s.quality, s.mode, camera, *scene.volume).lowPass;
     const Emission e = shade(scene, camera, *work, stats);
-    if (!splatter.streams()) project(scene, camera, *work, stats);
+    if (!splatter.streams()) project(scene, camera, s.quality, s.mode, *work, stats);
     const SheetPlan plan = order(splatter, scene, camera, s, *work, stats);
     if (!splatter.streams()) bin(camera, s, *work, stats);
     PolicyContext ctx = policyContext(scene, camera, s);
@@ -177,6 +180,26 @@ Image referenceFrame(const Scene::Impl& scene, const Camera& camera, const Rende
     const ReferenceField field(*scene.volume, lit, scene.kernel, FieldLayout::Emission);
     return renderReference(*scene.volume, field, camera, s, &stats, depth,
                            scene.splats.gradientScale, labelLookup(scene));
+}
+
+/// The reference through the Gaussian pixel filter (Quality::pixelFilter, pixel_filter.h);
+/// an iso depth image stays point-sampled (a filtered depth is no surface's depth).
+Image filteredReferenceFrame(const Scene::Impl& scene, const Camera& camera,
+                             const RenderSettings& s, RenderStats& stats, Image* depth) {
+    RenderStats fine;
+    const PixelFilterResult r = filteredImage(
+        camera, s.quality.pixelFilter, s.quality.pixelFilterTolerance,
+        [&](const CameraParams& p) {
+            return referenceFrame(scene, Camera(p, *scene.volume), s, fine, nullptr);
+        });
+    stats.referenceStep = fine.referenceStep;
+    stats.pixelSamples = r.samples;
+    stats.pixelFilterChange = r.change;
+    if (depth) {
+        RenderStats centre;
+        (void)referenceFrame(scene, camera, s, centre, depth);
+    }
+    return r.image;
 }
 
 /// True when a perspective frame has a kernel whose bounding sphere comes within two of its
@@ -231,6 +254,10 @@ void validateFrame(const RenderSettings& s) {
     if (q.tileSize < 8 || q.tileSize > 64) throw Error("tile size must be between 8 and 64 pixels");
     if (!(q.lod >= 0 && q.lod <= 64))
         throw Error("level of detail threshold must be between 0 (off) and 64 pixels per voxel");
+    if (!(q.pixelFilter >= 0 && q.pixelFilter <= 4))
+        throw Error("pixel filter sigma must be between 0 (point sampling) and 4 pixels");
+    if (!(q.pixelFilterTolerance > 0) || !std::isfinite(q.pixelFilterTolerance))
+        throw Error("pixel filter tolerance must be a positive number");
     if (s.threads < 0 || s.threads > 1024)
         throw Error("thread count must be between 0 (all) and 1024");
     if (!(q.referenceStep > 0) || !(q.referenceTolerance > 0))
@@ -261,7 +288,9 @@ Image renderFrame(const Scene::Impl& scene, const RenderSettings& given, RenderS
                                        ? scene
                                        : levelOfDetail(scene, camera, s.quality.lod);
         if (s.renderer == RendererKind::Reference) {
-            image = referenceFrame(scene, camera, s, local, depth);
+            image = s.quality.pixelFilter > 0
+                        ? filteredReferenceFrame(scene, camera, s, local, depth)
+                        : referenceFrame(scene, camera, s, local, depth);
         } else if (needsExactPath(level, camera)) {
             image = referenceFrame(scene, camera, s, local, depth);
             local.exactPixels = std::size_t(camera.width()) * std::size_t(camera.height());

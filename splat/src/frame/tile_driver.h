@@ -344,8 +344,10 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
         return std::chrono::duration<double, std::milli>(b - a).count();
     };
     const TileGrid g(in.camera.width(), in.camera.height(), in.settings.quality.tileSize);
-    const SplatProjector projector(in.scene.splats, in.camera, in.scene.volume->spacing,
-                                   in.scene.kernel.radius());
+    const SplatProjector projector(
+        in.scene.splats, in.camera, in.scene.volume->spacing, in.scene.kernel.radius(),
+        footprintFilter(in.scene.kernel, in.settings.quality, in.settings.mode, in.camera,
+                        *in.scene.volume));
     const std::vector<float> pathScale = perspectivePathScale(in.camera, in.plan.normal);
     constexpr bool surface = kSurfacePolicy<Policy>;
     const bool cull = Policy::kTerminates && in.settings.order == CompositeOrder::FrontToBack &&

@@ -26,6 +26,7 @@ constexpr Names<CompositeOrder, 2> kOrders{
     {{CompositeOrder::FrontToBack, "ftb"}, {CompositeOrder::BackToFront, "btf"}}};
 constexpr Names<Projection, 2> kProjections{
     {{Projection::Orthographic, "ortho"}, {Projection::Perspective, "perspective"}}};
+constexpr Names<Ewa, 3> kEwas{{{Ewa::Off, "off"}, {Ewa::On, "on"}, {Ewa::Auto, "auto"}}};
 
 template <class E, std::size_t N>
 const char* nameOf(const Names<E, N>& names, E value) {
@@ -52,6 +53,8 @@ const char* toString(RenderMode v) { return nameOf(kModes, v); }
 const char* toString(Classification v) { return nameOf(kClassifications, v); }
 const char* toString(CompositeOrder v) { return nameOf(kOrders, v); }
 const char* toString(Projection v) { return nameOf(kProjections, v); }
+const char* toString(Ewa v) { return nameOf(kEwas, v); }
+Ewa parseEwa(std::string_view s) { return parseName(kEwas, s, "EWA setting"); }
 RendererKind parseRenderer(std::string_view s) { return parseName(kRenderers, s, "renderer"); }
 RenderMode parseMode(std::string_view s) { return parseName(kModes, s, "mode"); }
 Classification parseClassification(std::string_view s) {
