@@ -1,8 +1,12 @@
 // Sort-last compositing, splat's direct-send against IceT (issue 26, README "Beyond one
 // machine" -> "Memory, scaling and a model"). Under `mpirun -np P` every rank holds one
-// partial RGBA float image of W x H with premultiplied colour (a deterministic synthetic
-// "brick" image: a soft disc, different per rank, transparent outside it, as a brick's
-// projection is) and all ranks share one visibility order. The images are composited
+// partial RGBA float image of W x H with premultiplied colour and all ranks share one
+// visibility order. The partial images are either synthetic (a soft disc, different per
+// rank, transparent outside it, as a brick's projection is) or, with --volume SPEC, the
+// real partial images of splat's bricked render: rank 0 renders SPEC in P bricks
+// (renderBricked, axis splatter, transfer function gray-ramp, azimuth 30, elevation 15),
+// keeps the partial images and the k-d visibility order that renderBricked hands to its
+// BrickGroup, and sends brick b's image to rank b. The images are composited
 //   (a) by splat::mpi's BrickGroup::composite (the code `splat render --bricks` runs:
 //       MPI_Alltoallv of row strips, each strip composited front to back, MPI_Gatherv to
 //       rank 0), called as it is, one brick per rank;
@@ -16,7 +20,7 @@
 // figure the median over the repetitions. Bytes sent per rank: splat's from its message
 // sizes (sent only, the same definition as IceT's), IceT's from ICET_BYTES_SENT.
 //
-//   mpirun -np P icet_compare [--size N] [--reps R] [--coverage F]
+//   mpirun -np P icet_compare [--size N] [--reps R] [--coverage F] [--volume SPEC]
 // prints one JSON object per line on rank 0: {"P", "size", "method", "median_ms",
 // "bytes_sent_max", "bytes_sent_mean", "max_abs"}.
 #include <IceT.h>
@@ -36,6 +40,9 @@
 #include "splat/image.h"
 #include "splat/mpi/brick_group.h"
 #include "splat/mpi/session.h"
+#include "splat/settings.h"
+#include "splat/transfer.h"
+#include "splat/volume_io.h"
 
 namespace {
 
@@ -79,6 +86,60 @@ std::uint64_t directSendBytes(int rank, int ranks, int n) {
     return row * (std::uint64_t(n) - own) + (rank == 0 ? 0 : row * own);
 }
 
+/// One process holding every brick that keeps the partial images and the order renderBricked
+/// composites them in.
+class KeepingGroup : public splat::LocalBrickGroup {
+  public:
+    std::vector<std::pair<int, splat::Image>> partials;
+    std::vector<int> order;
+    splat::Image composite(std::vector<std::pair<int, splat::Image>>& p,
+                           const std::vector<int>& frontToBack, int width, int height,
+                           splat::RenderMode mode, const glm::vec4& background,
+                           std::uint64_t* bytes) override {
+        partials = p;
+        order = frontToBack;
+        return LocalBrickGroup::composite(p, frontToBack, width, height, mode, background, bytes);
+    }
+};
+
+/// Rank 0 renders `spec` in `ranks` bricks at n x n; every rank gets its brick's partial
+/// image, every rank the visibility order.
+splat::Image brickImage(const std::string& spec, int rank, int ranks, int n,
+                        std::vector<int>& order) {
+    splat::Image mine(n, n);
+    order.assign(std::size_t(ranks), 0);
+    if (rank == 0) {
+        splat::RenderSettings s;
+        s.renderer = splat::RendererKind::Axis;
+        s.mode = splat::RenderMode::Dvr;
+        s.camera.width = s.camera.height = n;
+        s.camera.azimuthDeg = 30;
+        s.camera.elevationDeg = 15;
+        s.transfer = splat::TransferFunction::preset("gray-ramp");
+        s.quality.earlyTermination = 0;
+        bool alone = false;
+        const splat::Volume geometry = splat::volumeGeometry(spec, {}, &alone);
+        KeepingGroup group;
+        splat::renderBricked(
+            geometry,
+            [&](const splat::Brick& b) {
+                return splat::loadVolumeBrick(spec, {}, b.loadLo, b.loadHi);
+            },
+            s, ranks, group, nullptr);
+        order = group.order;
+        for (auto& [b, image] : group.partials) {
+            if (b == 0)
+                mine = image;
+            else
+                MPI_Send(&image.pixels[0].x, 4 * n * n, MPI_FLOAT, b, 7, MPI_COMM_WORLD);
+        }
+    } else {
+        MPI_Recv(&mine.pixels[0].x, 4 * n * n, MPI_FLOAT, 0, 7, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    }
+    MPI_Bcast(order.data(), ranks, MPI_INT, 0, MPI_COMM_WORLD);
+    return mine;
+}
+
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     const std::size_t m = v.size() / 2;
@@ -95,7 +156,8 @@ struct Result {
 double maxAbs(const float* got, const splat::Image& want) {
     double m = 0;
     for (std::size_t i = 0; i < want.pixels.size(); ++i)
-        for (int c = 0; c < 4; ++c) m = std::max(m, double(std::fabs(got[4 * i + c] - want.pixels[i][c])));
+        for (int c = 0; c < 4; ++c)
+            m = std::max(m, double(std::fabs(got[4 * i + c] - want.pixels[i][c])));
     return m;
 }
 
@@ -113,30 +175,45 @@ int main(int argc, char** argv) {
     splat::mpi::Session session(&argc, &argv);
     int n = 256, reps = 15;
     float coverage = 0.7f;
+    std::string volume;
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string a = argv[i];
-        if (a == "--size") n = std::atoi(argv[i + 1]);
-        else if (a == "--reps") reps = std::atoi(argv[i + 1]);
-        else if (a == "--coverage") coverage = float(std::atof(argv[i + 1]));
+        if (a == "--size")
+            n = std::atoi(argv[i + 1]);
+        else if (a == "--reps")
+            reps = std::atoi(argv[i + 1]);
+        else if (a == "--coverage")
+            coverage = float(std::atof(argv[i + 1]));
+        else if (a == "--volume")
+            volume = argv[i + 1];
     }
     const int rank = session.rank(), ranks = session.size();
-    const splat::Image mine = partialImage(rank, ranks, n, coverage);
-    const std::vector<int> order = frontToBack(ranks);
+    std::vector<int> order = frontToBack(ranks);
+    const splat::Image mine = volume.empty() ? partialImage(rank, ranks, n, coverage)
+                                             : brickImage(volume, rank, ranks, n, order);
     const glm::vec4 transparent(0.0f);
 
-    // The reference: every partial image on every rank, composited in one process.
+    // The reference: every rank's partial image composited in one process, on rank 0.
     splat::Image reference;
+    std::vector<splat::Image> all(rank == 0 ? std::size_t(ranks) : 0, splat::Image(n, n));
+    if (rank == 0) all[0] = mine;
+    for (int r = 1; r < ranks; ++r) {
+        if (rank == r) MPI_Send(&mine.pixels[0].x, 4 * n * n, MPI_FLOAT, 0, 8, MPI_COMM_WORLD);
+        if (rank == 0)
+            MPI_Recv(&all[std::size_t(r)].pixels[0].x, 4 * n * n, MPI_FLOAT, r, 8, MPI_COMM_WORLD,
+                     MPI_STATUS_IGNORE);
+    }
     if (rank == 0) {
-        std::vector<splat::Image> all;
-        for (int r = 0; r < ranks; ++r) all.push_back(partialImage(r, ranks, n, coverage));
         std::vector<const splat::Image*> ordered;
         for (int r : order) ordered.push_back(&all[std::size_t(r)]);
         reference = splat::compositeBricks(ordered, splat::RenderMode::Dvr, transparent);
+        all.clear();
     }
 
-    auto timeIt = [&](auto&& call) {
+    auto timeIt = [&](auto&& prepare, auto&& call) {
         std::vector<double> ms;
         for (int k = 0; k < reps; ++k) {
+            prepare();
             MPI_Barrier(MPI_COMM_WORLD);
             const double t0 = MPI_Wtime();
             call();
@@ -159,12 +236,16 @@ int main(int argc, char** argv) {
         auto group = splat::mpi::makeBrickGroup(session);
         splat::Image out;
         Result r;
-        r.medianMs = timeIt([&] {
-            std::vector<std::pair<int, splat::Image>> partials;
-            partials.emplace_back(rank, mine);  // composite() consumes its partials
-            out = group->composite(partials, order, n, n, splat::RenderMode::Dvr, transparent,
-                                   nullptr);
-        });
+        std::vector<std::pair<int, splat::Image>> partials;
+        r.medianMs = timeIt(
+            [&] {
+                partials.clear();
+                partials.emplace_back(rank, mine);  // composite() consumes its partials
+            },
+            [&] {
+                out = group->composite(partials, order, n, n, splat::RenderMode::Dvr, transparent,
+                                       nullptr);
+            });
         bytesOver(double(directSendBytes(rank, ranks, n)), r);
         if (rank == 0) r.maxAbs = maxAbs(&out.pixels[0].x, reference);
         if (rank == 0) print(ranks, n, "splat direct-send", r);
@@ -207,13 +288,14 @@ int main(int argc, char** argv) {
         IceTImage image;
         double bytes = 0;
         Result r;
-        r.medianMs = timeIt([&] {
-            image = icetCompositeImage(&mine.pixels[0].x, nullptr, viewport, identity, identity,
-                                       background);
-            IceTInt sent = 0;
-            icetGetIntegerv(ICET_BYTES_SENT, &sent);
-            bytes = double(sent);
-        });
+        r.medianMs = timeIt([] {},
+                            [&] {
+                                image = icetCompositeImage(&mine.pixels[0].x, nullptr, viewport,
+                                                           identity, identity, background);
+                                IceTInt sent = 0;
+                                icetGetIntegerv(ICET_BYTES_SENT, &sent);
+                                bytes = double(sent);
+                            });
         bytesOver(bytes, r);
         if (rank == 0) r.maxAbs = maxAbs(icetImageGetColorcf(image), reference);
         if (rank == 0) print(ranks, n, v.name, r);
