@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "cli_util.h"
+#include "image_diff.h"
 #include "splat/bricks.h"
 #include "splat/camera.h"
 #include "splat/error.h"
@@ -13,22 +14,9 @@
 #include "splat/volume_io.h"
 
 using namespace splat;
+using namespace splat::test;
 
 namespace {
-
-float peakOf(const Image& im) {
-    float m = 0;
-    for (const glm::vec4& p : im.pixels) m = std::max({m, p.r, p.g, p.b, p.a});
-    return m;
-}
-
-float maxDiff(const Image& a, const Image& b) {
-    REQUIRE(a.pixels.size() == b.pixels.size());
-    float m = 0;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i)
-        for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(a.pixels[i][c] - b.pixels[i][c]));
-    return m;
-}
 
 Volume cropOf(const Volume& v, const glm::ivec3& lo, const glm::ivec3& hi) {
     Volume c;

@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.h"
+#include "image_diff.h"
+#include "mpi_util.h"
 #include "splat/image_io.h"
 
 using namespace splat;
@@ -16,29 +18,6 @@ using namespace splat::test;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// True when `mpirun` is OpenMPI's (it needs --oversubscribe for more ranks than cores;
-/// MPICH's hydra oversubscribes by itself and has no such option).
-bool openMpi() {
-    static const bool yes =
-        runProgram("mpirun", {"--version"}).out.find("Open MPI") != std::string::npos;
-    return yes;
-}
-
-/// `mpirun [--oversubscribe] -np N splat ARGS`, killed after 120 s (a hang fails the test).
-RunResult mpirun(int n, std::vector<std::string> args) {
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-    ::setenv("OMPI_MCA_btl", "self,vader", 0);  // one machine: shared memory, no network probe
-    // Containers often forbid the cross-memory attach of OpenMPI's shared-memory transport.
-    ::setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
-    std::vector<std::string> a = {"-s", "KILL", "120", "mpirun"};
-    if (openMpi()) a.push_back("--oversubscribe");
-    for (const std::string& s : {std::string("-np"), std::to_string(n), std::string(SPLAT_EXE)})
-        a.push_back(s);
-    a.insert(a.end(), args.begin(), args.end());
-    return runProgram("timeout", a);
-}
 
 std::string bytesOf(const fs::path& p) { return readTextFile(p); }
 
@@ -51,20 +30,6 @@ void requireSameFiles(const fs::path& a, const fs::path& b) {
         REQUIRE(fs::exists(b / n));
         CHECK(bytesOf(a / n) == bytesOf(b / n));
     }
-}
-
-float peakOf(const Image& im) {
-    float m = 0;
-    for (const glm::vec4& p : im.pixels) m = std::max({m, p.r, p.g, p.b, p.a});
-    return m;
-}
-
-float maxDiff(const Image& a, const Image& b) {
-    REQUIRE(a.pixels.size() == b.pixels.size());
-    float m = 0;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i)
-        for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(a.pixels[i][c] - b.pixels[i][c]));
-    return m;
 }
 
 }  // namespace
@@ -116,7 +81,7 @@ TEST_CASE("mpi: rotate on 2 and 3 ranks writes the one-process frames, GIF and c
     };
     for (int n : {2, 3}) {
         fs::remove_all(out);
-        const RunResult r = mpirun(n, args);
+        const RunResult r = mpirunSplat(n, args);
         INFO(n << " ranks: " << r.err);
         REQUIRE(r.status == 0);
         CHECK(r.errLines().empty());
@@ -127,7 +92,7 @@ TEST_CASE("mpi: rotate on 2 and 3 ranks writes the one-process frames, GIF and c
     fs::remove(out / "frame_0005.png");
     auto resumed = args;
     resumed.push_back("--resume");
-    const RunResult r = mpirun(2, resumed);
+    const RunResult r = mpirunSplat(2, resumed);
     INFO(r.err);
     REQUIRE(r.status == 0);
     CHECK(r.out.find("wrote 2 frames") != std::string::npos);
@@ -138,7 +103,7 @@ TEST_CASE("mpi: rotate on 2 and 3 ranks writes the one-process frames, GIF and c
         "-o",     (dir / "two").string()};
     REQUIRE(runSplat(two).status == 0);
     moveTo(dir / "two", dir / "two_one");
-    REQUIRE(mpirun(3, two).status == 0);
+    REQUIRE(mpirunSplat(3, two).status == 0);
     requireSameFiles(dir / "two_one", dir / "two");
 }
 
@@ -155,7 +120,7 @@ TEST_CASE("mpi: popping on 3 ranks finds what one process finds", "[.mpi]") {
     const RunResult one = runSplat(args);
     REQUIRE(one.status == 0);
     moveTo(dir / "pop", dir / "pop_one");
-    const RunResult three = mpirun(3, args);
+    const RunResult three = mpirunSplat(3, args);
     INFO(three.err);
     REQUIRE(three.status == 0);
     CHECK(bytesOf(dir / "pop_one" / "metrics.csv") == bytesOf(dir / "pop" / "metrics.csv"));
@@ -206,7 +171,7 @@ TEST_CASE("mpi: a bricked render on 2 and 3 ranks matches one process within 1e-
         const Image one = readImage((dir / (mode + "_one.exr")).string());
         for (int n : {2, 3}) {
             const std::string out = mode + "_np" + std::to_string(n) + ".exr";
-            const RunResult r = mpirun(n, args(out));
+            const RunResult r = mpirunSplat(n, args(out));
             INFO(mode << " on " << n << " ranks: " << r.err);
             REQUIRE(r.status == 0);
             CHECK(maxDiff(one, readImage((dir / out).string())) <= 1e-5f * peakOf(one));
@@ -231,7 +196,7 @@ TEST_CASE("mpi: a bricked render on 2 and 3 ranks matches one process within 1e-
                                                (dir / ("axis_" + mode + ".exr")).string()};
         REQUIRE(runSplat(args).status == 0);
         const Image one = readImage((dir / ("axis_" + mode + ".exr")).string());
-        const RunResult r = mpirun(3, args);
+        const RunResult r = mpirunSplat(3, args);
         INFO(r.err);
         REQUIRE(r.status == 0);
         CHECK(maxDiff(one, readImage((dir / ("axis_" + mode + ".exr")).string())) <=
@@ -259,7 +224,7 @@ TEST_CASE("mpi: a bricked render on 2 and 3 ranks matches one process within 1e-
     const Image one = readImage((dir / "blob_one.exr").string());
     for (const auto& [n, bricks] : std::vector<std::pair<int, std::string>>{{3, "5"}, {3, "2"}}) {
         const std::string out = "blob_" + std::to_string(n) + "_" + bricks + ".exr";
-        const RunResult r = mpirun(n, args(out, bricks));
+        const RunResult r = mpirunSplat(n, args(out, bricks));
         INFO(r.err);
         REQUIRE(r.status == 0);
         CHECK(maxDiff(one, readImage((dir / out).string())) <= 1e-5f * peakOf(one));
@@ -277,7 +242,7 @@ TEST_CASE("mpi: a failing rank ends the job with one error on rank 0, no output,
         for (int n = 0; n < 6 * 5 * 25; ++n) out.put(char(n % 200));
     }
     const fs::path png = dir / "out.png";
-    const RunResult r = mpirun(3, {"render", raw.string(), "--background-value", "0", "--size",
+    const RunResult r = mpirunSplat(3, {"render", raw.string(), "--background-value", "0", "--size",
                                    "24x24", "-o", png.string()});
     INFO(r.err);
     CHECK(r.status != 0);
@@ -293,7 +258,7 @@ TEST_CASE("mpi: a failing rank ends the job with one error on rank 0, no output,
     CHECK(!fs::exists(png));
     // A bad option fails on every rank alike: one error line, usage status.
     const RunResult u =
-        mpirun(2, {"rotate", "synthetic:blob:8", "--frames", "0", "-o", (dir / "never").string()});
+        mpirunSplat(2, {"rotate", "synthetic:blob:8", "--frames", "0", "-o", (dir / "never").string()});
     CHECK(u.status != 0);
     int usage = 0;
     for (const std::string& line : u.errLines()) usage += line.rfind("splat: error: ", 0) == 0;

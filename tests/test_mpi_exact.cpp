@@ -8,6 +8,8 @@
 #include <regex>
 
 #include "cli_util.h"
+#include "image_diff.h"
+#include "mpi_util.h"
 #include "splat/image_io.h"
 
 using namespace splat;
@@ -15,34 +17,6 @@ using namespace splat::test;
 namespace fs = std::filesystem;
 
 namespace {
-
-RunResult mpirunSplat(int n, std::vector<std::string> args) {
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-    ::setenv("OMPI_MCA_btl", "self,vader", 0);
-    ::setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
-    std::vector<std::string> a = {"-s", "KILL", "120", "mpirun"};
-    if (runProgram("mpirun", {"--version"}).out.find("Open MPI") != std::string::npos)
-        a.push_back("--oversubscribe");
-    for (const std::string& s : {std::string("-np"), std::to_string(n), std::string(SPLAT_EXE)})
-        a.push_back(s);
-    a.insert(a.end(), args.begin(), args.end());
-    return runProgram("timeout", a);
-}
-
-float peakOf(const Image& im) {
-    float m = 0;
-    for (const glm::vec4& p : im.pixels) m = std::max({m, p.r, p.g, p.b, p.a});
-    return m;
-}
-
-float maxDiff(const Image& a, const Image& b) {
-    REQUIRE(a.pixels.size() == b.pixels.size());
-    float m = 0;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i)
-        for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(a.pixels[i][c] - b.pixels[i][c]));
-    return m;
-}
 
 /// The bytes rank 0 reports it exchanged.
 unsigned long long rank0Bytes(const std::string& out) {

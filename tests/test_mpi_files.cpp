@@ -9,6 +9,8 @@
 #include <fstream>
 
 #include "cli_util.h"
+#include "image_diff.h"
+#include "mpi_util.h"
 #include "deflate_util.h"
 #include "footprint/kernel.h"
 #include "splat/brick_budget.h"
@@ -21,35 +23,6 @@ using namespace splat::test;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// `mpirun [--oversubscribe] -np N splat ARGS` as tests/test_mpi.cpp starts it.
-RunResult mpirunSplat(int n, std::vector<std::string> args) {
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-    ::setenv("OMPI_MCA_btl", "self,vader", 0);
-    ::setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
-    std::vector<std::string> a = {"-s", "KILL", "120", "mpirun"};
-    if (runProgram("mpirun", {"--version"}).out.find("Open MPI") != std::string::npos)
-        a.push_back("--oversubscribe");
-    for (const std::string& s : {std::string("-np"), std::to_string(n), std::string(SPLAT_EXE)})
-        a.push_back(s);
-    a.insert(a.end(), args.begin(), args.end());
-    return runProgram("timeout", a);
-}
-
-float maxDiffOf(const Image& a, const Image& b) {
-    REQUIRE(a.pixels.size() == b.pixels.size());
-    float m = 0;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i)
-        for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(a.pixels[i][c] - b.pixels[i][c]));
-    return m;
-}
-
-float peak(const Image& im) {
-    float m = 0;
-    for (const glm::vec4& p : im.pixels) m = std::max({m, p.r, p.g, p.b, p.a});
-    return m;
-}
 
 }  // namespace
 
@@ -85,7 +58,7 @@ TEST_CASE("mpi: bricks read from NRRD files, K chosen from --rank-memory", "[.mp
             const RunResult r = mpirunSplat(n, args(out, "150.18"));
             INFO(file << " on " << n << " ranks: " << r.err << r.out);
             REQUIRE(r.status == 0);
-            CHECK(maxDiffOf(one, readImage((dir / out).string())) <= 1e-5f * peak(one));
+            CHECK(maxDiff(one, readImage((dir / out).string())) <= 1e-5f * peakOf(one));
             BrickBudget b;
             b.rankBytes = std::uint64_t(150.18 * 1048576.0);
             b.ranks = n;

@@ -9,26 +9,13 @@
 #include <sstream>
 
 #include "cli_util.h"
+#include "mpi_util.h"
 #include "splat/image_io.h"
 
 using namespace splat::test;
 namespace fs = std::filesystem;
 
 namespace {
-
-RunResult mpirunStudy(int n, std::vector<std::string> args) {
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-    ::setenv("OMPI_MCA_btl", "self,vader", 0);
-    ::setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
-    std::vector<std::string> a = {"-s", "KILL", "120", "mpirun"};
-    if (runProgram("mpirun", {"--version"}).out.find("Open MPI") != std::string::npos)
-        a.push_back("--oversubscribe");
-    for (const std::string& s : {std::string("-np"), std::to_string(n), std::string(SPLAT_EXE)})
-        a.push_back(s);
-    a.insert(a.end(), args.begin(), args.end());
-    return runProgram("timeout", a);
-}
 
 /// study.csv without the columns that time or weigh the run (and the Pareto mark, which
 /// follows the times).
@@ -70,7 +57,7 @@ TEST_CASE("mpi: study on 2 ranks measures what one process measures", "[.mpi]") 
     const RunResult one = runSplat(args("one"));
     INFO(one.err);
     REQUIRE(one.status == 0);
-    const RunResult two = mpirunStudy(2, args("np2"));
+    const RunResult two = mpirunSplat(2, args("np2"));
     INFO(two.err);
     REQUIRE(two.status == 0);
     const auto a = untimedCsv(dir / "one" / "study.csv"), b = untimedCsv(dir / "np2" / "study.csv");
