@@ -54,14 +54,22 @@ TEST_CASE("mpi: rotate --bricks on 2 ranks writes the one-process frames", "[.mp
     fs::remove_all(dir);
     for (const std::string renderer : {"reference", "axis", "sheet"}) {
         auto args = [&](const std::string& out) {
-            return std::vector<std::string>{"rotate",     "synthetic:phantom:23",
-                                            "--renderer", renderer,
-                                            "--size",     "34x30",
-                                            "--frames",   "3",
-                                            "--format",   "exr",
-                                            "--early-termination", "0",
-                                            "--ref-tolerance", "1e-7",
-                                            "-q",         "-o",
+            return std::vector<std::string>{"rotate",
+                                            "synthetic:phantom:23",
+                                            "--renderer",
+                                            renderer,
+                                            "--size",
+                                            "34x30",
+                                            "--frames",
+                                            "3",
+                                            "--format",
+                                            "exr",
+                                            "--early-termination",
+                                            "0",
+                                            "--ref-tolerance",
+                                            "1e-7",
+                                            "-q",
+                                            "-o",
                                             (dir / (renderer + out)).string()};
         };
         REQUIRE(runSplat(args("_one")).status == 0);
@@ -89,10 +97,9 @@ TEST_CASE("mpi: rotate --bricks on 2 ranks writes the one-process frames", "[.mp
         << "NRRD0004\ntype: float\ndimension: 3\nsizes: 20 20 20\nendian: little\n"
            "encoding: raw\n\n"
         << data;
-    const RunResult bad =
-        mpirunSplat(2, {"rotate", (dir / "short.nrrd").string(), "--bricks", "2", "--frames",
-                        "2", "--size", "16x16", "--background-value", "0", "-q", "-o",
-                        (dir / "short").string()});
+    const RunResult bad = mpirunSplat(
+        2, {"rotate", (dir / "short.nrrd").string(), "--bricks", "2", "--frames", "2", "--size",
+            "16x16", "--background-value", "0", "-q", "-o", (dir / "short").string()});
     CHECK(bad.status == 1);
     CHECK(bad.err.find("splat: error:") != std::string::npos);
     CHECK(!fs::exists(dir / "short" / "frame_0000.png"));

@@ -17,8 +17,8 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <regex>
 
 #include "bricked_render.h"
@@ -265,9 +265,9 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
         warn(
             "--renderer sheet with --brick-composite fast is approximate where its slabs cross a "
             "brick face (README \"Beyond one machine\"); --brick-composite exact is not");
-    BrickedFrames frames(geometry, brickLoader(a.volume), settings, bricks, group,
-                         a.brickComposite == "exact" ? BrickComposite::Exact
-                                                     : BrickComposite::Fast);
+    BrickedFrames frames(
+        geometry, brickLoader(a.volume), settings, bricks, group,
+        a.brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
     std::size_t todo = 0, done = 0;
     for (bool k : keep) todo += k ? 0 : 1;
     std::string failure;
@@ -300,9 +300,8 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
             "%.1f ms once; render %.1f ms, composite %.1f ms, exchanged %llu bytes over %zu "
             "frames\n",
             r, all[r].rendered, all[r].bricks, all[r].samplesLoaded,
-            all[r].samplesLoaded * 4.0 / 1048576.0, all[r].loadMs, all[r].sceneMs,
-            all[r].renderMs, all[r].compositeMs,
-            static_cast<unsigned long long>(all[r].bytesExchanged), todo);
+            all[r].samplesLoaded * 4.0 / 1048576.0, all[r].loadMs, all[r].sceneMs, all[r].renderMs,
+            all[r].compositeMs, static_cast<unsigned long long>(all[r].bytesExchanged), todo);
 }
 }  // namespace
 
@@ -388,8 +387,8 @@ void registerRotate(CLI::App& app) {
             if (a->bricks < 0 || a->bricks > 4096)
                 throw Error("--bricks must be between 0 and 4096");
             if (a->brickComposite != "exact" && a->brickComposite != "fast")
-                throw Error("--brick-composite must be exact or fast (got '" +
-                            a->brickComposite + "')");
+                throw Error("--brick-composite must be exact or fast (got '" + a->brickComposite +
+                            "')");
             if (!(a->rankMemory >= 0 && a->rankMemory <= 1e9))
                 throw Error("--rank-memory must be between 0 and 1e9 MiB");
         });
@@ -470,9 +469,10 @@ void registerRotate(CLI::App& app) {
                 checkExtraOutput(a->contact, "--contact-sheet");
                 checkExtraOutput(a->mp4, "--mp4");
                 if (keepImages &&
-                    double(a->frames) * settings.camera.width * settings.camera.height > double(1 << 28))
-                    throw Error("--gif/--contact-sheet with " + std::to_string(a->frames) + " frames of " +
-                                a->render.size +
+                    double(a->frames) * settings.camera.width * settings.camera.height >
+                        double(1 << 28))
+                    throw Error("--gif/--contact-sheet with " + std::to_string(a->frames) +
+                                " frames of " + a->render.size +
                                 " would not fit in memory; use fewer frames or a smaller --size");
                 keep = prepareFolder(*a, manifest, settings.camera.width, settings.camera.height);
                 beginRun(*cmd);
@@ -483,7 +483,8 @@ void registerRotate(CLI::App& app) {
                 }
                 std::error_code ec;
                 fs::create_directories(a->outDir, ec);
-                if (!fs::is_directory(a->outDir)) throw Error(a->outDir + ": cannot create output folder");
+                if (!fs::is_directory(a->outDir))
+                    throw Error(a->outDir + ": cannot create output folder");
 
                 // The display window (mip, xray) is fixed by the first frame a folder gets, and
                 // kept in the manifest so that resumed frames match.

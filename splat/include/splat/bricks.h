@@ -208,6 +208,11 @@ class BrickedFrames {
     /// The frame seen by `camera` (the constructor's settings otherwise), on process 0
     /// (others: empty).
     Image render(const CameraParams& camera);
+    /// The same with `renderer` (popping's renderers): each renderer has its own Scenes of
+    /// the bricks (built at its first frame, sharing the bricks' samples). `stats`: this
+    /// process's splats, the axis-aligned splatter's sheet axis and sign (the whole frame's:
+    /// they follow the view) and the milliseconds.
+    Image render(const CameraParams& camera, RendererKind renderer, RenderStats* stats = nullptr);
     /// This process's work so far (construction and every render).
     const BrickStats& stats() const { return st_; }
     /// The settings with the transfer function and iso level resolved (the whole volume's).
@@ -216,6 +221,10 @@ class BrickedFrames {
 
   private:
     std::shared_ptr<const Scene> scene(int index, const RenderSettings& bs);
+    Image renderFrame(const CameraParams& camera, RendererKind renderer, RenderStats& stats);
+    bool exact(RendererKind renderer) const {
+        return renderer == RendererKind::Sheet && composite_ == BrickComposite::Exact;
+    }
     Volume loadBrick(int b);
 
     Volume geometry_;
@@ -224,9 +233,12 @@ class BrickedFrames {
     BrickLayout layout_;
     std::vector<int> mine_;
     RenderSettings s_;
-    bool exactSheets_ = false, keep_ = true;
-    std::vector<std::shared_ptr<const Volume>> volumes_;  ///< mine_'s, until their Scene
-    std::vector<std::shared_ptr<const Scene>> scenes_;   ///< mine_'s (keep)
+    BrickComposite composite_ = BrickComposite::Exact;
+    bool keep_ = true;
+    /// mine_'s samples (with `keep` for good, else until their Scene).
+    std::vector<std::shared_ptr<const Volume>> volumes_;
+    /// mine_'s Scenes for each renderer (keep), by RendererKind.
+    std::vector<std::vector<std::shared_ptr<const Scene>>> scenes_;
     BrickStats st_;
 };
 

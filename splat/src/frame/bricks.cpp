@@ -197,7 +197,12 @@ Image LocalBrickGroup::composite(std::vector<std::pair<int, Image>>& partials,
 BrickedFrames::BrickedFrames(const Volume& geometry, std::function<Volume(const Brick&)> load,
                              const RenderSettings& frame, int bricks, BrickGroup& group,
                              BrickComposite composite, bool keep)
-    : geometry_(geometry), load_(std::move(load)), group_(group), s_(frame), keep_(keep) {
+    : geometry_(geometry),
+      load_(std::move(load)),
+      group_(group),
+      s_(frame),
+      composite_(composite),
+      keep_(keep) {
     if (frame.edges.enabled())
         throw Error(
             "--bricks: edge enhancement scales by the whole volume's largest gradient; "
@@ -210,16 +215,16 @@ BrickedFrames::BrickedFrames(const Volume& geometry, std::function<Volume(const 
     for (int b = group.rank(); b < bricks; b += group.size()) mine_.push_back(b);
     st_.rendered = int(mine_.size());
     volumes_.resize(mine_.size());
-    scenes_.resize(mine_.size());
+    scenes_.resize(3);
 
     // The whole volume's range, when the settings are relative to it: one pass that loads
     // each brick; kept when the Scenes are (`keep`), or when this process holds one brick.
     const bool relative = frame.transfer.normalized || frame.isoNormalized;
-    exactSheets_ = frame.renderer == RendererKind::Sheet && composite == BrickComposite::Exact;
+    const bool exactSheets = exact(frame.renderer);
     std::string error;
     float lo = INFINITY, hi = -INFINITY;
     try {
-        if (keep || relative || (mine_.size() == 1 && !exactSheets_))
+        if (keep || relative || (mine_.size() == 1 && !exactSheets))
             for (std::size_t i = 0; i < mine_.size(); ++i) {
                 Volume v = loadBrick(mine_[i]);
                 if (relative)
@@ -245,7 +250,7 @@ BrickedFrames::BrickedFrames(const Volume& geometry, std::function<Volume(const 
         for (std::size_t i = 0; i < mine_.size(); ++i) {
             RenderSettings bs =
                 brickSettings(s_, geometry_, layout_.bricks[std::size_t(mine_[i])], geometry_.dims);
-            if (exactSheets_) bs.clipping.planes.clear();
+            if (exactSheets) bs.clipping.planes.clear();
             scene(int(i), bs);
         }
     } catch (const std::exception& e) {
@@ -267,20 +272,38 @@ Volume BrickedFrames::loadBrick(int b) {
 
 std::shared_ptr<const Scene> BrickedFrames::scene(int i, const RenderSettings& bs) {
     const std::size_t k = std::size_t(i);
-    if (scenes_[k]) return scenes_[k];
-    std::shared_ptr<const Volume> v = std::move(volumes_[k]);
-    if (!v) v = std::make_shared<const Volume>(loadBrick(mine_[k]));
+    std::vector<std::shared_ptr<const Scene>>& set = scenes_.at(std::size_t(bs.renderer));
+    set.resize(mine_.size());
+    if (set[k]) return set[k];
+    std::shared_ptr<const Volume> v = keep_ ? volumes_[k] : std::move(volumes_[k]);
+    if (!v) {
+        v = std::make_shared<const Volume>(loadBrick(mine_[k]));
+        if (keep_) volumes_[k] = v;
+    }
     const auto t = Clock::now();
     auto sc = std::make_shared<const Scene>(std::move(v), bs);
     st_.sceneMs += msSince(t);
-    if (keep_) scenes_[k] = sc;
+    if (keep_) set[k] = sc;
     return sc;
 }
 
-Image BrickedFrames::render(const CameraParams& camera) {
+Image BrickedFrames::render(const CameraParams& camera) { return render(camera, s_.renderer); }
+
+Image BrickedFrames::render(const CameraParams& camera, RendererKind renderer, RenderStats* stats) {
+    const auto start = Clock::now();
+    RenderStats frameStats;
+    Image out = renderFrame(camera, renderer, frameStats);
+    frameStats.milliseconds = msSince(start);
+    if (stats) *stats = frameStats;
+    return out;
+}
+
+Image BrickedFrames::renderFrame(const CameraParams& camera, RendererKind renderer,
+                                 RenderStats& frameStats) {
     RenderSettings s = s_;
     s.camera = camera;
-    if (exactSheets_)
+    s.renderer = renderer;
+    if (exact(renderer))
         return renderBrickedSlabs(
             geometry_, layout_, mine_,
             [&](int i, const RenderSettings& bs) { return scene(i, bs); }, s, group_, st_);
@@ -297,6 +320,10 @@ Image BrickedFrames::render(const CameraParams& camera) {
             partials.emplace_back(b, sc->render(bs, &rs));
             st_.renderMs += msSince(t);
             st_.splats += rs.splats;
+            frameStats.splats += rs.splats;
+            frameStats.voxels += rs.voxels;
+            frameStats.sheetAxis = rs.sheetAxis;
+            frameStats.sheetSign = rs.sheetSign;
         }
     } catch (const std::exception& e) {
         error = e.what();
@@ -304,8 +331,8 @@ Image BrickedFrames::render(const CameraParams& camera) {
     group_.agree(error);
     const auto t = Clock::now();
     const std::vector<int> order = visibilityOrder(layout_, geometry_, camera);
-    Image out = group_.composite(partials, order, camera.width, camera.height, s.mode,
-                                 s.background, &st_.bytesExchanged);
+    Image out = group_.composite(partials, order, camera.width, camera.height, s.mode, s.background,
+                                 &st_.bytesExchanged);
     st_.compositeMs += msSince(t);
     return out;
 }
