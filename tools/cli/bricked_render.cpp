@@ -51,7 +51,7 @@ std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume) {
     };
 }
 
-Volume brickedGeometry(const VolumeArgs& volume) {
+Volume brickedGeometry(const VolumeArgs& volume, bool* aloneOut) {
     const LoadOptions options = loadOptionsFromArgs(volume);
     const bool given = !volume.backgroundValue.empty() && volume.backgroundValue != "auto";
     bool alone = false;
@@ -60,7 +60,9 @@ Volume brickedGeometry(const VolumeArgs& volume) {
         geometry.background = std::stof(volume.backgroundValue);
         geometry.backgroundSource = "--background-value";
     }
-    if (!alone)
+    if (aloneOut)
+        *aloneOut = alone;
+    else if (!alone)
         warn(volume.spec +
              ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, an "
              "ANALYZE pair): every rank loads the whole volume once and keeps its brick");

@@ -12,8 +12,9 @@
 namespace splat::cli {
 
 /// The geometry of the volume of `volume` (no samples; background as --background-value
-/// says, else from the outer faces), with a warning when its samples are not read by brick.
-Volume brickedGeometry(const VolumeArgs& volume);
+/// says, else from the outer faces), with a warning when its samples are not read by brick
+/// (`alone`: whether they are; given, no warning).
+Volume brickedGeometry(const VolumeArgs& volume, bool* alone = nullptr);
 
 /// Loads brick's samples (with its ghost layers) of the volume of `volume`.
 std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume);

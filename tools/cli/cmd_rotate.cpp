@@ -409,8 +409,9 @@ void registerRotate(CLI::App& app) {
         int bricks = a->bricks;
         std::optional<Volume> geometry;
         const std::uint64_t rankBytes = std::uint64_t(a->rankMemory * 1048576.0);
+        bool alone = true;
         if (bricks > 0 || rankBytes > 0 || processCount() > 1) {
-            geometry = brickedGeometry(a->volume);
+            geometry = brickedGeometry(a->volume, &alone);
             settings = withFreeCameraTarget(settings, *geometry);
             bool fits = true;
             if (bricks == 0) {
@@ -424,6 +425,10 @@ void registerRotate(CLI::App& app) {
                                  std::to_string(geometry->voxelCount()) + " samples");
         }
         const bool bricked = bricks > 0;
+        if (bricked && !alone && !workerProcess())
+            warn(a->volume.spec +
+                 ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, "
+                 "an ANALYZE pair): every rank loads the whole volume once and keeps its brick");
         if (given(*cmd, "brick-composite") && !fromScene(*cmd, "brick-composite") &&
             (!bricked || settings.renderer != RendererKind::Sheet) && !workerProcess())
             warn(
