@@ -16,11 +16,8 @@
 
 namespace splat::cli {
 
-namespace {
-
-/// K from the budget per process (README "Beyond one machine"), said on rank 0.
 int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int ranks,
-                     std::uint64_t rankBytes) {
+                     std::uint64_t rankBytes, bool* wholeFits, bool quiet) {
     const footprint::Kernel kernel =
         footprint::Kernel::fromName(settings.kernel, settings.kernelSigma, settings.kernelRadius);
     BrickBudget budget;
@@ -30,7 +27,8 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
     budget.height = settings.camera.height;
     budget.ghost = ghostLayers(kernel.radius(), geometry.spacing);
     const BrickChoice c = chooseBricks(geometry.dims, budget);
-    if (!workerProcess()) {
+    if (wholeFits) *wholeFits = c.wholeFits;
+    if (!workerProcess() && !quiet) {
         const double mib = 1048576.0;
         std::printf(
             "bricks: %d (%d per process) for a budget of %.1f MiB per process%s: estimated "
@@ -46,11 +44,14 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
     return c.bricks;
 }
 
-}  // namespace
+std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume) {
+    const LoadOptions options = loadOptionsFromArgs(volume);
+    return [spec = volume.spec, options](const Brick& brick) {
+        return loadVolumeBrick(spec, options, brick.loadLo, brick.loadHi);
+    };
+}
 
-void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
-                         RenderSettings settings, int bricks, std::uint64_t rankBytes,
-                         const std::string& output, BrickComposite composite) {
+Volume brickedGeometry(const VolumeArgs& volume, bool* aloneOut) {
     const LoadOptions options = loadOptionsFromArgs(volume);
     const bool given = !volume.backgroundValue.empty() && volume.backgroundValue != "auto";
     bool alone = false;
@@ -59,10 +60,19 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
         geometry.background = std::stof(volume.backgroundValue);
         geometry.backgroundSource = "--background-value";
     }
-    if (!alone)
+    if (aloneOut)
+        *aloneOut = alone;
+    else if (!alone)
         warn(volume.spec +
              ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, an "
              "ANALYZE pair): every rank loads the whole volume once and keeps its brick");
+    return geometry;
+}
+
+void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
+                         RenderSettings settings, int bricks, std::uint64_t rankBytes,
+                         const std::string& output, BrickComposite composite) {
+    const Volume geometry = brickedGeometry(volume);
     if (settings.renderer == RendererKind::Sheet && composite == BrickComposite::Fast)
         warn(
             "--renderer sheet with --brick-composite fast is approximate where its slabs cross a "
@@ -78,12 +88,8 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
         throw UsageError("--bricks " + std::to_string(bricks) + " is more than the volume's " +
                          std::to_string(geometry.voxelCount()) + " samples");
     BrickStats st;
-    const Image image = renderBricked(
-        geometry,
-        [&](const Brick& brick) {
-            return loadVolumeBrick(volume.spec, options, brick.loadLo, brick.loadHi);
-        },
-        settings, bricks, *group, &st, composite);
+    const Image image =
+        renderBricked(geometry, brickLoader(volume), settings, bricks, *group, &st, composite);
     const std::vector<BrickStats> all = group->gather(st);
     if (workerProcess()) return;
     removeStaleTemporaries(std::filesystem::path(output).parent_path());

@@ -2,6 +2,7 @@
 // `splat render --bricks K`, and `splat render` under `mpirun -np P` (K = P unless given):
 // sort-last bricked rendering (splat/bricks.h, README "Beyond one machine").
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "render_options.h"
@@ -9,6 +10,19 @@
 #include "volume_options.h"
 
 namespace splat::cli {
+
+/// The geometry of the volume of `volume` (no samples; background as --background-value
+/// says, else from the outer faces), with a warning when its samples are not read by brick
+/// (`alone`: whether they are; given, no warning).
+Volume brickedGeometry(const VolumeArgs& volume, bool* alone = nullptr);
+
+/// Loads brick's samples (with its ghost layers) of the volume of `volume`.
+std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume);
+
+/// K from the budget per process (`rankBytes`, 0: defaultRankBytes) by chooseBricks, said on
+/// rank 0 unless `quiet`; `wholeFits`: whether the whole volume fits one process.
+int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int ranks,
+                     std::uint64_t rankBytes, bool* wholeFits = nullptr, bool quiet = false);
 
 /// Every process loads and renders its bricks, the group composites the frame, and rank 0
 /// writes it to `output` and prints what the frame took. `bricks` 0: chosen from the budget

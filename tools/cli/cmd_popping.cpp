@@ -6,8 +6,10 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <sstream>
 
+#include "bricked_render.h"
 #include "commands.h"
 #include "diagnostics.h"
 #include "parallel.h"
@@ -28,6 +30,7 @@ struct PoppingCommand {
     RenderArgs render;
     PoppingArgs popping;
     std::string report;
+    int bricks = 0;
     bool quiet = false, resume = false;
 };
 
@@ -75,6 +78,10 @@ void registerPopping(CLI::App& app) {
     addFlag(*cmd, "--resume", a->resume,
             "finish an interrupted run: reuse the frames it left in REPORT/.frames", out);
     addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
+    addOption(*cmd, "--bricks", a->bricks,
+              "sort-last, one process: cut the volume into K bricks, loaded and built once, "
+              "every frame rendered by them and composited (0: off; exact sheets)",
+              out);
     cmd->footer(
         "Examples:\n"
         "  splat popping synthetic:phantom:64 --from 40 --to 50 --step 0.5 --report pop\n"
@@ -92,6 +99,12 @@ void registerPopping(CLI::App& app) {
         loadOptionsFromArgs(a->volume);
         // The Scene is validated against its first renderer (iso: the reference alone).
         settings.renderer = o.renderers.front();
+        if (a->bricks < 0 || a->bricks > 4096)
+            throw UsageError("--bricks must be between 0 and 4096");
+        if (a->bricks > 0 && processCount() > 1)
+            throw UsageError(
+                "popping --bricks runs on one process; under mpirun popping is frame-parallel "
+                "(leave out --bricks)");
         if (workerProcess())  // under mpirun: render the frames rank 0 asks for (parallel.h)
             return serveFrames([&] {
                 auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
@@ -103,9 +116,28 @@ void registerPopping(CLI::App& app) {
         const std::string journal = a->report + "/.frames";
         prepareJournal(*cmd, journal, a->resume);
         o.frameJournal = journal;
-        auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
-        settings = withDataDefaults(a->render, settings, *volume);
-        const Scene scene(volume, settings);
+        // README "Beyond one machine": --bricks renders every frame from bricks whose Scenes
+        // are built once (splat/bricks.h BrickedFrames), through the analyser's frame seam.
+        std::shared_ptr<const Volume> volume;
+        std::optional<Scene> scene;
+        std::optional<Volume> geometry;
+        std::unique_ptr<BrickGroup> group;
+        std::unique_ptr<BrickedFrames> bricked;
+        if (a->bricks > 0) {
+            geometry = brickedGeometry(a->volume);
+            settings = withFreeCameraTarget(settings, *geometry);
+            group = brickGroup();
+            bricked = std::make_unique<BrickedFrames>(*geometry, brickLoader(a->volume), settings,
+                                                      a->bricks, *group);
+            o.renderFrame = [&](const RenderSettings& s, RenderStats* st) {
+                return bricked->render(s.camera, s.renderer, st);
+            };
+            settings = bricked->settings();
+        } else {
+            volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
+            settings = withDataDefaults(a->render, settings, *volume);
+            scene.emplace(volume, settings);
+        }
         installInterruptHandler();
         ProgressReporter progress("frames", a->quiet);
         o.progress = [&](std::size_t d, std::size_t t, const std::string& w) {
@@ -113,12 +145,16 @@ void registerPopping(CLI::App& app) {
         };
         PoppingResult result;
         try {
+            if (bricked && !a->popping.path.empty())
+                throw Error("popping --bricks takes a sweep (--from, --to, --step), not --path");
             result =
-                a->popping.path.empty()
-                    ? analyzePopping(scene, sweep, o)
-                    : analyzePopping(
-                          scene, CameraPath::fromJson(a->popping.path, scene.settings().camera, a->popping.frames),
-                          o);
+                bricked ? analyzePopping(*geometry, settings, sweep, o)
+                : a->popping.path.empty()
+                    ? analyzePopping(*scene, sweep, o)
+                    : analyzePopping(*scene,
+                                     CameraPath::fromJson(a->popping.path, scene->settings().camera,
+                                                          a->popping.frames),
+                                     o);
         } catch (const Cancelled&) {
             progress.finish();
             throw Error(

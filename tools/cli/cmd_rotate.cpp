@@ -11,14 +11,17 @@
 
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <regex>
 
+#include "bricked_render.h"
 #include "commands.h"
 #include "diagnostics.h"
 #include "parallel.h"
@@ -45,8 +48,9 @@ struct RotateCommand {
     RenderArgs render;
     std::string outDir, gif, contact, mp4, format = "png", name = "frame_%04d", sweep = "azimuth",
                                            path;
-    int frames = 36, fps = 12, parallelFrames = 0;
-    double from = 0, to = 360;
+    int frames = 36, fps = 12, parallelFrames = 0, bricks = 0;
+    double from = 0, to = 360, rankMemory = 0;
+    std::string brickComposite = "exact";
     bool resume = false, overwrite = false, quiet = false;
 };
 
@@ -247,6 +251,58 @@ void checkExtraOutput(const std::string& path, const char* flag) {
     if (::access(parent.c_str(), W_OK) != 0)
         throw Error(path + ": the folder '" + parent.string() + "' is not writable");
 }
+/// The frames of a bricked sequence (README "Beyond one machine"), on every rank of
+/// `group`: each loads its bricks and builds their Scenes once, then every view not kept is
+/// rendered by them and composited; rank 0 hands it to `emit` (view, image, milliseconds).
+/// A failure on rank 0 (writing a frame) or on any rank ends every rank at the next frame.
+void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
+                         const RenderSettings& settings, int bricks, BrickGroup& group,
+                         const CameraPath& path, const std::vector<bool>& keep,
+                         ProgressReporter& progress,
+                         const std::function<void(std::size_t, const Image&, double)>& emit) {
+    const bool leader = group.rank() == 0;
+    if (leader && settings.renderer == RendererKind::Sheet && a.brickComposite == "fast")
+        warn(
+            "--renderer sheet with --brick-composite fast is approximate where its slabs cross a "
+            "brick face (README \"Beyond one machine\"); --brick-composite exact is not");
+    BrickedFrames frames(
+        geometry, brickLoader(a.volume), settings, bricks, group,
+        a.brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
+    std::size_t todo = 0, done = 0;
+    for (bool k : keep) todo += k ? 0 : 1;
+    std::string failure;
+    for (std::size_t v = 0; v < path.views.size(); ++v) {
+        group.agree(failure);
+        if (keep[v]) continue;
+        const auto t = std::chrono::steady_clock::now();
+        const Image image = frames.render(path.views[v]);
+        if (!leader) continue;
+        try {
+            const double ms =
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t)
+                    .count();
+            emit(v, image, ms);
+            if (!progress(++done, todo, "view " + std::to_string(v)))
+                throw Error("interrupted after " + std::to_string(done) +
+                            " new frames; the frames written are complete (--resume finishes "
+                            "them)");
+        } catch (const std::exception& e) {
+            failure = e.what();
+        }
+    }
+    group.agree(failure);
+    const std::vector<BrickStats> all = group.gather(frames.stats());
+    if (!leader || a.quiet) return;
+    progress.finish();
+    for (std::size_t r = 0; r < all.size(); ++r)
+        std::printf(
+            "rank %zu: %d of %d bricks, largest %zu samples (%.1f MiB), load %.1f ms, scene "
+            "%.1f ms once; render %.1f ms, composite %.1f ms, exchanged %llu bytes over %zu "
+            "frames\n",
+            r, all[r].rendered, all[r].bricks, all[r].samplesLoaded,
+            all[r].samplesLoaded * 4.0 / 1048576.0, all[r].loadMs, all[r].sceneMs, all[r].renderMs,
+            all[r].compositeMs, static_cast<unsigned long long>(all[r].bytesExchanged), todo);
+}
 }  // namespace
 
 void registerRotate(CLI::App& app) {
@@ -268,6 +324,19 @@ void registerRotate(CLI::App& app) {
               seq, PathKind::Input);
     addOption(*cmd, "--parallel-frames", a->parallelFrames,
               "frames rendered at once, one thread each (0: automatic)", seq);
+    addOption(*cmd, "--bricks", a->bricks,
+              "sort-last: cut the volume into K bricks, loaded and built once, every frame "
+              "rendered by them and composited (0: off; under mpirun chosen from "
+              "--rank-memory when the volume does not fit one process)",
+              seq);
+    addOption(*cmd, "--rank-memory", a->rankMemory,
+              "bricks: memory per process in MiB (default under mpirun: 80% of the physical "
+              "memory / processes on the node); frames in parallel when the volume fits",
+              seq);
+    addOption(*cmd, "--brick-composite", a->brickComposite,
+              "bricks of --renderer sheet: exact (slab sheets summed across bricks) or fast "
+              "(partial images, approximate at brick faces)",
+              seq);
     addOption(*cmd, "-o,--output", a->outDir, "output folder for the frames (created)", out,
               PathKind::Output);
     addOption(*cmd, "--name", a->name, "frame file name pattern (printf %d of the frame index)",
@@ -315,6 +384,13 @@ void registerRotate(CLI::App& app) {
                 throw Error(a->mp4 + ": --mp4 needs a .mp4 file name");
             if (!a->mp4.empty() && a->format != "png")
                 throw Error("--mp4 is made from png frames (--format png)");
+            if (a->bricks < 0 || a->bricks > 4096)
+                throw Error("--bricks must be between 0 and 4096");
+            if (a->brickComposite != "exact" && a->brickComposite != "fast")
+                throw Error("--brick-composite must be exact or fast (got '" + a->brickComposite +
+                            "')");
+            if (!(a->rankMemory >= 0 && a->rankMemory <= 1e9))
+                throw Error("--rank-memory must be between 0 and 1e9 MiB");
         });
         if (!a->path.empty())
             for (const char* k : {"from", "to", "sweep"})
@@ -327,28 +403,48 @@ void registerRotate(CLI::App& app) {
         use.imageExt = "." + a->format;
         RenderSettings settings = settingsFromArgs(a->render, use);
         loadOptionsFromArgs(a->volume);
-        if (workerProcess())  // under mpirun: render the frames rank 0 asks for (parallel.h)
+        // README "Beyond one machine": bricks when asked (--bricks), or when the budget per
+        // process says the volume does not fit one (mpirun, --rank-memory); else frames in
+        // parallel. Every rank decides alike (the same geometry).
+        int bricks = a->bricks;
+        std::optional<Volume> geometry;
+        const std::uint64_t rankBytes = std::uint64_t(a->rankMemory * 1048576.0);
+        bool alone = true;
+        if (bricks > 0 || rankBytes > 0 || processCount() > 1) {
+            geometry = brickedGeometry(a->volume, &alone);
+            settings = withFreeCameraTarget(settings, *geometry);
+            bool fits = true;
+            if (bricks == 0) {
+                bricksFromBudget(*geometry, settings, processCount(), rankBytes, &fits, true);
+                if (!fits)
+                    bricks = bricksFromBudget(*geometry, settings, processCount(), rankBytes);
+            }
+            if (bricks > int(std::min<std::size_t>(geometry->voxelCount(), 1 << 20)))
+                throw UsageError("--bricks " + std::to_string(bricks) +
+                                 " is more than the volume's " +
+                                 std::to_string(geometry->voxelCount()) + " samples");
+        }
+        const bool bricked = bricks > 0;
+        if (bricked && !alone && !workerProcess())
+            warn(a->volume.spec +
+                 ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, "
+                 "an ANALYZE pair): every rank loads the whole volume once and keeps its brick");
+        if (given(*cmd, "brick-composite") && !fromScene(*cmd, "brick-composite") &&
+            (!bricked || settings.renderer != RendererKind::Sheet) && !workerProcess())
+            warn(
+                "--brick-composite applies to bricked sequences (--bricks, or mpirun when the "
+                "volume does not fit one process) of --renderer sheet: ignored");
+        if (!bricked && workerProcess())  // under mpirun: render the frames rank 0 asks for
             return serveFrames([&] {
                 auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
                 return Scene(v, withDataDefaults(a->render, settings, *v));
             });
+        // Rank 0 prepares the outputs; a bricked run's other ranks learn whether it could,
+        // and which frames are kept (--resume), before rendering with it.
+        const bool leader = !workerProcess();
+        const std::unique_ptr<BrickGroup> group = bricked ? brickGroup() : nullptr;
         std::string ffmpeg;
-        if (!a->mp4.empty()) {
-            ffmpeg = findProgram("ffmpeg");
-            if (ffmpeg.empty())
-                throw Error(
-                    "--mp4 needs the ffmpeg program, which is not installed "
-                    "(Debian: apt-get install ffmpeg)");
-        }
-        checkExtraOutput(a->gif, "--gif");
-        checkExtraOutput(a->contact, "--contact-sheet");
-        checkExtraOutput(a->mp4, "--mp4");
         const bool keepImages = !a->gif.empty() || !a->contact.empty();
-        if (keepImages &&
-            double(a->frames) * settings.camera.width * settings.camera.height > double(1 << 28))
-            throw Error("--gif/--contact-sheet with " + std::to_string(a->frames) + " frames of " +
-                        a->render.size +
-                        " would not fit in memory; use fewer frames or a smaller --size");
         const CameraPath path =
             a->path.empty()
                 ? CameraPath::turn(
@@ -360,62 +456,105 @@ void registerRotate(CLI::App& app) {
                       a->frames)
                 : CameraPath::fromJson(a->path, settings.camera, a->frames);
         nlohmann::json manifest = manifestOf(*a, settings);
-        const std::vector<bool> keep =
-            prepareFolder(*a, manifest, settings.camera.width, settings.camera.height);
-        beginRun(*cmd);
-        auto volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
-        settings = withDataDefaults(a->render, settings, *volume);
-        const Scene scene(volume, settings);
-        std::error_code ec;
-        fs::create_directories(a->outDir, ec);
-        if (!fs::is_directory(a->outDir)) throw Error(a->outDir + ": cannot create output folder");
-
-        // The display window (mip, xray) is fixed by the first frame a folder gets, and
-        // kept in the manifest so that resumed frames match.
+        std::vector<bool> keep(std::size_t(a->frames), false);
+        std::shared_ptr<const Volume> volume;
+        std::optional<Scene> scene;
         std::optional<WriteOptions> display;
-        if (std::ifstream in(fs::path(a->outDir) / kManifest); in && a->resume) {
-            try {
-                const nlohmann::json old = nlohmann::json::parse(in);
-                if (old.contains("window")) {
-                    WriteOptions w;
-                    w.mapping = DisplayMapping::Window;
-                    w.windowLow = old["window"][0].get<float>();
-                    w.windowHigh = old["window"][1].get<float>();
-                    display = withMetadata(w);
+        std::string failure;
+        try {
+            if (leader) {
+                if (!a->mp4.empty()) {
+                    ffmpeg = findProgram("ffmpeg");
+                    if (ffmpeg.empty())
+                        throw Error(
+                            "--mp4 needs the ffmpeg program, which is not installed "
+                            "(Debian: apt-get install ffmpeg)");
                 }
-            } catch (const std::exception&) {
+                checkExtraOutput(a->gif, "--gif");
+                checkExtraOutput(a->contact, "--contact-sheet");
+                checkExtraOutput(a->mp4, "--mp4");
+                if (keepImages &&
+                    double(a->frames) * settings.camera.width * settings.camera.height >
+                        double(1 << 28))
+                    throw Error("--gif/--contact-sheet with " + std::to_string(a->frames) +
+                                " frames of " + a->render.size +
+                                " would not fit in memory; use fewer frames or a smaller --size");
+                keep = prepareFolder(*a, manifest, settings.camera.width, settings.camera.height);
+                beginRun(*cmd);
+                if (!bricked) {
+                    volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
+                    settings = withDataDefaults(a->render, settings, *volume);
+                    scene.emplace(volume, settings);
+                }
+                std::error_code ec;
+                fs::create_directories(a->outDir, ec);
+                if (!fs::is_directory(a->outDir))
+                    throw Error(a->outDir + ": cannot create output folder");
+
+                // The display window (mip, xray) is fixed by the first frame a folder gets, and
+                // kept in the manifest so that resumed frames match.
+                if (std::ifstream in(fs::path(a->outDir) / kManifest); in && a->resume) {
+                    try {
+                        const nlohmann::json old = nlohmann::json::parse(in);
+                        if (old.contains("window")) {
+                            WriteOptions w;
+                            w.mapping = DisplayMapping::Window;
+                            w.windowLow = old["window"][0].get<float>();
+                            w.windowHigh = old["window"][1].get<float>();
+                            display = withMetadata(w);
+                        }
+                    } catch (const std::exception&) {
+                    }
+                }
             }
+        } catch (const std::exception& e) {
+            if (!bricked) throw;
+            failure = e.what();
+        }
+        if (bricked) {
+            group->agree(failure);
+            std::vector<unsigned char> kept(keep.begin(), keep.end());
+            group->broadcast(kept);
+            keep.assign(kept.begin(), kept.end());
         }
         std::vector<Image> shown(keepImages ? std::size_t(a->frames) : 0);
         double totalMs = 0;
         std::size_t rendered = 0;
         installInterruptHandler();
-        ProgressReporter progress("frames", a->quiet);
+        ProgressReporter progress("frames", a->quiet || !leader);
         SequenceOptions so;
         so.parallelFrames = a->parallelFrames;
         so.skip = [&](std::size_t v) { return keep[v]; };
         so.progress = [&](std::size_t d, std::size_t t, const std::string& w) {
             return progress(d, t, w);
         };
+        // One finished frame (rank 0): written, and kept for the GIF and contact sheet.
+        const auto emit = [&](std::size_t view, const Image& image, double ms) {
+            if (!display) {
+                display = displayOptions(a->render, settings, image);
+                if (display->mapping == DisplayMapping::Window)
+                    manifest["window"] = {display->windowLow, display->windowHigh};
+                writeTextAtomic(fs::path(a->outDir) / kManifest, manifest.dump(2) + "\n");
+            }
+            writeImage(frameFile(*a, view), image, *display);
+            totalMs += ms;
+            ++rendered;
+            if (keepImages) shown[view] = toDisplay(image, *display);
+        };
         try {
-            renderSequence(scene, {settings.renderer}, path, so, [&](SequenceFrame&& f) {
-                Image& image = f.images[0];
-                if (!display) {
-                    display = displayOptions(a->render, settings, image);
-                    if (display->mapping == DisplayMapping::Window)
-                        manifest["window"] = {display->windowLow, display->windowHigh};
-                    writeTextAtomic(fs::path(a->outDir) / kManifest, manifest.dump(2) + "\n");
-                }
-                writeImage(frameFile(*a, f.view), image, *display);
-                totalMs += f.stats[0].milliseconds;
-                ++rendered;
-                if (keepImages) shown[f.view] = toDisplay(image, *display);
-            });
+            if (bricked)
+                renderBrickedFrames(*a, *geometry, settings, bricks, *group, path, keep, progress,
+                                    emit);
+            else
+                renderSequence(*scene, {settings.renderer}, path, so, [&](SequenceFrame&& f) {
+                    emit(f.view, f.images[0], f.stats[0].milliseconds);
+                });
         } catch (const Cancelled&) {
             progress.finish();
             throw Error("interrupted after " + std::to_string(rendered) +
                         " new frames; the frames written are complete (--resume finishes them)");
         }
+        if (!leader) return;
         progress.finish();
         if (rendered == 0 && !fs::exists(fs::path(a->outDir) / kManifest))
             writeTextAtomic(fs::path(a->outDir) / kManifest, manifest.dump(2) + "\n");

@@ -13,6 +13,7 @@
 // test_bricks.cpp); the splatters cut their sheet pixels' paths at the brick faces
 // (frame/clip_cut.h) and their seam error is measured there.
 #include <functional>
+#include <memory>
 #include <glm/glm.hpp>
 #include <string>
 #include <utility>
@@ -151,6 +152,8 @@ class BrickGroup {
     /// The sum of every process's `image` on process 0 (others: empty); their non-zero
     /// pixels are disjoint, so the sum is exact.
     virtual Image sumImages(const Image& image, std::uint64_t* bytes) = 0;
+    /// Process 0's `bytes` on every process (the others' size and contents are replaced).
+    virtual void broadcast(std::vector<unsigned char>& bytes) = 0;
 };
 
 /// One process, every brick: what `splat render --bricks K` does without mpirun (each
@@ -168,6 +171,7 @@ class LocalBrickGroup : public BrickGroup {
     void reduceSlabs(std::vector<float>&, std::vector<int>&, const std::vector<int>&, std::size_t,
                      std::size_t, std::uint64_t*) override {}
     Image sumImages(const Image& image, std::uint64_t*) override { return image; }
+    void broadcast(std::vector<unsigned char>&) override {}
 };
 
 /// How the partial results of the image-aligned splatter's bricks are composited (the
@@ -181,22 +185,77 @@ enum class BrickComposite {
     Fast,
 };
 
-/// Renders `frame` of the volume of geometry `geometry` cut into `bricks` bricks: this
-/// process loads (`load`: the samples of a brick's loaded box, background as `geometry`'s)
-/// and renders its bricks, and the group composites the frame. The transfer function and a
-/// normalised iso level are resolved against the whole volume's range (the group's). Edge
-/// enhancement (its scale is the whole volume's largest gradient) and labels are refused.
-/// Returns the frame on process 0.
-/// `composite`: how the image-aligned splatter's bricks are composited.
+class Scene;
+
+/// The bricks of one volume rendered frame after frame (`splat rotate --bricks`): the
+/// constructor loads this process's bricks (`load`: the samples of a brick's loaded box,
+/// background as `geometry`'s) and, with `keep`, builds their Scenes once; each render()
+/// renders a view of them and the group composites it. Every call is collective over the
+/// group. The transfer function and a normalised iso level are resolved against the whole
+/// volume's range (the group's) once. Edge enhancement (its scale is the whole volume's
+/// largest gradient) and labels are refused. Without `keep`, each render() loads, renders
+/// and frees the bricks in turn (memory follows the largest brick: renderBricked).
+class BrickedFrames {
+  public:
+    /// `frame`: the settings of every view but the camera. `composite`: how the
+    /// image-aligned splatter's bricks are composited.
+    BrickedFrames(const Volume& geometry, std::function<Volume(const Brick&)> load,
+                  const RenderSettings& frame, int bricks, BrickGroup& group,
+                  BrickComposite composite = BrickComposite::Exact, bool keep = true);
+    ~BrickedFrames();
+    BrickedFrames(const BrickedFrames&) = delete;
+    BrickedFrames& operator=(const BrickedFrames&) = delete;
+    /// The frame seen by `camera` (the constructor's settings otherwise), on process 0
+    /// (others: empty).
+    Image render(const CameraParams& camera);
+    /// The same with `renderer` (popping's renderers): each renderer has its own Scenes of
+    /// the bricks (built at its first frame, sharing the bricks' samples). `stats`: this
+    /// process's splats, the axis-aligned splatter's sheet axis and sign (the whole frame's:
+    /// they follow the view) and the milliseconds.
+    Image render(const CameraParams& camera, RendererKind renderer, RenderStats* stats = nullptr);
+    /// This process's work so far (construction and every render).
+    const BrickStats& stats() const { return st_; }
+    /// The settings with the transfer function and iso level resolved (the whole volume's).
+    const RenderSettings& settings() const { return s_; }
+    const BrickLayout& layout() const { return layout_; }
+
+  private:
+    std::shared_ptr<const Scene> scene(int index, const RenderSettings& bs);
+    Image renderFrame(const CameraParams& camera, RendererKind renderer, RenderStats& stats);
+    bool exact(RendererKind renderer) const {
+        return renderer == RendererKind::Sheet && composite_ == BrickComposite::Exact;
+    }
+    Volume loadBrick(int b);
+
+    Volume geometry_;
+    std::function<Volume(const Brick&)> load_;
+    BrickGroup& group_;
+    BrickLayout layout_;
+    std::vector<int> mine_;
+    RenderSettings s_;
+    BrickComposite composite_ = BrickComposite::Exact;
+    bool keep_ = true;
+    /// mine_'s samples (with `keep` for good, else until their Scene).
+    std::vector<std::shared_ptr<const Volume>> volumes_;
+    /// mine_'s Scenes for each renderer (keep), by RendererKind.
+    std::vector<std::vector<std::shared_ptr<const Scene>>> scenes_;
+    BrickStats st_;
+};
+
+/// One frame: BrickedFrames(geometry, load, frame, bricks, group, composite, false)
+/// rendered once at frame.camera; `stats`: this process's work. Returns the frame on
+/// process 0.
 Image renderBricked(const Volume& geometry, const std::function<Volume(const Brick&)>& load,
                     const RenderSettings& frame, int bricks, BrickGroup& group,
                     BrickStats* stats = nullptr, BrickComposite composite = BrickComposite::Exact);
 
 /// renderBricked's exact path of the image-aligned splatter (slab_sheets.h): this process's
-/// bricks `mine` of `layout` (`load` gives brick b's samples) are all held at once, their
-/// sheets summed over the processes one group of slabs at a time.
-Image renderBrickedSlabs(const Volume& geometry, const BrickLayout& layout,
-                         const std::vector<int>& mine, const std::function<Volume(int)>& load,
-                         const RenderSettings& frame, BrickGroup& group, BrickStats& stats);
+/// bricks `mine` of `layout` (`scene` gives brick mine[i]'s Scene built with the settings
+/// given, clipping cleared) are all held at once, their sheets summed over the processes one
+/// group of slabs at a time.
+Image renderBrickedSlabs(
+    const Volume& geometry, const BrickLayout& layout, const std::vector<int>& mine,
+    const std::function<std::shared_ptr<const Scene>(int, const RenderSettings&)>& scene,
+    const RenderSettings& frame, BrickGroup& group, BrickStats& stats);
 
 }  // namespace splat

@@ -61,6 +61,11 @@ struct PoppingOptions {
     /// uninterrupted one. The folder must exist; the caller empties it when the scene, the
     /// sweep or the renderers change. Costs width x height x 16 bytes per frame.
     std::string frameJournal;
+    /// Renders one frame (the settings' camera and renderer) instead of the Scene, e.g. from
+    /// bricks (splat/bricks.h BrickedFrames; `splat popping --bricks K`). Set: every frame is
+    /// rendered through it, one after another (parallelFrames does not apply). The findings
+    /// depend only on the images.
+    std::function<Image(const RenderSettings&, RenderStats*)> renderFrame;
 };
 
 /// A change measured at one interval width while refining an event.
@@ -138,6 +143,11 @@ struct PoppingResult {
 /// then grows once, by the refinement's frames (events x (refine + 2) x renderers), and
 /// stays; `done` never exceeds it. Cancel reaches inside the frame in flight.
 PoppingResult analyzePopping(const Scene& scene, const Sweep& sweep, const PoppingOptions& options);
+/// The same with frames from options.renderFrame (required) of a volume of geometry
+/// `geometry` (dims, spacing, origin, direction; no samples needed) and `settings` (the
+/// Scene's settings).
+PoppingResult analyzePopping(const Volume& geometry, const RenderSettings& settings,
+                             const Sweep& sweep, const PoppingOptions& options);
 /// The same over any camera path (at least 3 views; every view of the same image size and
 /// projection, all orbit or all free cameras): interval n lies between views n and n + 1,
 /// thresholds and report as for a sweep; refinement bisects an interval in path position,

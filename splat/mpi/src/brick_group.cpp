@@ -203,6 +203,13 @@ class MpiBrickGroup : public BrickGroup {
         return out;
     }
 
+    void broadcast(std::vector<unsigned char>& bytes) override {
+        unsigned long long n = bytes.size();
+        MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+        bytes.resize(std::size_t(n));
+        if (n) MPI_Bcast(bytes.data(), int(n), MPI_UNSIGNED_CHAR, 0, MPI_COMM_WORLD);
+    }
+
   private:
     Session& s_;
 };

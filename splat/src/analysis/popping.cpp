@@ -68,10 +68,13 @@ class Analyzer {
   public:
     /// `positions` are the views' sweep angles or path positions, `cameraAt` the camera at
     /// any position between the first and the last.
-    Analyzer(const Scene& scene, const Sweep& sweep, std::size_t pathViews,
-             std::vector<double> positions, std::function<CameraParams(double)> cameraAt,
-             std::vector<double> predicted, const PoppingOptions& options)
+    /// `scene` null: frames from options.renderFrame, of `settings`.
+    Analyzer(const Scene* scene, const RenderSettings& settings, const Sweep& sweep,
+             std::size_t pathViews, std::vector<double> positions,
+             std::function<CameraParams(double)> cameraAt, std::vector<double> predicted,
+             const PoppingOptions& options)
         : scene_(scene),
+          settings_(settings),
           sweep_(sweep),
           pathViews_(pathViews),
           positions_(std::move(positions)),
@@ -80,6 +83,7 @@ class Analyzer {
           options_(options) {
         kinds_ = options.renderers;
         if (kinds_.empty()) throw Error("popping: no renderer to analyse");
+        if (!scene_ && !options.renderFrame) throw Error("popping: no Scene and no renderFrame");
         for (std::size_t i = 0; i < kinds_.size(); ++i)
             for (std::size_t j = 0; j < i; ++j)
                 if (kinds_[i] == kinds_[j])
@@ -101,7 +105,7 @@ class Analyzer {
         r.pathViews = pathViews_;
         r.options = options_;
         r.options.progress = nullptr;
-        r.settings = scene_.settings();
+        r.settings = settings_;
         r.renderers = kinds_;
         r.angles = positions_;
         r.predictedSwitches = predicted_;
@@ -146,15 +150,16 @@ class Analyzer {
         auto readUpTo = [&](std::size_t end) {
             while (next < end) consume(next, renderView(r.angles[next]));
         };
-        renderSequence(scene_, kinds_, path, so, [&](SequenceFrame&& f) {
-            readUpTo(f.view);
-            View cur{std::move(f.images), std::move(f.stats)};
-            if (!options_.frameJournal.empty())
-                for (std::size_t k = 0; k < kinds_.size(); ++k)
-                    journal::storeFrame(journalFile(r.angles[f.view], k), cur.images[k],
-                                        cur.stats[k]);
-            consume(f.view, std::move(cur));
-        });
+        if (!options_.renderFrame)  // else every view by renderView, below
+            renderSequence(*scene_, kinds_, path, so, [&](SequenceFrame&& f) {
+                readUpTo(f.view);
+                View cur{std::move(f.images), std::move(f.stats)};
+                if (!options_.frameJournal.empty())
+                    for (std::size_t k = 0; k < kinds_.size(); ++k)
+                        journal::storeFrame(journalFile(r.angles[f.view], k), cur.images[k],
+                                            cur.stats[k]);
+                consume(f.view, std::move(cur));
+            });
         readUpTo(views);
         for (std::size_t k = 0; k < kinds_.size(); ++k) {
             RendererSeries& s = r.series[k];
@@ -320,7 +325,7 @@ class Analyzer {
         View v;
         v.images.resize(kinds_.size());
         v.stats.resize(kinds_.size());
-        RenderSettings s = scene_.settings();
+        RenderSettings s = settings_;
         s.camera = cameraAt_(angle);
         s.progress = [this](std::size_t, std::size_t, const std::string& what) {
             poll(what);
@@ -332,7 +337,8 @@ class Analyzer {
             const std::filesystem::path file = journaling ? journalFile(angle, k) : "";
             if (!journaling || !journal::loadFrame(file, s.camera.width, s.camera.height,
                                                    v.images[k], v.stats[k])) {
-                v.images[k] = scene_.render(s, &v.stats[k]);
+                v.images[k] = options_.renderFrame ? options_.renderFrame(s, &v.stats[k])
+                                                   : scene_->render(s, &v.stats[k]);
                 if (journaling) journal::storeFrame(file, v.images[k], v.stats[k]);
             }
             report(std::string(toString(kinds_[k])) + " at " + std::to_string(angle));
@@ -357,7 +363,7 @@ class Analyzer {
     }
 
     void setWindow(const View& first) {
-        const RenderMode mode = scene_.settings().mode;
+        const RenderMode mode = settings_.mode;
         if (mode == RenderMode::Dvr || mode == RenderMode::Iso) return;
         float mx = 0;
         for (const Image& im : first.images)
@@ -384,7 +390,8 @@ class Analyzer {
         return flipMean(display(test), display(reference), fo);
     }
 
-    const Scene& scene_;
+    const Scene* scene_;
+    RenderSettings settings_;
     const Sweep& sweep_;
     std::size_t pathViews_;
     std::vector<double> positions_, predicted_;
@@ -501,7 +508,21 @@ PoppingResult analyzePopping(const Scene& scene, const Sweep& sweep,
                     std::to_string(angles.size()) + ")");
     auto cameraAt = [&sweep](double a) { return sweep.camera(a); };
     std::vector<double> predicted = sheetSwitches(angles, cameraAt, scene.volume());
-    return Analyzer(scene, sweep, 0, std::move(angles), cameraAt, std::move(predicted), options)
+    return Analyzer(&scene, scene.settings(), sweep, 0, std::move(angles), cameraAt,
+                    std::move(predicted), options)
+        .run();
+}
+
+PoppingResult analyzePopping(const Volume& geometry, const RenderSettings& settings,
+                             const Sweep& sweep, const PoppingOptions& options) {
+    std::vector<double> angles = sweep.angles();
+    if (angles.size() < 3)
+        throw Error("popping: a sweep needs at least 3 views (from, to and step give " +
+                    std::to_string(angles.size()) + ")");
+    auto cameraAt = [&sweep](double a) { return sweep.camera(a); };
+    std::vector<double> predicted = sheetSwitches(angles, cameraAt, geometry);
+    return Analyzer(nullptr, settings, sweep, 0, std::move(angles), cameraAt, std::move(predicted),
+                    options)
         .run();
 }
 
@@ -511,8 +532,8 @@ PoppingResult analyzePopping(const Scene& scene, const CameraPath& path,
     auto cameraAt = [&path](double x) { return pathCamera(path, x); };
     std::vector<double> predicted = sheetSwitches(u, cameraAt, scene.volume());
     const Sweep none;
-    return Analyzer(scene, none, path.views.size(), std::move(u), cameraAt, std::move(predicted),
-                    options)
+    return Analyzer(&scene, scene.settings(), none, path.views.size(), std::move(u), cameraAt,
+                    std::move(predicted), options)
         .run();
 }
 

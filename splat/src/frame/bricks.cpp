@@ -194,9 +194,15 @@ Image LocalBrickGroup::composite(std::vector<std::pair<int, Image>>& partials,
     return compositeBricks(ordered, mode, background);
 }
 
-Image renderBricked(const Volume& geometry, const std::function<Volume(const Brick&)>& load,
-                    const RenderSettings& frame, int bricks, BrickGroup& group, BrickStats* stats,
-                    BrickComposite composite) {
+BrickedFrames::BrickedFrames(const Volume& geometry, std::function<Volume(const Brick&)> load,
+                             const RenderSettings& frame, int bricks, BrickGroup& group,
+                             BrickComposite composite, bool keep)
+    : geometry_(geometry),
+      load_(std::move(load)),
+      group_(group),
+      s_(frame),
+      composite_(composite),
+      keep_(keep) {
     if (frame.edges.enabled())
         throw Error(
             "--bricks: edge enhancement scales by the whole volume's largest gradient; "
@@ -204,82 +210,139 @@ Image renderBricked(const Volume& geometry, const std::function<Volume(const Bri
     if (frame.labels.enabled) throw Error("--bricks: labels are rendered without bricks");
     const footprint::Kernel kernel =
         footprint::Kernel::fromName(frame.kernel, frame.kernelSigma, frame.kernelRadius);
-    const BrickLayout layout =
-        splitBricks(geometry.dims, bricks, ghostLayers(kernel.radius(), geometry.spacing));
-    BrickStats st;
-    st.bricks = bricks;
-    std::vector<int> mine;
-    for (int b = group.rank(); b < bricks; b += group.size()) mine.push_back(b);
-    st.rendered = int(mine.size());
+    layout_ = splitBricks(geometry.dims, bricks, ghostLayers(kernel.radius(), geometry.spacing));
+    st_.bricks = bricks;
+    for (int b = group.rank(); b < bricks; b += group.size()) mine_.push_back(b);
+    st_.rendered = int(mine_.size());
+    volumes_.resize(mine_.size());
+    scenes_.resize(3);
 
     // The whole volume's range, when the settings are relative to it: one pass that loads
-    // each brick, unless this process holds a single brick (kept for rendering).
+    // each brick; kept when the Scenes are (`keep`), or when this process holds one brick.
     const bool relative = frame.transfer.normalized || frame.isoNormalized;
-    const bool exactSheets =
-        frame.renderer == RendererKind::Sheet && composite == BrickComposite::Exact;
-    std::optional<Volume> kept;
+    const bool exactSheets = exact(frame.renderer);
     std::string error;
     float lo = INFINITY, hi = -INFINITY;
-    auto loadBrick = [&](int b) {
-        const auto t = Clock::now();
-        Volume v = load(layout.bricks[std::size_t(b)]);
-        v.background = geometry.background;
-        st.samplesLoaded = std::max(st.samplesLoaded, v.voxelCount());
-        st.loadMs += msSince(t);
-        return v;
-    };
     try {
-        if (relative || (mine.size() == 1 && !exactSheets))
-            for (int b : mine) {
-                Volume v = loadBrick(b);
-                for (std::size_t n = 0; n < v.voxelCount(); ++n)
-                    lo = std::min(lo, v.value(n)), hi = std::max(hi, v.value(n));
-                if (mine.size() == 1) kept = std::move(v);
+        if (keep || relative || (mine_.size() == 1 && !exactSheets))
+            for (std::size_t i = 0; i < mine_.size(); ++i) {
+                Volume v = loadBrick(mine_[i]);
+                if (relative)
+                    for (std::size_t n = 0; n < v.voxelCount(); ++n)
+                        lo = std::min(lo, v.value(n)), hi = std::max(hi, v.value(n));
+                if (keep || mine_.size() == 1)
+                    volumes_[i] = std::make_shared<const Volume>(std::move(v));
             }
     } catch (const std::exception& e) {
         error = e.what();
     }
     group.agree(error);
-    RenderSettings s = frame;
     if (relative) {
         group.range(lo, hi);
-        s.transfer = s.transfer.resolved(lo, hi);
-        if (s.isoNormalized) {
-            s.isoLevel = lo + s.isoLevel * (hi - lo);
-            s.isoNormalized = false;
+        s_.transfer = s_.transfer.resolved(lo, hi);
+        if (s_.isoNormalized) {
+            s_.isoLevel = lo + s_.isoLevel * (hi - lo);
+            s_.isoNormalized = false;
         }
     }
-    if (exactSheets) {
-        Image out = renderBrickedSlabs(geometry, layout, mine, loadBrick, s, group, st);
-        if (stats) *stats = st;
-        return out;
-    }
-    std::vector<std::pair<int, Image>> partials;
-    try {
-        for (int b : mine) {
-            const Brick& brick = layout.bricks[std::size_t(b)];
-            auto v = std::make_shared<const Volume>(kept ? std::move(*kept) : loadBrick(b));
-            kept.reset();
-            auto t = Clock::now();
-            const RenderSettings bs = brickSettings(s, geometry, brick, geometry.dims);
-            const Scene scene(v, bs);
-            st.sceneMs += msSince(t);
-            t = Clock::now();
-            RenderStats rs;
-            partials.emplace_back(b, scene.render(bs, &rs));
-            st.renderMs += msSince(t);
-            st.splats += rs.splats;
+    if (!keep) return;
+    try {  // the Scenes, once (their camera is any view's: a Scene does not depend on it)
+        for (std::size_t i = 0; i < mine_.size(); ++i) {
+            RenderSettings bs =
+                brickSettings(s_, geometry_, layout_.bricks[std::size_t(mine_[i])], geometry_.dims);
+            if (exactSheets) bs.clipping.planes.clear();
+            scene(int(i), bs);
         }
     } catch (const std::exception& e) {
         error = e.what();
     }
     group.agree(error);
+}
+
+BrickedFrames::~BrickedFrames() = default;
+
+Volume BrickedFrames::loadBrick(int b) {
     const auto t = Clock::now();
-    const std::vector<int> order = visibilityOrder(layout, geometry, frame.camera);
-    Image out = group.composite(partials, order, frame.camera.width, frame.camera.height,
-                                frame.mode, frame.background, &st.bytesExchanged);
-    st.compositeMs = msSince(t);
-    if (stats) *stats = st;
+    Volume v = load_(layout_.bricks[std::size_t(b)]);
+    v.background = geometry_.background;
+    st_.samplesLoaded = std::max(st_.samplesLoaded, v.voxelCount());
+    st_.loadMs += msSince(t);
+    return v;
+}
+
+std::shared_ptr<const Scene> BrickedFrames::scene(int i, const RenderSettings& bs) {
+    const std::size_t k = std::size_t(i);
+    std::vector<std::shared_ptr<const Scene>>& set = scenes_.at(std::size_t(bs.renderer));
+    set.resize(mine_.size());
+    if (set[k]) return set[k];
+    std::shared_ptr<const Volume> v = keep_ ? volumes_[k] : std::move(volumes_[k]);
+    if (!v) {
+        v = std::make_shared<const Volume>(loadBrick(mine_[k]));
+        if (keep_) volumes_[k] = v;
+    }
+    const auto t = Clock::now();
+    auto sc = std::make_shared<const Scene>(std::move(v), bs);
+    st_.sceneMs += msSince(t);
+    if (keep_) set[k] = sc;
+    return sc;
+}
+
+Image BrickedFrames::render(const CameraParams& camera) { return render(camera, s_.renderer); }
+
+Image BrickedFrames::render(const CameraParams& camera, RendererKind renderer, RenderStats* stats) {
+    const auto start = Clock::now();
+    RenderStats frameStats;
+    Image out = renderFrame(camera, renderer, frameStats);
+    frameStats.milliseconds = msSince(start);
+    if (stats) *stats = frameStats;
+    return out;
+}
+
+Image BrickedFrames::renderFrame(const CameraParams& camera, RendererKind renderer,
+                                 RenderStats& frameStats) {
+    RenderSettings s = s_;
+    s.camera = camera;
+    s.renderer = renderer;
+    if (exact(renderer))
+        return renderBrickedSlabs(
+            geometry_, layout_, mine_,
+            [&](int i, const RenderSettings& bs) { return scene(i, bs); }, s, group_, st_);
+    std::vector<std::pair<int, Image>> partials;
+    std::string error;
+    try {
+        for (std::size_t i = 0; i < mine_.size(); ++i) {
+            const int b = mine_[i];
+            const RenderSettings bs =
+                brickSettings(s, geometry_, layout_.bricks[std::size_t(b)], geometry_.dims);
+            const std::shared_ptr<const Scene> sc = scene(int(i), bs);
+            const auto t = Clock::now();
+            RenderStats rs;
+            partials.emplace_back(b, sc->render(bs, &rs));
+            st_.renderMs += msSince(t);
+            st_.splats += rs.splats;
+            frameStats.splats += rs.splats;
+            frameStats.voxels += rs.voxels;
+            frameStats.sheetAxis = rs.sheetAxis;
+            frameStats.sheetSign = rs.sheetSign;
+        }
+    } catch (const std::exception& e) {
+        error = e.what();
+    }
+    group_.agree(error);
+    const auto t = Clock::now();
+    const std::vector<int> order = visibilityOrder(layout_, geometry_, camera);
+    Image out = group_.composite(partials, order, camera.width, camera.height, s.mode, s.background,
+                                 &st_.bytesExchanged);
+    st_.compositeMs += msSince(t);
+    return out;
+}
+
+Image renderBricked(const Volume& geometry, const std::function<Volume(const Brick&)>& load,
+                    const RenderSettings& frame, int bricks, BrickGroup& group, BrickStats* stats,
+                    BrickComposite composite) {
+    BrickedFrames frames(geometry, load, frame, bricks, group, composite, false);
+    Image out = frames.render(frame.camera);
+    if (stats) *stats = frames.stats();
     return out;
 }
 

@@ -262,9 +262,10 @@ SlabLayout slabLayout(const RenderSettings& s, const Volume& geometry, float nea
     return L;
 }
 
-Image renderBrickedSlabs(const Volume& geometry, const BrickLayout& layout,
-                         const std::vector<int>& mine, const std::function<Volume(int)>& load,
-                         const RenderSettings& frame, BrickGroup& group, BrickStats& st) {
+Image renderBrickedSlabs(
+    const Volume& geometry, const BrickLayout& layout, const std::vector<int>& mine,
+    const std::function<std::shared_ptr<const Scene>(int, const RenderSettings&)>& scene,
+    const RenderSettings& frame, BrickGroup& group, BrickStats& st) {
     RenderSettings s = frame;
     if (s.mode == RenderMode::Iso) s.order = CompositeOrder::FrontToBack;  // as renderFrame
     if (s.clipping.enabled())
@@ -275,21 +276,18 @@ Image renderBrickedSlabs(const Volume& geometry, const BrickLayout& layout,
             "--bricks with --renderer sheet renders full resolution: leave out --lod or use "
             "--brick-composite fast");
     // Every brick of this process, held at once: a slab group needs them all.
-    std::vector<std::unique_ptr<Scene>> scenes;
+    std::vector<std::shared_ptr<const Scene>> scenes;
     std::vector<RenderSettings> settings;
     std::vector<BrickSheets> sheets;
     std::string error;
     float nearest = INFINITY, farthest = -INFINITY;
     try {
-        for (int b : mine) {
-            const Brick& brick = layout.bricks[std::size_t(b)];
-            auto v = std::make_shared<const Volume>(load(b));
-            auto t = Clock::now();
+        for (std::size_t i = 0; i < mine.size(); ++i) {
+            const Brick& brick = layout.bricks[std::size_t(mine[i])];
             RenderSettings bs = brickSettings(s, geometry, brick, geometry.dims);
             bs.clipping.planes.clear();  // every kernel in one brick: nothing is cut
-            scenes.push_back(std::make_unique<Scene>(v, bs));
-            st.sceneMs += msSince(t);
-            t = Clock::now();
+            scenes.push_back(scene(int(i), bs));
+            const auto t = Clock::now();
             sheets.emplace_back(*scenes.back(), bs, brick.lo - brick.loadLo,
                                 brick.hi - brick.loadLo, geometry);
             settings.push_back(bs);
