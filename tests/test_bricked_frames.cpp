@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.h"
+#include "image_diff.h"
 #include "splat/bricks.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
@@ -20,20 +21,6 @@ using namespace splat::test;
 namespace fs = std::filesystem;
 
 namespace {
-
-float peakOf(const Image& im) {
-    float m = 0;
-    for (const glm::vec4& p : im.pixels) m = std::max({m, p.r, p.g, p.b, p.a});
-    return m;
-}
-
-float maxDiff(const Image& a, const Image& b) {
-    REQUIRE(a.pixels.size() == b.pixels.size());
-    float m = 0;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i)
-        for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(a.pixels[i][c] - b.pixels[i][c]));
-    return m;
-}
 
 }  // namespace
 

@@ -9,45 +9,14 @@
 #include <fstream>
 
 #include "cli_util.h"
+#include "image_diff.h"
+#include "mpi_util.h"
 #include "splat/image_io.h"
 #include "splat/synthetic.h"
 
 using namespace splat;
 using namespace splat::test;
 namespace fs = std::filesystem;
-
-namespace {
-
-/// `mpirun [--oversubscribe] -np N splat ARGS` as tests/test_mpi.cpp starts it.
-RunResult mpirunSplat(int n, std::vector<std::string> args) {
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-    ::setenv("OMPI_MCA_btl", "self,vader", 0);
-    ::setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
-    std::vector<std::string> a = {"-s", "KILL", "120", "mpirun"};
-    if (runProgram("mpirun", {"--version"}).out.find("Open MPI") != std::string::npos)
-        a.push_back("--oversubscribe");
-    for (const std::string& s : {std::string("-np"), std::to_string(n), std::string(SPLAT_EXE)})
-        a.push_back(s);
-    a.insert(a.end(), args.begin(), args.end());
-    return runProgram("timeout", a);
-}
-
-float maxDiffOf(const Image& a, const Image& b) {
-    REQUIRE(a.pixels.size() == b.pixels.size());
-    float m = 0;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i)
-        for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(a.pixels[i][c] - b.pixels[i][c]));
-    return m;
-}
-
-float peak(const Image& im) {
-    float m = 0;
-    for (const glm::vec4& p : im.pixels) m = std::max({m, p.r, p.g, p.b, p.a});
-    return m;
-}
-
-}  // namespace
 
 TEST_CASE("mpi: rotate --bricks on 2 ranks writes the one-process frames", "[.mpi]") {
     const fs::path dir = testTmpDir("mpi_rotate");
@@ -84,8 +53,8 @@ TEST_CASE("mpi: rotate --bricks on 2 ranks writes the one-process frames", "[.mp
             const Image one = readImage((dir / (renderer + "_one") / name).string());
             const Image two = readImage((dir / (renderer + "_np2") / name).string());
             INFO(renderer << " frame " << f);
-            CHECK(peak(one) > 0.05f);
-            CHECK(maxDiffOf(one, two) <= 1e-5f * peak(one));
+            CHECK(peakOf(one) > 0.05f);
+            CHECK(maxDiff(one, two) <= 1e-5f * peakOf(one));
         }
     }
     // A file too short for its header: rank 1's brick is beyond its end. One error, exit 1,
