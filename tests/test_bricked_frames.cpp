@@ -20,10 +20,6 @@ using namespace splat;
 using namespace splat::test;
 namespace fs = std::filesystem;
 
-namespace {
-
-}  // namespace
-
 TEST_CASE("bricked frames: Scenes built once render every view as one process", "[bricks]") {
     const std::string spec = "synthetic:phantom:27";
     const Volume v = loadVolume(spec);
