@@ -268,8 +268,8 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
     BrickedFrames frames(
         geometry, brickLoader(a.volume), settings, bricks, group,
         a.brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
-    std::size_t todo = 0, done = 0;
-    for (bool k : keep) todo += k ? 0 : 1;
+    std::size_t pending = 0, done = 0;
+    for (bool k : keep) pending += k ? 0 : 1;
     std::string failure;
     for (std::size_t v = 0; v < path.views.size(); ++v) {
         group.agree(failure);
@@ -282,7 +282,7 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t)
                     .count();
             emit(v, image, ms);
-            if (!progress(++done, todo, "view " + std::to_string(v)))
+            if (!progress(++done, pending, "view " + std::to_string(v)))
                 throw Error("interrupted after " + std::to_string(done) +
                             " new frames; the frames written are complete (--resume finishes "
                             "them)");
@@ -301,7 +301,7 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
             "frames\n",
             r, all[r].rendered, all[r].bricks, all[r].samplesLoaded,
             all[r].samplesLoaded * 4.0 / 1048576.0, all[r].loadMs, all[r].sceneMs, all[r].renderMs,
-            all[r].compositeMs, static_cast<unsigned long long>(all[r].bytesExchanged), todo);
+            all[r].compositeMs, static_cast<unsigned long long>(all[r].bytesExchanged), pending);
 }
 }  // namespace
 
