@@ -11,6 +11,7 @@
 #include <mutex>
 #include <numeric>
 
+#include "frame/stopwatch.h"
 #include "frame_journal.h"
 #include "splat/flip.h"
 #include "splat/image_io.h"
@@ -19,11 +20,6 @@
 namespace splat {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 constexpr std::size_t kMaxViews = 100000;
 

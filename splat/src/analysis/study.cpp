@@ -11,6 +11,7 @@
 #include <optional>
 #include <sstream>
 
+#include "frame/stopwatch.h"
 #include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "splat/frame_farm.h"
@@ -26,11 +27,6 @@
 namespace splat {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 double median(std::vector<double> v) {
     if (v.empty()) return 0;

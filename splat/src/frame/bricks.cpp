@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "footprint/kernel.h"
+#include "frame/stopwatch.h"
 #include "splat/camera.h"
 #include "splat/error.h"
 #include "splat/scene.h"
@@ -168,17 +169,6 @@ Image compositeBricks(const std::vector<const Image*>& frontToBack, RenderMode m
         for (glm::vec4& o : out.pixels) o += (1.0f - o.a) * background;
     return out;
 }
-
-}  // namespace splat
-
-namespace splat {
-
-namespace {
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
-}  // namespace
 
 void LocalBrickGroup::agree(const std::string& error) {
     if (!error.empty()) throw Error(error);

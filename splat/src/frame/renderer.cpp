@@ -14,6 +14,7 @@
 #include "frame/compositing.h"
 #include "frame/frame.h"
 #include "frame/projection.h"
+#include "frame/stopwatch.h"
 #include "frame/tile_binning.h"
 #include "model/level_of_detail.h"
 #include "reference/pixel_filter.h"
@@ -24,11 +25,6 @@
 namespace splat {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 /// Emission to splat: null (the list's own, SplatList::emission) or (shaded scenes) this
 /// view's shaded emission.
@@ -131,7 +127,8 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
     const Splatter& splatter =
         s.renderer == RendererKind::Axis ? axisAlignedSplatter() : imageAlignedSplatter();
     const WorkspaceLease work(scene);
-    stats.ewaSigma = footprintFilter(scene.kernel, s.quality, s.mode, camera, *scene.volume).lowPass;
+    stats.ewaSigma =
+        footprintFilter(scene.kernel, s.quality, s.mode, camera, *scene.volume).lowPass;
     const Emission e = shade(scene, camera, *work, stats);
     if (!splatter.streams()) project(scene, camera, s.quality, s.mode, *work, stats);
     const SheetPlan plan = order(splatter, scene, camera, s, *work, stats);
@@ -188,8 +185,7 @@ Image filteredReferenceFrame(const Scene::Impl& scene, const Camera& camera,
                              const RenderSettings& s, RenderStats& stats, Image* depth) {
     RenderStats fine;
     const PixelFilterResult r = filteredImage(
-        camera, s.quality.pixelFilter, s.quality.pixelFilterTolerance,
-        [&](const CameraParams& p) {
+        camera, s.quality.pixelFilter, s.quality.pixelFilterTolerance, [&](const CameraParams& p) {
             return referenceFrame(scene, Camera(p, *scene.volume), s, fine, nullptr);
         });
     stats.referenceStep = fine.referenceStep;

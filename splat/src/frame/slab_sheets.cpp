@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "frame/frame.h"
+#include "frame/stopwatch.h"
 #include "splat/bricks.h"
 #include "splat/error.h"
 #include "splatters/splatter.h"
@@ -228,19 +229,6 @@ std::uint32_t slabGroup(const SlabLayout& layout, std::size_t bytes) {
     const std::size_t n = perSlab ? bytes / perSlab : 1;
     return std::uint32_t(std::clamp<std::size_t>(n, 1, std::max<std::uint32_t>(layout.slabs, 1)));
 }
-
-}  // namespace splat
-
-namespace splat {
-
-namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
-
-}  // namespace
 
 SlabLayout slabLayout(const RenderSettings& s, const Volume& geometry, float nearest,
                       float farthest) {
