@@ -1,6 +1,7 @@
 // `splat render` in bricks (bricked_render.h).
 #include "bricked_render.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
@@ -17,7 +18,7 @@
 namespace splat::cli {
 
 int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int ranks,
-                     std::uint64_t rankBytes, bool* wholeFits, bool quiet) {
+                     std::uint64_t rankBytes, bool* wholeFits, bool quiet, int sceneSets) {
     const footprint::Kernel kernel =
         footprint::Kernel::fromName(settings.kernel, settings.kernelSigma, settings.kernelRadius);
     BrickBudget budget;
@@ -26,6 +27,7 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
     budget.width = settings.camera.width;
     budget.height = settings.camera.height;
     budget.ghost = ghostLayers(kernel.radius(), geometry.spacing);
+    budget.splatShare *= std::max(sceneSets, 1);
     const BrickChoice c = chooseBricks(geometry.dims, budget);
     if (wholeFits) *wholeFits = c.wholeFits;
     if (!workerProcess() && !quiet) {

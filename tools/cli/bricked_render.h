@@ -21,8 +21,11 @@ std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume);
 
 /// K from the budget per process (`rankBytes`, 0: defaultRankBytes) by chooseBricks, said on
 /// rank 0 unless `quiet`; `wholeFits`: whether the whole volume fits one process.
+/// `sceneSets`: the Scenes (splat lists) held per brick, one per renderer (popping: its
+/// renderers), each counted in the estimate.
 int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int ranks,
-                     std::uint64_t rankBytes, bool* wholeFits = nullptr, bool quiet = false);
+                     std::uint64_t rankBytes, bool* wholeFits = nullptr, bool quiet = false,
+                     int sceneSets = 1);
 
 /// Every process loads and renders its bricks, the group composites the frame, and rank 0
 /// writes it to `output` and prints what the frame took. `bricks` 0: chosen from the budget

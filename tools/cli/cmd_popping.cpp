@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "bricked_render.h"
+#include "bricked_requests.h"
 #include "commands.h"
 #include "diagnostics.h"
 #include "parallel.h"
@@ -31,6 +32,8 @@ struct PoppingCommand {
     PoppingArgs popping;
     std::string report;
     int bricks = 0;
+    double rankMemory = 0;  ///< MiB; 0: the default under mpirun, off otherwise
+    std::string brickComposite = "exact";
     bool quiet = false, resume = false;
 };
 
@@ -79,8 +82,18 @@ void registerPopping(CLI::App& app) {
             "finish an interrupted run: reuse the frames it left in REPORT/.frames", out);
     addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
     addOption(*cmd, "--bricks", a->bricks,
-              "sort-last, one process: cut the volume into K bricks, loaded and built once, "
-              "every frame rendered by them and composited (0: off; exact sheets)",
+              "sort-last: cut the volume into K bricks, loaded and built once, every frame of "
+              "the analysis rendered by them and composited, exact sheets (0: off; under mpirun "
+              "chosen from --rank-memory when the volume does not fit one process)",
+              out);
+    addOption(*cmd, "--rank-memory", a->rankMemory,
+              "bricks: memory per process in MiB (default under mpirun: 80% of the physical "
+              "memory / processes on the node); frames in parallel when the volume fits",
+              out);
+    addOption(*cmd, "--brick-composite", a->brickComposite,
+              "bricks of the image-aligned splatter: exact (slab sheets summed across bricks: "
+              "the findings do not change with K) or fast (partial images, approximate at brick "
+              "faces)",
               out);
     cmd->footer(
         "Examples:\n"
@@ -101,38 +114,93 @@ void registerPopping(CLI::App& app) {
         settings.renderer = o.renderers.front();
         if (a->bricks < 0 || a->bricks > 4096)
             throw UsageError("--bricks must be between 0 and 4096");
-        if (a->bricks > 0 && processCount() > 1)
+        if (!(a->rankMemory >= 0 && a->rankMemory <= 1e9))
+            throw UsageError("--rank-memory must be between 0 and 1e9 MiB");
+        if (a->brickComposite != "exact" && a->brickComposite != "fast")
+            throw UsageError("--brick-composite must be exact or fast (got '" + a->brickComposite +
+                             "')");
+        // README "Beyond one machine": bricks when asked (--bricks), or when the budget per
+        // process says the volume does not fit one (mpirun, --rank-memory); else frames in
+        // parallel under mpirun. Every rank decides alike (the same geometry).
+        int bricks = a->bricks;
+        std::optional<Volume> geometry;
+        bool alone = true;
+        const std::uint64_t rankBytes = std::uint64_t(a->rankMemory * 1048576.0);
+        if (bricks > 0 || rankBytes > 0 || processCount() > 1) {
+            geometry = brickedGeometry(a->volume, &alone);
+            settings = withFreeCameraTarget(settings, *geometry);
+            bool fits = true;
+            if (bricks == 0) {
+                // Each renderer holds its own Scenes of the bricks (splat lists) over the same
+                // samples: the budget counts the splats once per renderer.
+                const int sets = int(o.renderers.size());
+                bricksFromBudget(*geometry, settings, processCount(), rankBytes, &fits, true, sets);
+                if (!fits)
+                    bricks = bricksFromBudget(*geometry, settings, processCount(), rankBytes,
+                                              nullptr, false, sets);
+            }
+            if (bricks > int(std::min<std::size_t>(geometry->voxelCount(), 1 << 20)))
+                throw UsageError("--bricks " + std::to_string(bricks) +
+                                 " is more than the volume's " +
+                                 std::to_string(geometry->voxelCount()) + " samples");
+        }
+        const bool bricked = bricks > 0;
+        if (bricked && !a->popping.path.empty())
             throw UsageError(
-                "popping --bricks runs on one process; under mpirun popping is frame-parallel "
-                "(leave out --bricks)");
-        if (workerProcess())  // under mpirun: render the frames rank 0 asks for (parallel.h)
+                "popping in bricks (--bricks, or a volume beyond --rank-memory) takes a sweep "
+                "(--from, --to, --step), not --path");
+        if (!bricked && workerProcess())  // under mpirun: render the frames rank 0 asks for
             return serveFrames([&] {
                 auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
                 return Scene(v, withDataDefaults(a->render, settings, *v));
             });
+        const bool sheet = std::find(o.renderers.begin(), o.renderers.end(),
+                                     RendererKind::Sheet) != o.renderers.end();
+        if (given(*cmd, "brick-composite") && !fromScene(*cmd, "brick-composite") &&
+            (!bricked || !sheet))
+            warn(
+                "--brick-composite applies to popping in bricks (--bricks, or a volume beyond "
+                "--rank-memory) with the image-aligned splatter (sheet): ignored");
+        else if (bricked && sheet && a->brickComposite == "fast")
+            warn(
+                "--brick-composite fast: the image-aligned splatter is approximate where its "
+                "slabs cross a brick face, so its findings may change with the bricks (README "
+                "\"Beyond one machine\"); --brick-composite exact is not");
+        if (bricked && !alone)
+            warn(a->volume.spec +
+                 ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, "
+                 "an ANALYZE pair): every rank loads the whole volume once and keeps its brick");
+        // README "Beyond one machine": in bricks every rank loads its bricks and builds their
+        // Scenes once (splat/bricks.h BrickedFrames; a brick that cannot be read fails every
+        // rank here, before any file is written); rank 0 runs the analysis and asks the group
+        // for every frame it needs (bricked_requests.h), the other ranks serve them.
+        std::unique_ptr<BrickGroup> group;
+        std::unique_ptr<BrickedFrames> frames;
+        if (bricked) {
+            group = brickGroup();
+            frames = std::make_unique<BrickedFrames>(
+                *geometry, brickLoader(a->volume), settings, bricks, *group,
+                a->brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
+            settings = frames->settings();
+        }
+        std::optional<BrickedFrameRequests> requests;
+        if (bricked) requests.emplace(*frames, *group);
+        if (workerProcess()) {
+            if (requests->serve()) group->gather(frames->stats());
+            return;
+        }
         beginRun(*cmd);
         // The frames rendered so far are journaled, so that --resume after an interruption
         // renders only the rest; the journal goes once the report is written.
         const std::string journal = a->report + "/.frames";
         prepareJournal(*cmd, journal, a->resume);
         o.frameJournal = journal;
-        // README "Beyond one machine": --bricks renders every frame from bricks whose Scenes
-        // are built once (splat/bricks.h BrickedFrames), through the analyser's frame seam.
         std::shared_ptr<const Volume> volume;
         std::optional<Scene> scene;
-        std::optional<Volume> geometry;
-        std::unique_ptr<BrickGroup> group;
-        std::unique_ptr<BrickedFrames> bricked;
-        if (a->bricks > 0) {
-            geometry = brickedGeometry(a->volume);
-            settings = withFreeCameraTarget(settings, *geometry);
-            group = brickGroup();
-            bricked = std::make_unique<BrickedFrames>(*geometry, brickLoader(a->volume), settings,
-                                                      a->bricks, *group);
+        if (bricked) {
             o.renderFrame = [&](const RenderSettings& s, RenderStats* st) {
-                return bricked->render(s.camera, s.renderer, st);
+                return requests->render(s.camera, s.renderer, st);
             };
-            settings = bricked->settings();
         } else {
             volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
             settings = withDataDefaults(a->render, settings, *volume);
@@ -145,8 +213,6 @@ void registerPopping(CLI::App& app) {
         };
         PoppingResult result;
         try {
-            if (bricked && !a->popping.path.empty())
-                throw Error("popping --bricks takes a sweep (--from, --to, --step), not --path");
             result =
                 bricked ? analyzePopping(*geometry, settings, sweep, o)
                 : a->popping.path.empty()
@@ -162,9 +228,24 @@ void registerPopping(CLI::App& app) {
                 "rendered)");
         }
         progress.finish();
+        std::vector<BrickStats> ranks;
+        if (bricked) {
+            requests->end(true);
+            ranks = group->gather(frames->stats());
+        }
         writePoppingReport(result, a->report, commandLine());
         removeJournal(journal);
         printSummary(result);
+        if (!a->quiet)
+            for (std::size_t r = 0; r < ranks.size(); ++r)
+                std::printf(
+                    "rank %zu: %d of %d bricks, largest %zu samples (%.1f MiB), load %.1f ms, "
+                    "scene %.1f ms; render %.1f ms, composite %.1f ms, exchanged %llu bytes over "
+                    "%zu frames\n",
+                    r, ranks[r].rendered, ranks[r].bricks, ranks[r].samplesLoaded,
+                    ranks[r].samplesLoaded * 4.0 / 1048576.0, ranks[r].loadMs, ranks[r].sceneMs,
+                    ranks[r].renderMs, ranks[r].compositeMs,
+                    static_cast<unsigned long long>(ranks[r].bytesExchanged), requests->frames());
         std::printf("wrote %s/report.html, metrics.csv, summary.json (%.1f s)\n", a->report.c_str(),
                     result.totalMs / 1000.0);
         finishRun(*cmd);

@@ -4,8 +4,10 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <chrono>
 #include <climits>
 #include <cstring>
+#include <thread>
 #include <type_traits>
 
 #include "splat/error.h"
@@ -204,8 +206,16 @@ class MpiBrickGroup : public BrickGroup {
     }
 
     void broadcast(std::vector<unsigned char>& bytes) override {
+        // The size first, without spinning: a rank waiting for rank 0 (which may work alone
+        // meanwhile, as popping's analysis does between the frames it asks for) sleeps
+        // between tests, since a blocking broadcast polls a core in OpenMPI.
         unsigned long long n = bytes.size();
-        MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+        MPI_Request request;
+        MPI_Ibcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD, &request);
+        for (int done = 0; !done;) {
+            MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+            if (!done) std::this_thread::sleep_for(std::chrono::microseconds(200));
+        }
         bytes.resize(std::size_t(n));
         if (n) MPI_Bcast(bytes.data(), int(n), MPI_UNSIGNED_CHAR, 0, MPI_COMM_WORLD);
     }
