@@ -87,3 +87,24 @@ TEST_CASE("brick budget: the default is 80% of physical memory over the ranks on
     ::unsetenv("OMPI_COMM_WORLD_LOCAL_SIZE");
     CHECK(defaultRankBytes(2) == one / 2);
 }
+
+TEST_CASE("brick budget: bytes per sample beyond one splat list (popping's renderers)",
+          "[bricks]") {
+    BrickBudget b;
+    b.width = b.height = 64;
+    b.ghost = 5;
+    b.ranks = 2;
+    b.rankBytes = 400 * MiB;
+    b.extraSampleBytes = 45.5;  // popping's three renderers at a quarter of splats
+    // phantom:200 (8 M samples): 150 MiB + 8 M x 56 bytes = 577 MiB whole, beyond 400 MiB;
+    // two bricks of 200 x 200 x 105 = 4.2 M samples (ghost layers included): 374 MiB.
+    const BrickChoice c = chooseBricks(glm::ivec3(200), b);
+    CHECK_FALSE(c.wholeFits);
+    CHECK(c.bricks == 2);
+    CHECK(c.largestBrick == 4200000);
+    CHECK(c.rankBytes == brickMemoryEstimate(4200000, 64, 64, 1, 0.25) + 4200000ull * 455 / 10);
+    CHECK(c.rankBytes <= b.rankBytes);
+    // Without the extra bytes the whole volume fits (8 M x 10.5 bytes + 150 MiB = 230 MiB).
+    b.extraSampleBytes = 0;
+    CHECK(chooseBricks(glm::ivec3(200), b).wholeFits);
+}

@@ -69,9 +69,9 @@ double requireSameFindings(const fs::path& one, const fs::path& bricked, double 
         REQUIRE(ea.size() == eb.size());
         CHECK(sa["renderers"][renderer]["exact_views"] == sb["renderers"][renderer]["exact_views"]);
         for (std::size_t i = 0; i < ea.size(); ++i) {
-            for (const char* key : {"angle_from", "angle_to", "refined_width", "refined_angle",
-                                    "sheet_axis_before", "sheet_axis_after", "sheet_sign_before",
-                                    "sheet_sign_after", "predicted"})
+            for (const char* key :
+                 {"angle_from", "angle_to", "refined_width", "refined_angle", "sheet_axis_before",
+                  "sheet_axis_after", "sheet_sign_before", "sheet_sign_after", "predicted"})
                 CHECK(ea[i][key] == eb[i][key]);
             // The same classification: a discontinuity (|slope| < 0.25) or continuous change.
             CHECK((std::abs(ea[i]["refined_slope"].get<double>()) < 0.25) ==
@@ -138,7 +138,7 @@ TEST_CASE("mpi: popping in bricks fails with one error, no report and no hang", 
     const fs::path dir = testTmpDir("mpi_popping_fail");
     fs::remove_all(dir);
     fs::create_directories(dir);
-    const std::vector<std::string> sweep = {"--size", "16x16", "--from", "40",   "--to",
+    const std::vector<std::string> sweep = {"--size", "16x16",  "--from", "40",        "--to",
                                             "44",     "--step", "2",      "--no-flip", "-q"};
     auto run = [&](int ranks, std::vector<std::string> args) {
         args.insert(args.end(), sweep.begin(), sweep.end());
@@ -166,8 +166,8 @@ TEST_CASE("mpi: popping in bricks fails with one error, no report and no hang", 
         << std::string(reinterpret_cast<const char*>(data.data()), data.size() * sizeof(float));
     {
         const RunResult r =
-            run(2, {"popping", (dir / "short.nrrd").string(), "--bricks", "2",
-                    "--background-value", "0", "--report", (dir / "short").string()});
+            run(2, {"popping", (dir / "short.nrrd").string(), "--bricks", "2", "--background-value",
+                    "0", "--report", (dir / "short").string()});
         INFO(r.err);
         CHECK(r.status == 1);
         CHECK(oneError(r));
@@ -178,9 +178,9 @@ TEST_CASE("mpi: popping in bricks fails with one error, no report and no hang", 
     // A frame that fails on every rank mid-analysis (the exact sheets refuse perspective, at
     // the first sheet frame, after the first axis frame): rank 0 ends the requests.
     {
-        const RunResult r = run(3, {"popping", "synthetic:phantom:20", "--bricks", "3",
-                                    "--projection", "perspective", "--report",
-                                    (dir / "persp").string()});
+        const RunResult r =
+            run(3, {"popping", "synthetic:phantom:20", "--bricks", "3", "--projection",
+                    "perspective", "--report", (dir / "persp").string()});
         INFO(r.err);
         CHECK(r.status == 1);
         CHECK(oneError(r));

@@ -18,7 +18,8 @@
 namespace splat::cli {
 
 int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int ranks,
-                     std::uint64_t rankBytes, bool* wholeFits, bool quiet, int sceneSets) {
+                     std::uint64_t rankBytes, bool* wholeFits, bool quiet,
+                     double extraSampleBytes) {
     const footprint::Kernel kernel =
         footprint::Kernel::fromName(settings.kernel, settings.kernelSigma, settings.kernelRadius);
     BrickBudget budget;
@@ -27,7 +28,7 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
     budget.width = settings.camera.width;
     budget.height = settings.camera.height;
     budget.ghost = ghostLayers(kernel.radius(), geometry.spacing);
-    budget.splatShare *= std::max(sceneSets, 1);
+    budget.extraSampleBytes = extraSampleBytes;
     const BrickChoice c = chooseBricks(geometry.dims, budget);
     if (wholeFits) *wholeFits = c.wholeFits;
     if (!workerProcess() && !quiet) {
@@ -44,6 +45,16 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
                  " bricks exceed the budget per process by the estimate; rendering anyway");
     }
     return c.bricks;
+}
+
+double poppingSampleBytes(const std::vector<RendererKind>& renderers, double splatShare) {
+    double bytes = 0;
+    for (std::size_t k = 1; k < renderers.size(); ++k) bytes += splatShare * 26.0;
+    for (RendererKind r : renderers) {
+        if (r == RendererKind::Reference) bytes += 20.0;
+        if (r == RendererKind::Sheet) bytes += splatShare * 50.0;
+    }
+    return bytes;
 }
 
 std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume) {

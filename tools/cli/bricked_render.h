@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "render_options.h"
 #include "splat/bricks.h"
@@ -21,11 +22,18 @@ std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume);
 
 /// K from the budget per process (`rankBytes`, 0: defaultRankBytes) by chooseBricks, said on
 /// rank 0 unless `quiet`; `wholeFits`: whether the whole volume fits one process.
-/// `sceneSets`: the Scenes (splat lists) held per brick, one per renderer (popping: its
-/// renderers), each counted in the estimate.
+/// `extraSampleBytes`: bytes per sample held beyond the samples and one splat list
+/// (BrickBudget; popping: poppingSampleBytes).
 int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int ranks,
                      std::uint64_t rankBytes, bool* wholeFits = nullptr, bool quiet = false,
-                     int sceneSets = 1);
+                     double extraSampleBytes = 0);
+
+/// What `splat popping` in bricks holds per sample beyond the samples and one splat list: one
+/// Scene per renderer of `renderers` over the same samples — another splat list each (26
+/// bytes per splat), the reference's field grid (20 bytes per sample: FieldGrid<4> and <1>),
+/// and the image-aligned splatter's projected splats (measured: ~50 bytes per splat, 120 MB
+/// for the 2.4 M splats of phantom:200) — with `splatShare` of the samples as splats.
+double poppingSampleBytes(const std::vector<RendererKind>& renderers, double splatShare = 0.25);
 
 /// Every process loads and renders its bricks, the group composites the frame, and rank 0
 /// writes it to `output` and prints what the frame took. `bricks` 0: chosen from the budget

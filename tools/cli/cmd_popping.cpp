@@ -131,13 +131,13 @@ void registerPopping(CLI::App& app) {
             settings = withFreeCameraTarget(settings, *geometry);
             bool fits = true;
             if (bricks == 0) {
-                // Each renderer holds its own Scenes of the bricks (splat lists) over the same
-                // samples: the budget counts the splats once per renderer.
-                const int sets = int(o.renderers.size());
-                bricksFromBudget(*geometry, settings, processCount(), rankBytes, &fits, true, sets);
+                // Each renderer holds its own Scenes of the bricks over the same samples.
+                const double extra = poppingSampleBytes(o.renderers);
+                bricksFromBudget(*geometry, settings, processCount(), rankBytes, &fits, true,
+                                 extra);
                 if (!fits)
                     bricks = bricksFromBudget(*geometry, settings, processCount(), rankBytes,
-                                              nullptr, false, sets);
+                                              nullptr, false, extra);
             }
             if (bricks > int(std::min<std::size_t>(geometry->voxelCount(), 1 << 20)))
                 throw UsageError("--bricks " + std::to_string(bricks) +
@@ -154,8 +154,8 @@ void registerPopping(CLI::App& app) {
                 auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
                 return Scene(v, withDataDefaults(a->render, settings, *v));
             });
-        const bool sheet = std::find(o.renderers.begin(), o.renderers.end(),
-                                     RendererKind::Sheet) != o.renderers.end();
+        const bool sheet = std::find(o.renderers.begin(), o.renderers.end(), RendererKind::Sheet) !=
+                           o.renderers.end();
         if (given(*cmd, "brick-composite") && !fromScene(*cmd, "brick-composite") &&
             (!bricked || !sheet))
             warn(

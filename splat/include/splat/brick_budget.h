@@ -21,6 +21,11 @@ struct BrickBudget {
     /// Share of the samples assumed to become splats (the transfer function decides; the
     /// phantom's skull preset keeps 3%, a head MR 10-40%).
     double splatShare = 0.25;
+    /// Bytes per sample of the brick held beyond its samples and one splat list: more
+    /// renderers' structures (`splat popping` holds one Scene per renderer: another splat
+    /// list each, the reference's field grid of 20 bytes per sample, the image-aligned
+    /// splatter's projected splats).
+    double extraSampleBytes = 0;
 };
 
 /// The estimated peak bytes of a process holding a brick of `samples` samples (ghost layers

@@ -28,8 +28,12 @@ BrickChoice chooseBricks(const glm::ivec3& dims, const BrickBudget& budget, int 
     const std::uint64_t samples =
         std::uint64_t(dims.x) * std::uint64_t(dims.y) * std::uint64_t(dims.z);
     const int cap = int(std::min<std::uint64_t>(std::uint64_t(std::max(maxBricks, 1)), samples));
+    const auto extra = [&](std::uint64_t n) {
+        return std::uint64_t(double(n) * std::max(budget.extraSampleBytes, 0.0));
+    };
     BrickChoice c;
-    c.wholeFits = brickMemoryEstimate(samples, budget.width, budget.height, 1, budget.splatShare) <=
+    c.wholeFits = brickMemoryEstimate(samples, budget.width, budget.height, 1, budget.splatShare) +
+                      extra(samples) <=
                   budget.rankBytes;
     // The largest brick of K bricks; 0 when the volume cannot be cut into K (a brick would
     // be left without samples: a thin volume).
@@ -50,7 +54,8 @@ BrickChoice chooseBricks(const glm::ivec3& dims, const BrickBudget& budget, int 
         c.bricks = K;
         c.largestBrick = largestOf(K);
         c.rankBytes = brickMemoryEstimate(c.largestBrick, budget.width, budget.height, held,
-                                          budget.splatShare);
+                                          budget.splatShare) +
+                      extra(c.largestBrick);
         c.withinBudget = c.rankBytes <= budget.rankBytes;
         if (c.withinBudget || c.wholeFits || K + P > cap || largestOf(K + P) == 0) break;
         K += P;
