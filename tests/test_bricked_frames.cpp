@@ -194,7 +194,7 @@ TEST_CASE("cli: popping --bricks K finds the events of popping", "[bricks][cli]"
         CHECK(one["renderers"]["axis"]["events"].size() == 1);
         CHECK(one["predicted_switches"] == b["predicted_switches"]);
     }
-    // Under one process only: a sweep, not a path.
+    // K out of range: a usage error.
     CHECK(runSplat({"popping", "synthetic:phantom:8", "--bricks", "-1", "--report",
                     (dir / "x").string()})
               .status == 2);

@@ -2,8 +2,9 @@
 // popping --bricks K` (rank 0 runs the analysis and asks the ranks for every frame, each rank
 // renders its bricks, the group composites) finds what the one-process popping finds: the
 // same events (angles, refined angle and width, sheet axes, prediction, classification) and
-// metrics.csv within the bricked bound; a rank that cannot read its brick, or a frame that
-// fails, ends the job with one error on rank 0, no report and no hang.
+// metrics.csv within the bricked bound, over a sweep or a camera path; a rank that cannot read
+// its brick, or a frame that fails, ends the job with one error on rank 0, no report and no
+// hang.
 // Hidden tag [.mpi], run by the ctest test mpi.ranks when splat is built with MPI.
 #if SPLAT_TEST_HAVE_MPI
 #include <catch2/catch.hpp>
@@ -132,6 +133,30 @@ TEST_CASE("mpi: popping in bricks on 2 and 3 ranks finds what one process finds"
         WARN(name << ": largest difference of a measure " << worst);
         CHECK(!fs::exists(dir / name / ".frames"));  // the journal goes with the report
     }
+    // A camera path (the same views, as path positions 0..6): 3 bricks on 2 ranks.
+    std::ofstream(dir / "path.json") << R"({"keys": [{"azimuth": 42}, {"azimuth": 48}]})";
+    auto pathArgs = [&](const std::string& report) {
+        std::vector<std::string> a;
+        bool value = false;  // the value of a sweep option, left out
+        for (const std::string& x : args(report)) {
+            const bool sweepOption = x == "--from" || x == "--to" || x == "--step";
+            if (!sweepOption && !value) a.push_back(x);
+            value = sweepOption;
+        }
+        a.insert(a.end(), {"--path", (dir / "path.json").string(), "--frames", "7"});
+        return a;
+    };
+    const RunResult onePath = runSplat(pathArgs("path_one"));
+    INFO(onePath.err);
+    REQUIRE(onePath.status == 0);
+    auto a = pathArgs("path_np2");
+    a.insert(a.end(), {"--bricks", "3"});
+    const RunResult r = mpirunSplat(2, a);
+    INFO(r.out << r.err);
+    REQUIRE(r.status == 0);
+    requireSameFindings(dir / "path_one", dir / "path_np2", bound);
+    CHECK(nlohmann::json::parse(
+              readTextFile(dir / "path_np2" / "summary.json"))["sweep"]["angle"] == "path");
 }
 
 TEST_CASE("mpi: popping in bricks fails with one error, no report and no hang", "[.mpi]") {
@@ -196,16 +221,6 @@ TEST_CASE("mpi: popping in bricks fails with one error, no report and no hang", 
         INFO(r.err);
         CHECK(r.status == 1);
         CHECK(oneError(r));
-    }
-    // --path is refused in bricks, on every rank alike (usage).
-    {
-        const RunResult r =
-            run(2, {"popping", "synthetic:phantom:20", "--bricks", "2", "--path",
-                    (dir / "short.nrrd").string(), "--report", (dir / "path").string()});
-        INFO(r.err);
-        CHECK(r.status == 2);
-        CHECK(oneError(r));
-        CHECK(!fs::exists(dir / "path"));
     }
 }
 #endif

@@ -145,10 +145,6 @@ void registerPopping(CLI::App& app) {
                                  std::to_string(geometry->voxelCount()) + " samples");
         }
         const bool bricked = bricks > 0;
-        if (bricked && !a->popping.path.empty())
-            throw UsageError(
-                "popping in bricks (--bricks, or a volume beyond --rank-memory) takes a sweep "
-                "(--from, --to, --step), not --path");
         if (!bricked && workerProcess())  // under mpirun: render the frames rank 0 asks for
             return serveFrames([&] {
                 auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
@@ -213,14 +209,16 @@ void registerPopping(CLI::App& app) {
         };
         PoppingResult result;
         try {
-            result =
-                bricked ? analyzePopping(*geometry, settings, sweep, o)
-                : a->popping.path.empty()
-                    ? analyzePopping(*scene, sweep, o)
-                    : analyzePopping(*scene,
-                                     CameraPath::fromJson(a->popping.path, scene->settings().camera,
-                                                          a->popping.frames),
-                                     o);
+            if (a->popping.path.empty()) {
+                result = bricked ? analyzePopping(*geometry, settings, sweep, o)
+                                 : analyzePopping(*scene, sweep, o);
+            } else {
+                const CameraPath path = CameraPath::fromJson(
+                    a->popping.path, bricked ? settings.camera : scene->settings().camera,
+                    a->popping.frames);
+                result = bricked ? analyzePopping(*geometry, settings, path, o)
+                                 : analyzePopping(*scene, path, o);
+            }
         } catch (const Cancelled&) {
             progress.finish();
             throw Error(

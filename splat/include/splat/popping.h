@@ -154,6 +154,10 @@ PoppingResult analyzePopping(const Volume& geometry, const RenderSettings& setti
 /// rendering the camera interpolated between its two views (interpolateCamera).
 PoppingResult analyzePopping(const Scene& scene, const CameraPath& path,
                              const PoppingOptions& options);
+/// The same over a camera path with frames from options.renderFrame (required) of a volume
+/// of geometry `geometry` and `settings` (as the sweep's overload above).
+PoppingResult analyzePopping(const Volume& geometry, const RenderSettings& settings,
+                             const CameraPath& path, const PoppingOptions& options);
 /// The same over explicit cameras.
 PoppingResult analyzePopping(const Scene& scene, const std::vector<CameraParams>& views,
                              const PoppingOptions& options);

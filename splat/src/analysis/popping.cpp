@@ -533,6 +533,17 @@ PoppingResult analyzePopping(const Scene& scene, const CameraPath& path,
         .run();
 }
 
+PoppingResult analyzePopping(const Volume& geometry, const RenderSettings& settings,
+                             const CameraPath& path, const PoppingOptions& options) {
+    std::vector<double> u = pathPositions(path);
+    auto cameraAt = [&path](double x) { return pathCamera(path, x); };
+    std::vector<double> predicted = sheetSwitches(u, cameraAt, geometry);
+    const Sweep none;
+    return Analyzer(nullptr, settings, none, path.views.size(), std::move(u), cameraAt,
+                    std::move(predicted), options)
+        .run();
+}
+
 PoppingResult analyzePopping(const Scene& scene, const std::vector<CameraParams>& views,
                              const PoppingOptions& options) {
     CameraPath path;
