@@ -32,6 +32,6 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
                          RenderSettings settings, int bricks, std::uint64_t rankBytes,
                          const std::string& output,
                          BrickComposite composite = BrickComposite::Exact,
-                         const std::string& compositor = "auto");
+                         const std::string& compositor = "direct");
 
 }  // namespace splat::cli

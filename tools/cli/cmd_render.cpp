@@ -22,7 +22,7 @@ struct RenderCommand {
     std::string output;
     int bricks = 0;
     std::string brickComposite = "exact";
-    std::string compositor = "auto";
+    std::string compositor = "direct";
     double rankMemory = 0;  ///< MiB; 0: the default under mpirun, off otherwise
 };
 }  // namespace
@@ -51,8 +51,8 @@ void registerRender(CLI::App& app) {
               "Output");
     addOption(*cmd, "--compositor", args->compositor,
               "bricks under mpirun: how the ranks composite the partial images: direct "
-              "(sparse direct-send) | icet (IceT radix-k, when built with it) | auto (icet when "
-              "built with it, else direct)",
+              "(sparse direct-send, the default) | icet (IceT radix-k, when built with it) | auto "
+              "(icet when built with it, else direct)",
               "Output");
     cmd->footer(
         "Examples:\n"

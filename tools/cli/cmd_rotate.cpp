@@ -51,7 +51,7 @@ struct RotateCommand {
     int frames = 36, fps = 12, parallelFrames = 0, bricks = 0;
     double from = 0, to = 360, rankMemory = 0;
     std::string brickComposite = "exact";
-    std::string compositor = "auto";
+    std::string compositor = "direct";
     bool resume = false, overwrite = false, quiet = false;
 };
 
@@ -339,8 +339,8 @@ void registerRotate(CLI::App& app) {
               "(partial images, approximate at brick faces)",
               seq);
     addOption(*cmd, "--compositor", a->compositor,
-              "bricks under mpirun: direct (sparse direct-send) | icet (IceT radix-k, when "
-              "built with it) | auto (icet when built with it, else direct)",
+              "bricks under mpirun: direct (sparse direct-send, the default) | icet (IceT "
+              "radix-k, when built with it) | auto (icet when built with it, else direct)",
               seq);
     addOption(*cmd, "-o,--output", a->outDir, "output folder for the frames (created)", out,
               PathKind::Output);

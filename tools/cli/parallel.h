@@ -45,13 +45,14 @@ void printError(const std::string& line);
 void serveFrames(const std::function<Scene()>& build);
 
 /// `--compositor direct|icet|auto` of render and rotate: how the ranks composite the partial
-/// images of bricks (splat/mpi/brick_group.h). auto: icet when this splat was built with IceT
+/// images of bricks (splat/mpi/brick_group.h; direct by default, chosen from measurement:
+/// README "Direct-send beside IceT"). auto: icet when this splat was built with IceT
 /// (SPLAT_ICET), else direct. A name that is none of the three, or icet in a splat built
 /// without IceT, is a UsageError.
 void checkCompositor(const std::string& name);
 
 /// The processes that render the bricks of a frame (splat/bricks.h): every rank under
 /// mpirun, compositing with `compositor` (checkCompositor), else this process alone.
-std::unique_ptr<BrickGroup> brickGroup(const std::string& compositor = "auto");
+std::unique_ptr<BrickGroup> brickGroup(const std::string& compositor = "direct");
 
 }  // namespace splat::cli
