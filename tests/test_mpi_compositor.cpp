@@ -17,7 +17,7 @@ using namespace splat;
 using namespace splat::test;
 namespace fs = std::filesystem;
 
-TEST_CASE("cli: --compositor takes direct, icet (when built with IceT) or auto", "[cli]") {
+TEST_CASE("cli: --compositor takes direct or icet (when built with IceT) or auto", "[cli]") {
     const fs::path dir = testTmpDir("compositor_usage");
     auto render = [&](const std::string& compositor) {
         return runSplat({"render", "synthetic:blob:8", "--size", "8x8", "--bricks", "2",
@@ -52,7 +52,7 @@ bool sameBits(const Image& a, const Image& b) {
 
 }  // namespace
 
-TEST_CASE("mpi: direct-send equals one process bit for bit, IceT within 1e-5 of the peak",
+TEST_CASE("mpi: direct-send equals one process bit for bit and IceT within 1e-5 of the peak",
           "[.mpi]") {
     const fs::path dir = testTmpDir("mpi_compositor");
     // A volume whose first brick holds only background: 30x8x8 samples, zero for x < 20, a
