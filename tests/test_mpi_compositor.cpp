@@ -46,8 +46,7 @@ namespace {
 
 bool sameBits(const Image& a, const Image& b) {
     return a.width == b.width && a.height == b.height &&
-           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof a.pixels[0]) ==
-               0;
+           std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof a.pixels[0]) == 0;
 }
 
 }  // namespace
@@ -72,22 +71,45 @@ TEST_CASE("mpi: direct-send equals one process bit for bit and IceT within 1e-5 
     const std::vector<Case> cases = {
         {"reference dvr", "synthetic:phantom:27", "reference", "dvr", {"--ref-tolerance", "1e-6"}},
         {"reference mip", "synthetic:phantom:27", "reference", "mip", {"--ref-tolerance", "1e-6"}},
-        {"reference xray", "synthetic:phantom:27", "reference", "xray", {"--ref-tolerance", "1e-6"}},
+        {"reference xray",
+         "synthetic:phantom:27",
+         "reference",
+         "xray",
+         {"--ref-tolerance", "1e-6"}},
         {"axis dvr", "synthetic:phantom:27", "axis", "dvr", {}},
         {"axis mip", "synthetic:phantom:27", "axis", "mip", {}},
         {"sheet fast dvr", "synthetic:phantom:27", "sheet", "dvr", {"--brick-composite", "fast"}},
-        {"axis dvr, an empty brick", raw.string(), "axis", "dvr",
+        {"axis dvr, an empty brick",
+         raw.string(),
+         "axis",
+         "dvr",
          {"--tf", "gray-ramp", "--background-value", "0"}},
-        {"reference dvr, an empty brick", raw.string(), "reference", "dvr",
+        {"reference dvr, an empty brick",
+         raw.string(),
+         "reference",
+         "dvr",
          {"--tf", "gray-ramp", "--background-value", "0", "--ref-tolerance", "1e-6"}},
     };
     for (const Case& c : cases) {
         for (int n : {2, 3}) {
             auto args = [&](const std::string& out, const std::string& compositor) {
-                std::vector<std::string> a = {"render", c.volume, "--renderer", c.renderer,
-                                              "--mode", c.mode, "--size", "36x30", "--azimuth",
-                                              "25", "--elevation", "15", "--early-termination",
-                                              "0", "--bricks", std::to_string(n), "-o",
+                std::vector<std::string> a = {"render",
+                                              c.volume,
+                                              "--renderer",
+                                              c.renderer,
+                                              "--mode",
+                                              c.mode,
+                                              "--size",
+                                              "36x30",
+                                              "--azimuth",
+                                              "25",
+                                              "--elevation",
+                                              "15",
+                                              "--early-termination",
+                                              "0",
+                                              "--bricks",
+                                              std::to_string(n),
+                                              "-o",
                                               (dir / out).string()};
                 a.insert(a.end(), c.extra.begin(), c.extra.end());
                 if (!compositor.empty()) a.insert(a.end(), {"--compositor", compositor});

@@ -108,10 +108,10 @@ std::unique_ptr<BrickGroup> brickGroup(const std::string& compositor) {
 #if SPLAT_HAVE_MPI
     checkCompositor(compositor);
     if (gSession)
-        return mpi::makeBrickGroup(*gSession, compositor == "icet" ||
-                                                      (compositor == "auto" && mpi::icetBuilt())
-                                                  ? mpi::Compositor::Icet
-                                                  : mpi::Compositor::Direct);
+        return mpi::makeBrickGroup(
+            *gSession, compositor == "icet" || (compositor == "auto" && mpi::icetBuilt())
+                           ? mpi::Compositor::Icet
+                           : mpi::Compositor::Direct);
 #else
     (void)compositor;
 #endif

@@ -8,9 +8,9 @@
 #include <cstring>
 #include <type_traits>
 
+#include "sparse_rows.h"
 #include "splat/error.h"
 #include "splat/slab_sheets.h"
-#include "sparse_rows.h"
 #if SPLAT_MPI_HAVE_ICET
 #include "icet_compositor.h"
 #endif

@@ -11,9 +11,9 @@
 #include <numeric>
 #include <string>
 
+#include "sparse_rows.h"
 #include "splat/bricks.h"
 #include "splat/error.h"
-#include "sparse_rows.h"
 
 namespace splat::mpi {
 
@@ -31,8 +31,8 @@ std::vector<int> rankOrder(const std::vector<int>& frontToBack, int ranks) {
         ++count[r];
     }
     for (int r = 0; r < ranks; ++r)
-        if (count[std::size_t(r)] && last[std::size_t(r)] - first[std::size_t(r)] + 1 !=
-                                         count[std::size_t(r)])
+        if (count[std::size_t(r)] &&
+            last[std::size_t(r)] - first[std::size_t(r)] + 1 != count[std::size_t(r)])
             return {};
     std::vector<int> order(static_cast<std::size_t>(ranks));
     std::iota(order.begin(), order.end(), 0);
