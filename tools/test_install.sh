@@ -7,6 +7,16 @@ cd "$(dirname "$0")/.."
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cmake --install build --prefix "$tmp/prefix" > "$tmp/install.log"
+# IceT (SPLAT_ICET) is private to splat::mpi, which is not installed: the installed package
+# config, splat.pc and libraries never name IceT or ParaView (README "Building").
+if grep -rliE "icet|paraview" "$tmp/prefix/lib"*/cmake "$tmp/prefix/lib"*/pkgconfig; then
+    echo "test_install: the installed package names IceT or ParaView (files above)"; exit 1
+fi
+for lib in $(find "$tmp/prefix" -name 'lib*.a' -o -name 'lib*.so*'); do
+    if nm -A "$lib" 2> /dev/null | grep -qi " [UT] icet"; then
+        echo "test_install: $lib refers to IceT"; exit 1
+    fi
+done
 cmake -S tools/consumer -B "$tmp/build" -DCMAKE_PREFIX_PATH="$tmp/prefix" -DCMAKE_BUILD_TYPE=Release \
     > "$tmp/configure.log" 2>&1 || { cat "$tmp/configure.log"; exit 1; }
 # A consumer configures without warning blocks from splat's or its dependencies' CMake files.

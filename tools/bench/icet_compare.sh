@@ -10,6 +10,9 @@
 #   of every partial image transparent, 3 covers it all: no transparent pixel for IceT's
 #   run-length encoding), or a volume (e.g. synthetic:phantom:128) whose bricked render
 #   gives the partial images (rank 0 renders P bricks, axis splatter, gray-ramp).
+# ICET_COMPARE_BASE=PATH also runs another build's icet_compare (e.g. one built from the
+# commit before the sparse direct-send) right after this one for each P and size, its
+# methods marked "(base)", so old and new are measured interleaved.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 REPS=${1:-15}
@@ -33,6 +36,10 @@ echo "(partial images: ${images[*]})"
 for p in $RANKS; do
     for n in $SIZES; do
         mpirun --oversubscribe -np "$p" build/bin/icet_compare --size "$n" --reps "$REPS" "${images[@]}" >> "$out"
+        if [ -n "${ICET_COMPARE_BASE:-}" ]; then
+            mpirun --oversubscribe -np "$p" "$ICET_COMPARE_BASE" --size "$n" --reps "$REPS" "${images[@]}" |
+                sed 's/"method": "\([^"]*\)"/"method": "\1 (base)"/' >> "$out"
+        fi
     done
 done
 /usr/bin/python3 - "$out" <<'PY'

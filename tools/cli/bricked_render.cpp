@@ -84,7 +84,8 @@ Volume brickedGeometry(const VolumeArgs& volume, bool* aloneOut) {
 
 void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
                          RenderSettings settings, int bricks, std::uint64_t rankBytes,
-                         const std::string& output, BrickComposite composite) {
+                         const std::string& output, BrickComposite composite,
+                         const std::string& compositor) {
     const Volume geometry = brickedGeometry(volume);
     if (settings.renderer == RendererKind::Sheet && composite == BrickComposite::Fast)
         warn(
@@ -95,7 +96,7 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
     runMetadata().push_back(
         {"splat:background_value", std::string(b) + " (" + geometry.backgroundSource + ")"});
     settings = withFreeCameraTarget(settings, geometry);
-    const std::unique_ptr<BrickGroup> group = brickGroup();
+    const std::unique_ptr<BrickGroup> group = brickGroup(compositor);
     if (bricks == 0) bricks = bricksFromBudget(geometry, settings, group->size(), rankBytes);
     if (bricks > int(std::min<std::size_t>(geometry.voxelCount(), 1 << 20)))
         throw UsageError("--bricks " + std::to_string(bricks) + " is more than the volume's " +

@@ -38,9 +38,11 @@ double poppingSampleBytes(const std::vector<RendererKind>& renderers, double spl
 /// Every process loads and renders its bricks, the group composites the frame, and rank 0
 /// writes it to `output` and prints what the frame took. `bricks` 0: chosen from the budget
 /// per process (`rankBytes`, 0: defaultRankBytes) by chooseBricks, printed on rank 0.
+/// `compositor`: --compositor (parallel.h).
 void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
                          RenderSettings settings, int bricks, std::uint64_t rankBytes,
                          const std::string& output,
-                         BrickComposite composite = BrickComposite::Exact);
+                         BrickComposite composite = BrickComposite::Exact,
+                         const std::string& compositor = "direct");
 
 }  // namespace splat::cli

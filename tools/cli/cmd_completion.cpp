@@ -24,6 +24,7 @@ std::map<std::string, std::string> choices() {
             {"--mode", "dvr mip xray iso"},
             {"--order", "ftb btf"},
             {"--brick-composite", "exact fast"},
+            {"--compositor", "direct icet auto"},
             {"--classify", "pre post"},
             {"--projection", "ortho perspective"},
             {"--kernel", "gaussian bspline"},

@@ -22,6 +22,7 @@ struct RenderCommand {
     std::string output;
     int bricks = 0;
     std::string brickComposite = "exact";
+    std::string compositor = "direct";
     double rankMemory = 0;  ///< MiB; 0: the default under mpirun, off otherwise
 };
 }  // namespace
@@ -48,6 +49,11 @@ void registerRender(CLI::App& app) {
               "one-process image; exchanges sheets) | fast (partial images, a seam of a few "
               "percent)",
               "Output");
+    addOption(*cmd, "--compositor", args->compositor,
+              "bricks under mpirun: how the ranks composite the partial images: direct "
+              "(sparse direct-send, the default) | icet (IceT radix-k, when built with it) | auto "
+              "(icet when built with it, else direct)",
+              "Output");
     cmd->footer(
         "Examples:\n"
         "  splat render ch2.nii.gz --tf mri-head --azimuth 30 -o head.png\n"
@@ -68,6 +74,9 @@ void registerRender(CLI::App& app) {
                              args->brickComposite + "')");
         if (!(args->rankMemory >= 0 && args->rankMemory <= 1e9))
             throw UsageError("--rank-memory must be between 0 and 1e9 MiB");
+        checkCompositor(args->compositor);
+        if (given(*cmd, "compositor") && !fromScene(*cmd, "compositor") && processCount() == 1)
+            warn("--compositor applies to bricks under mpirun: ignored");
         const bool bricked = args->bricks > 0 || args->rankMemory > 0 || processCount() > 1;
         if (given(*cmd, "brick-composite") && !fromScene(*cmd, "brick-composite") &&
             (!bricked || settings.renderer != RendererKind::Sheet))
@@ -80,7 +89,8 @@ void registerRender(CLI::App& app) {
             renderBrickedToFile(
                 args->volume, args->render, settings, args->bricks,
                 std::uint64_t(args->rankMemory * 1048576.0), args->output,
-                args->brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
+                args->brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast,
+                args->compositor);
             if (!workerProcess()) finishRun(*cmd);
             return;
         }

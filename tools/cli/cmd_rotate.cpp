@@ -51,6 +51,7 @@ struct RotateCommand {
     int frames = 36, fps = 12, parallelFrames = 0, bricks = 0;
     double from = 0, to = 360, rankMemory = 0;
     std::string brickComposite = "exact";
+    std::string compositor = "direct";
     bool resume = false, overwrite = false, quiet = false;
 };
 
@@ -337,6 +338,10 @@ void registerRotate(CLI::App& app) {
               "bricks of --renderer sheet: exact (slab sheets summed across bricks) or fast "
               "(partial images, approximate at brick faces)",
               seq);
+    addOption(*cmd, "--compositor", a->compositor,
+              "bricks under mpirun: direct (sparse direct-send, the default) | icet (IceT "
+              "radix-k, when built with it) | auto (icet when built with it, else direct)",
+              seq);
     addOption(*cmd, "-o,--output", a->outDir, "output folder for the frames (created)", out,
               PathKind::Output);
     addOption(*cmd, "--name", a->name, "frame file name pattern (printf %d of the frame index)",
@@ -399,6 +404,9 @@ void registerRotate(CLI::App& app) {
                          "set the views); ignored");
         if (a->gif.empty() && a->mp4.empty() && given(*cmd, "fps") && !fromScene(*cmd, "fps"))
             warn("--fps applies to --gif and --mp4 only; ignored");
+        checkCompositor(a->compositor);
+        if (given(*cmd, "compositor") && !fromScene(*cmd, "compositor") && processCount() == 1)
+            warn("--compositor applies to bricks under mpirun: ignored");
         RenderUse use;
         use.imageExt = "." + a->format;
         RenderSettings settings = settingsFromArgs(a->render, use);
@@ -442,7 +450,7 @@ void registerRotate(CLI::App& app) {
         // Rank 0 prepares the outputs; a bricked run's other ranks learn whether it could,
         // and which frames are kept (--resume), before rendering with it.
         const bool leader = !workerProcess();
-        const std::unique_ptr<BrickGroup> group = bricked ? brickGroup() : nullptr;
+        const std::unique_ptr<BrickGroup> group = bricked ? brickGroup(a->compositor) : nullptr;
         std::string ffmpeg;
         const bool keepImages = !a->gif.empty() || !a->contact.empty();
         const CameraPath path =

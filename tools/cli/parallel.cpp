@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <memory>
 
+#include "diagnostics.h"
+
 #if SPLAT_HAVE_MPI
 #include "splat/mpi/brick_group.h"
 #include "splat/mpi/frame_farm.h"
@@ -88,9 +90,30 @@ void serveFrames(const std::function<Scene()>& build) {
 #endif
 }
 
-std::unique_ptr<BrickGroup> brickGroup() {
+void checkCompositor(const std::string& name) {
+    if (name != "direct" && name != "icet" && name != "auto")
+        throw UsageError("--compositor must be direct, icet or auto (got '" + name + "')");
 #if SPLAT_HAVE_MPI
-    if (gSession) return mpi::makeBrickGroup(*gSession);
+    const bool icet = mpi::icetBuilt();
+#else
+    const bool icet = false;
+#endif
+    if (name == "icet" && !icet)
+        throw UsageError(
+            "--compositor icet: this splat was built without IceT (SPLAT_ICET; Debian: "
+            "paraview-dev, README \"Building\"); use --compositor direct");
+}
+
+std::unique_ptr<BrickGroup> brickGroup(const std::string& compositor) {
+#if SPLAT_HAVE_MPI
+    checkCompositor(compositor);
+    if (gSession)
+        return mpi::makeBrickGroup(
+            *gSession, compositor == "icet" || (compositor == "auto" && mpi::icetBuilt())
+                           ? mpi::Compositor::Icet
+                           : mpi::Compositor::Direct);
+#else
+    (void)compositor;
 #endif
     return std::make_unique<LocalBrickGroup>();
 }

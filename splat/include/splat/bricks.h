@@ -76,9 +76,17 @@ RenderSettings brickSettings(const RenderSettings& frame, const Volume& whole, c
                              const glm::ivec3& dims);
 
 /// Composites the partial images of one frame, front first, as `mode` combines pieces of a
-/// ray (dvr, iso: over; mip: max; xray: sum), then lays `background` behind (dvr, iso).
+/// ray (dvr, iso: over; mip: max; xray: sum), then lays `background` behind (dvr, iso):
+/// blendBackground(compositePieces(frontToBack, mode), mode, background).
 Image compositeBricks(const std::vector<const Image*>& frontToBack, RenderMode mode,
                       const glm::vec4& background);
+
+/// The pieces of compositeBricks: the partial images combined front first, no background.
+Image compositePieces(const std::vector<const Image*>& frontToBack, RenderMode mode);
+
+/// Lays `background` behind a composited frame (dvr, iso: I += (1 - alpha) background; mip
+/// and xray: unchanged), pixel by pixel, so it may be applied to any part of the frame.
+void blendBackground(Image& image, RenderMode mode, const glm::vec4& background);
 
 }  // namespace splat
 

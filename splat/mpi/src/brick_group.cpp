@@ -10,8 +10,12 @@
 #include <thread>
 #include <type_traits>
 
+#include "sparse_rows.h"
 #include "splat/error.h"
 #include "splat/slab_sheets.h"
+#if SPLAT_MPI_HAVE_ICET
+#include "icet_compositor.h"
+#endif
 
 namespace splat::mpi {
 
@@ -56,71 +60,22 @@ class MpiBrickGroup : public BrickGroup {
     Image composite(std::vector<std::pair<int, Image>>& partials,
                     const std::vector<int>& frontToBack, int width, int height, RenderMode mode,
                     const glm::vec4& background, std::uint64_t* bytes) override {
-        const int p = size();
-        const int bricks = int(frontToBack.size());
-        const std::size_t rowFloats = std::size_t(width) * 4;
-        // Send: for each destination rank, the destination's strip of each of my partials
-        // (in my brick order).
-        std::vector<int> sendCounts(p, 0), sendOffsets(p, 0), recvCounts(p, 0), recvOffsets(p, 0);
-        std::vector<float> send;
-        for (int d = 0; d < p; ++d) {
-            sendOffsets[d] = int(send.size());
-            const int r0 = stripBegin(height, d, p), r1 = stripBegin(height, d + 1, p);
-            for (const auto& [b, image] : partials) {
-                const float* from = &image.pixels[std::size_t(r0) * width].x;
-                send.insert(send.end(), from, from + std::size_t(r1 - r0) * rowFloats);
-            }
-            sendCounts[d] = int(send.size()) - sendOffsets[d];
-        }
-        // Receive: from each source rank, my strip of each of its bricks (b % p == source).
-        const int m0 = stripBegin(height, rank(), p), m1 = stripBegin(height, rank() + 1, p);
-        const std::size_t stripFloats = std::size_t(m1 - m0) * rowFloats;
-        int total = 0;
-        for (int q = 0; q < p; ++q) {
-            int count = 0;
-            for (int b = q; b < bricks; b += p) ++count;
-            recvOffsets[q] = total;
-            recvCounts[q] = int(std::size_t(count) * stripFloats);
-            total += recvCounts[q];
-        }
-        std::vector<float> recv(static_cast<std::size_t>(total));
-        MPI_Alltoallv(send.data(), sendCounts.data(), sendOffsets.data(), MPI_FLOAT, recv.data(),
-                      recvCounts.data(), recvOffsets.data(), MPI_FLOAT, MPI_COMM_WORLD);
-        std::uint64_t moved = 0;
-        for (int q = 0; q < p; ++q)
-            if (q != rank()) moved += 4ull * (std::uint64_t(sendCounts[q]) + recvCounts[q]);
-        partials.clear();  // the partial images are no longer needed
-        std::vector<Image> strips(static_cast<std::size_t>(bricks));
-        for (int q = 0; q < p; ++q) {
-            std::size_t at = std::size_t(recvOffsets[q]);
-            for (int b = q; b < bricks; b += p, at += stripFloats) {
-                strips[std::size_t(b)] = Image(width, m1 - m0);
-                std::memcpy(strips[std::size_t(b)].pixels.data(), recv.data() + at,
-                            stripFloats * sizeof(float));
-            }
-        }
-        recv.clear();
-        std::vector<const Image*> ordered;
-        for (int b : frontToBack) ordered.push_back(&strips[std::size_t(b)]);
-        const Image strip = m1 > m0 ? compositeBricks(ordered, mode, background) : Image();
-        // Gather the strips on rank 0.
-        std::vector<int> counts(p), offsets(p);
-        for (int q = 0; q < p; ++q) {
-            offsets[q] = int(std::size_t(stripBegin(height, q, p)) * rowFloats);
-            counts[q] = int(std::size_t(stripBegin(height, q + 1, p) - stripBegin(height, q, p)) *
-                            rowFloats);
-        }
-        Image out = rank() == 0 ? Image(width, height) : Image();
-        MPI_Gatherv(strip.pixels.empty() ? nullptr : &strip.pixels[0].x, counts[rank()], MPI_FLOAT,
-                    rank() == 0 ? &out.pixels[0].x : nullptr, counts.data(), offsets.data(),
-                    MPI_FLOAT, 0, MPI_COMM_WORLD);
-        if (rank() == 0)
-            for (int q = 1; q < p; ++q) moved += 4ull * std::uint64_t(counts[q]);
+        std::uint64_t sent = 0, received = 0;
+        Image out;
+#if SPLAT_MPI_HAVE_ICET
+        if (icet_ && icetComposites(frontToBack, mode, size()))
+            out = icet_->composite(partials, frontToBack, width, height, mode, &sent);
         else
-            moved += 4ull * std::uint64_t(counts[rank()]);
-        if (bytes) *bytes += moved;
+#endif
+            out = directSend(partials, frontToBack, width, height, mode, &sent, &received);
+        partials.clear();  // the partial images are no longer needed
+        if (rank() == 0) blendBackground(out, mode, background);
+        lastSent_ = sent;
+        if (bytes) *bytes += sent + received;
         return out;
     }
+
+    std::uint64_t lastSent() const { return lastSent_; }
 
     std::vector<BrickStats> gather(const BrickStats& mine) override {
         static_assert(std::is_trivially_copyable_v<BrickStats>);
@@ -221,13 +176,139 @@ class MpiBrickGroup : public BrickGroup {
     }
 
   private:
+    /// Sparse direct-send (brick_group.h): the frame on rank 0 without its background.
+    Image directSend(const std::vector<std::pair<int, Image>>& partials,
+                     const std::vector<int>& frontToBack, int width, int height, RenderMode mode,
+                     std::uint64_t* sent, std::uint64_t* received);
+
     Session& s_;
+    std::uint64_t lastSent_ = 0;
+#if SPLAT_MPI_HAVE_ICET
+    std::unique_ptr<IcetCompositor> icet_;
+
+  public:
+    void useIcet() { icet_ = std::make_unique<IcetCompositor>(); }
+#endif
 };
+
+Image MpiBrickGroup::directSend(const std::vector<std::pair<int, Image>>& partials,
+                                const std::vector<int>& frontToBack, int width, int height,
+                                RenderMode mode, std::uint64_t* sent, std::uint64_t* received) {
+    const int p = size(), me = rank();
+    const int bricks = int(frontToBack.size());
+    // My bricks in increasing index, the order every receiver expects them in.
+    std::vector<const std::pair<int, Image>*> mine;
+    for (const auto& partial : partials) mine.push_back(&partial);
+    std::sort(mine.begin(), mine.end(),
+              [](const auto* a, const auto* b) { return a->first < b->first; });
+    // Send: for each other rank, its strip of each of my partials, row spans only.
+    std::vector<int> sendCounts(p, 0), sendOffsets(p, 0), recvCounts(p, 0), recvOffsets(p, 0);
+    std::vector<float> send;
+    for (int d = 0; d < p; ++d) {
+        sendOffsets[d] = int(send.size());
+        if (d == me) continue;
+        for (const auto* partial : mine)
+            packRows(partial->second, stripBegin(height, d, p), stripBegin(height, d + 1, p), send);
+        if (send.size() > std::size_t(INT_MAX))
+            throw Error("bricks: a composite exceeds MPI's count (" + std::to_string(width) + "x" +
+                        std::to_string(height) + " on " + std::to_string(p) + " ranks)");
+        sendCounts[d] = int(send.size()) - sendOffsets[d];
+    }
+    MPI_Alltoall(sendCounts.data(), 1, MPI_INT, recvCounts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+    std::size_t total = 0;
+    for (int q = 0; q < p; ++q) {
+        recvOffsets[q] = int(total);
+        total += std::size_t(recvCounts[q]);
+    }
+    if (total > std::size_t(INT_MAX)) throw Error("bricks: a composite exceeds MPI's count");
+    std::vector<float> recv(total);
+    MPI_Alltoallv(send.data(), sendCounts.data(), sendOffsets.data(), MPI_FLOAT, recv.data(),
+                  recvCounts.data(), recvOffsets.data(), MPI_FLOAT, MPI_COMM_WORLD);
+    for (int q = 0; q < p; ++q)
+        if (q != me) *sent += 4ull * std::uint64_t(sendCounts[q]);
+    *received += 4ull * std::uint64_t(total);
+    send = {};
+    // My strip of every brick: mine copied, the others' unpacked (transparent elsewhere).
+    const int m0 = stripBegin(height, me, p), rows = stripBegin(height, me + 1, p) - m0;
+    const std::size_t stripPixels = std::size_t(rows) * std::size_t(width);
+    std::vector<Image> strips(static_cast<std::size_t>(bricks));
+    for (const auto* partial : mine) {
+        Image& strip = strips[std::size_t(partial->first)];
+        strip = Image(width, rows);
+        std::copy_n(partial->second.pixels.begin() + std::ptrdiff_t(std::size_t(m0) * width),
+                    stripPixels, strip.pixels.begin());
+    }
+    for (int q = 0; q < p; ++q) {
+        if (q == me) continue;
+        std::size_t at = std::size_t(recvOffsets[q]);
+        const std::size_t end = at + std::size_t(recvCounts[q]);
+        for (int b = q; b < bricks; b += p) {
+            strips[std::size_t(b)] = Image(width, rows);
+            at += unpackRows(recv.data() + at, end - at, strips[std::size_t(b)], 0, rows);
+        }
+    }
+    recv = {};
+    std::vector<const Image*> ordered;
+    for (int b : frontToBack) ordered.push_back(&strips[std::size_t(b)]);
+    const Image strip = rows > 0 ? compositePieces(ordered, mode) : Image();
+    strips.clear();
+    // Gather the strips on rank 0, row spans only.
+    std::vector<float> packed;
+    if (me != 0) packRows(strip, 0, rows, packed);
+    if (packed.size() > std::size_t(INT_MAX)) throw Error("bricks: a strip exceeds MPI's count");
+    const int count = int(packed.size());
+    std::vector<int> counts(me == 0 ? p : 0), offsets(me == 0 ? p : 0);
+    MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+    std::vector<float> gathered;
+    if (me == 0) {
+        std::size_t n = 0;
+        for (int q = 0; q < p; ++q) {
+            offsets[q] = int(n);
+            n += std::size_t(counts[q]);
+        }
+        if (n > std::size_t(INT_MAX)) throw Error("bricks: a frame exceeds MPI's count");
+        gathered.resize(n);
+        *received += 4ull * n;
+    } else {
+        *sent += 4ull * std::uint64_t(count);
+    }
+    MPI_Gatherv(packed.data(), count, MPI_FLOAT, gathered.data(), counts.data(), offsets.data(),
+                MPI_FLOAT, 0, MPI_COMM_WORLD);
+    if (me != 0) return Image();
+    Image out(width, height);
+    std::copy(strip.pixels.begin(), strip.pixels.end(), out.pixels.begin());
+    for (int q = 1; q < p; ++q) {
+        const int r0 = stripBegin(height, q, p), r1 = stripBegin(height, q + 1, p);
+        unpackRows(gathered.data() + offsets[q], std::size_t(counts[q]), out, r0, r1 - r0);
+    }
+    return out;
+}
 
 }  // namespace
 
-std::unique_ptr<BrickGroup> makeBrickGroup(Session& session) {
-    return std::make_unique<MpiBrickGroup>(session);
+bool icetBuilt() {
+#if SPLAT_MPI_HAVE_ICET
+    return true;
+#else
+    return false;
+#endif
+}
+
+std::unique_ptr<BrickGroup> makeBrickGroup(Session& session, Compositor compositor) {
+    auto group = std::make_unique<MpiBrickGroup>(session);
+    if (compositor == Compositor::Icet) {
+#if SPLAT_MPI_HAVE_ICET
+        group->useIcet();
+#else
+        throw Error("this splat was built without IceT (SPLAT_ICET=OFF): no IceT compositor");
+#endif
+    }
+    return group;
+}
+
+std::uint64_t lastBytesSent(const BrickGroup& group) {
+    const auto* g = dynamic_cast<const MpiBrickGroup*>(&group);
+    return g ? g->lastSent() : 0;
 }
 
 }  // namespace splat::mpi

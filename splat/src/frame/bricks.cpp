@@ -146,8 +146,7 @@ RenderSettings brickSettings(const RenderSettings& frame, const Volume& whole, c
     return s;
 }
 
-Image compositeBricks(const std::vector<const Image*>& frontToBack, RenderMode mode,
-                      const glm::vec4& background) {
+Image compositePieces(const std::vector<const Image*>& frontToBack, RenderMode mode) {
     if (frontToBack.empty()) throw Error("bricks: no partial image to composite");
     Image out = *frontToBack.front();
     for (std::size_t b = 1; b < frontToBack.size(); ++b) {
@@ -165,8 +164,18 @@ Image compositeBricks(const std::vector<const Image*>& frontToBack, RenderMode m
                 o += (1.0f - o.a) * c;
         }
     }
+    return out;
+}
+
+void blendBackground(Image& image, RenderMode mode, const glm::vec4& background) {
     if (mode == RenderMode::Dvr || mode == RenderMode::Iso)
-        for (glm::vec4& o : out.pixels) o += (1.0f - o.a) * background;
+        for (glm::vec4& o : image.pixels) o += (1.0f - o.a) * background;
+}
+
+Image compositeBricks(const std::vector<const Image*>& frontToBack, RenderMode mode,
+                      const glm::vec4& background) {
+    Image out = compositePieces(frontToBack, mode);
+    blendBackground(out, mode, background);
     return out;
 }
 

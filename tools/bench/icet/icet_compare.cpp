@@ -7,9 +7,10 @@
 // (renderBricked, axis splatter, transfer function gray-ramp, azimuth 30, elevation 15),
 // keeps the partial images and the k-d visibility order that renderBricked hands to its
 // BrickGroup, and sends brick b's image to rank b. The images are composited
-//   (a) by splat::mpi's BrickGroup::composite (the code `splat render --bricks` runs:
-//       MPI_Alltoallv of row strips, each strip composited front to back, MPI_Gatherv to
-//       rank 0), called as it is, one brick per rank;
+//   (a) by splat::mpi's BrickGroup::composite (the code `splat render --bricks` runs),
+//       called as it is, one brick per rank: direct-send (MPI_Alltoallv of the row spans of
+//       the strips, each strip composited front to back, MPI_Gatherv of the spans to rank 0)
+//       and the IceT compositor behind the same seam (--compositor icet);
 //   (b) by IceT (ParaView 5.11's copy, libvtkIceTCore/libvtkIceTMPI): icetCompositeImage
 //       with ICET_COMPOSITE_MODE_BLEND, ICET_ORDERED_COMPOSITE and icetCompositeOrder,
 //       a float RGBA colour buffer, no depth, one tile displayed on rank 0, for each
@@ -17,8 +18,9 @@
 //       ICET_STRATEGY_SEQUENTIAL, and ICET_STRATEGY_DIRECT / REDUCE.
 // Both results are compared on rank 0 (max abs over the RGBA floats), and each is timed:
 // per repetition MPI_Barrier, then the call; the time is the slowest rank's (MPI_MAX), the
-// figure the median over the repetitions. Bytes sent per rank: splat's from its message
-// sizes (sent only, the same definition as IceT's), IceT's from ICET_BYTES_SENT.
+// figure the median over the repetitions. Bytes sent per rank: splat's direct-send from its
+// message sizes (sent only, splat::mpi::lastBytesSent, the same definition as IceT's), IceT's
+// from ICET_BYTES_SENT.
 //
 //   mpirun -np P icet_compare [--size N] [--reps R] [--coverage F] [--volume SPEC]
 // prints one JSON object per line on rank 0: {"P", "size", "method", "median_ms",
@@ -75,15 +77,6 @@ std::vector<int> frontToBack(int ranks) {
     for (int r = 1; r < ranks; r += 2) order.push_back(r);
     for (int r = 0; r < ranks; r += 2) order.push_back(r);
     return order;
-}
-
-/// Bytes direct-send (brick_group.cpp) sends from `rank`: every other rank's strip of its
-/// partial image, then its own composited strip to rank 0 (rank 0 sends no strip).
-std::uint64_t directSendBytes(int rank, int ranks, int n) {
-    auto begin = [&](int r) { return std::int64_t(n) * r / ranks; };
-    const std::uint64_t row = 16ull * std::uint64_t(n);
-    const std::uint64_t own = std::uint64_t(begin(rank + 1) - begin(rank));
-    return row * (std::uint64_t(n) - own) + (rank == 0 ? 0 : row * own);
 }
 
 /// One process holding every brick that keeps the partial images and the order renderBricked
@@ -231,12 +224,17 @@ int main(int argc, char** argv) {
         r.bytesMean = sum / ranks;
     };
 
-    // (a) splat's direct-send, through splat::mpi's BrickGroup (brick b on rank b).
-    {
-        auto group = splat::mpi::makeBrickGroup(session);
+    // (a) splat's compositors, through splat::mpi's BrickGroup (brick b on rank b), called as
+    // `splat render --bricks` calls them: direct-send and, IceT's radix-k behind the same seam.
+    const std::pair<const char*, splat::mpi::Compositor> compositors[] = {
+        {"splat direct-send", splat::mpi::Compositor::Direct},
+        {"splat --compositor icet", splat::mpi::Compositor::Icet}};
+    for (const auto& [name, kind] : compositors) {
+        auto group = splat::mpi::makeBrickGroup(session, kind);
         splat::Image out;
         Result r;
         std::vector<std::pair<int, splat::Image>> partials;
+        double sent = 0;
         r.medianMs = timeIt(
             [&] {
                 partials.clear();
@@ -245,10 +243,11 @@ int main(int argc, char** argv) {
             [&] {
                 out = group->composite(partials, order, n, n, splat::RenderMode::Dvr, transparent,
                                        nullptr);
+                sent = double(splat::mpi::lastBytesSent(*group));
             });
-        bytesOver(double(directSendBytes(rank, ranks, n)), r);
+        bytesOver(sent, r);
         if (rank == 0) r.maxAbs = maxAbs(&out.pixels[0].x, reference);
-        if (rank == 0) print(ranks, n, "splat direct-send", r);
+        if (rank == 0) print(ranks, n, name, r);
     }
 
     // (b) IceT.
