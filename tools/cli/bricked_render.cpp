@@ -47,6 +47,28 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
     return c.bricks;
 }
 
+SequenceBricks chooseSequenceBricks(const VolumeArgs& volume, RenderSettings& settings,
+                                    int bricks, double rankMiB, double extraSampleBytes) {
+    SequenceBricks c;
+    c.bricks = bricks;
+    const std::uint64_t rankBytes = std::uint64_t(rankMiB * 1048576.0);
+    if (bricks == 0 && rankBytes == 0 && processCount() == 1) return c;
+    c.geometry = brickedGeometry(volume, &c.alone);
+    settings = withFreeCameraTarget(settings, *c.geometry);
+    if (c.bricks == 0) {
+        bool fits = true;
+        bricksFromBudget(*c.geometry, settings, processCount(), rankBytes, &fits, true,
+                         extraSampleBytes);
+        if (!fits)
+            c.bricks = bricksFromBudget(*c.geometry, settings, processCount(), rankBytes, nullptr,
+                                        false, extraSampleBytes);
+    }
+    if (c.bricks > int(std::min<std::size_t>(c.geometry->voxelCount(), 1 << 20)))
+        throw UsageError("--bricks " + std::to_string(c.bricks) + " is more than the volume's " +
+                         std::to_string(c.geometry->voxelCount()) + " samples");
+    return c;
+}
+
 double poppingSampleBytes(const std::vector<RendererKind>& renderers, double splatShare) {
     double bytes = 0;
     for (std::size_t k = 1; k < renderers.size(); ++k) bytes += splatShare * 26.0;

@@ -3,6 +3,7 @@
 // sort-last bricked rendering (splat/bricks.h, README "Beyond one machine").
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,19 @@ std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume);
 int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int ranks,
                      std::uint64_t rankBytes, bool* wholeFits = nullptr, bool quiet = false,
                      double extraSampleBytes = 0);
+
+/// Whether a sequence (`rotate`, `popping`) renders in bricks, README "Beyond one machine":
+/// when asked (`bricks` > 0), or when the budget per process (`rankMiB`, 0: defaultRankBytes)
+/// says the volume does not fit one (mpirun, --rank-memory; `extraSampleBytes` as in
+/// bricksFromBudget); else frames in parallel (`bricks` 0). Every rank decides alike (the same
+/// geometry). `settings` gets the geometry's free camera target when it was read.
+struct SequenceBricks {
+    int bricks = 0;
+    std::optional<Volume> geometry;  ///< read when bricks were asked for or under mpirun
+    bool alone = true;               ///< whether the samples are read by brick
+};
+SequenceBricks chooseSequenceBricks(const VolumeArgs& volume, RenderSettings& settings,
+                                    int bricks, double rankMiB, double extraSampleBytes = 0);
 
 /// What `splat popping` in bricks holds per sample beyond the samples and one splat list: one
 /// Scene per renderer of `renderers` over the same samples — another splat list each (26

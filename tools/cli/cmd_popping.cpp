@@ -33,6 +33,7 @@ struct PoppingCommand {
     std::string report;
     int bricks = 0;
     double rankMemory = 0;  ///< MiB; 0: the default under mpirun, off otherwise
+    std::string compositor = "direct";  ///< --compositor (parallel.h)
     std::string brickComposite = "exact";
     bool quiet = false, resume = false;
 };
@@ -95,6 +96,10 @@ void registerPopping(CLI::App& app) {
               "the findings do not change with K) or fast (partial images, approximate at brick "
               "faces)",
               out);
+    addOption(*cmd, "--compositor", a->compositor,
+              "bricks under mpirun: direct (sparse direct-send, the default) | icet (IceT "
+              "radix-k, when built with it) | auto (icet when built with it, else direct)",
+              out);
     cmd->footer(
         "Examples:\n"
         "  splat popping synthetic:phantom:64 --from 40 --to 50 --step 0.5 --report pop\n"
@@ -119,31 +124,16 @@ void registerPopping(CLI::App& app) {
         if (a->brickComposite != "exact" && a->brickComposite != "fast")
             throw UsageError("--brick-composite must be exact or fast (got '" + a->brickComposite +
                              "')");
-        // README "Beyond one machine": bricks when asked (--bricks), or when the budget per
-        // process says the volume does not fit one (mpirun, --rank-memory); else frames in
-        // parallel under mpirun. Every rank decides alike (the same geometry).
-        int bricks = a->bricks;
-        std::optional<Volume> geometry;
-        bool alone = true;
-        const std::uint64_t rankBytes = std::uint64_t(a->rankMemory * 1048576.0);
-        if (bricks > 0 || rankBytes > 0 || processCount() > 1) {
-            geometry = brickedGeometry(a->volume, &alone);
-            settings = withFreeCameraTarget(settings, *geometry);
-            bool fits = true;
-            if (bricks == 0) {
-                // Each renderer holds its own Scenes of the bricks over the same samples.
-                const double extra = poppingSampleBytes(o.renderers);
-                bricksFromBudget(*geometry, settings, processCount(), rankBytes, &fits, true,
-                                 extra);
-                if (!fits)
-                    bricks = bricksFromBudget(*geometry, settings, processCount(), rankBytes,
-                                              nullptr, false, extra);
-            }
-            if (bricks > int(std::min<std::size_t>(geometry->voxelCount(), 1 << 20)))
-                throw UsageError("--bricks " + std::to_string(bricks) +
-                                 " is more than the volume's " +
-                                 std::to_string(geometry->voxelCount()) + " samples");
-        }
+        checkCompositor(a->compositor);
+        if (given(*cmd, "compositor") && !fromScene(*cmd, "compositor") && processCount() == 1)
+            warn("--compositor applies to bricks under mpirun: ignored");
+        // Bricks, or frames in parallel under mpirun (README "Beyond one machine",
+        // chooseSequenceBricks); each renderer holds its own Scenes of the same samples.
+        const SequenceBricks choice = chooseSequenceBricks(
+            a->volume, settings, a->bricks, a->rankMemory, poppingSampleBytes(o.renderers));
+        const int bricks = choice.bricks;
+        const std::optional<Volume>& geometry = choice.geometry;
+        const bool alone = choice.alone;
         const bool bricked = bricks > 0;
         if (!bricked && workerProcess())  // under mpirun: render the frames rank 0 asks for
             return serveFrames([&] {
@@ -173,7 +163,7 @@ void registerPopping(CLI::App& app) {
         std::unique_ptr<BrickGroup> group;
         std::unique_ptr<BrickedFrames> frames;
         if (bricked) {
-            group = brickGroup();
+            group = brickGroup(a->compositor);
             frames = std::make_unique<BrickedFrames>(
                 *geometry, brickLoader(a->volume), settings, bricks, *group,
                 a->brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);

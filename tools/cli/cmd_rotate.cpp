@@ -411,27 +411,12 @@ void registerRotate(CLI::App& app) {
         use.imageExt = "." + a->format;
         RenderSettings settings = settingsFromArgs(a->render, use);
         loadOptionsFromArgs(a->volume);
-        // README "Beyond one machine": bricks when asked (--bricks), or when the budget per
-        // process says the volume does not fit one (mpirun, --rank-memory); else frames in
-        // parallel. Every rank decides alike (the same geometry).
-        int bricks = a->bricks;
-        std::optional<Volume> geometry;
-        const std::uint64_t rankBytes = std::uint64_t(a->rankMemory * 1048576.0);
-        bool alone = true;
-        if (bricks > 0 || rankBytes > 0 || processCount() > 1) {
-            geometry = brickedGeometry(a->volume, &alone);
-            settings = withFreeCameraTarget(settings, *geometry);
-            bool fits = true;
-            if (bricks == 0) {
-                bricksFromBudget(*geometry, settings, processCount(), rankBytes, &fits, true);
-                if (!fits)
-                    bricks = bricksFromBudget(*geometry, settings, processCount(), rankBytes);
-            }
-            if (bricks > int(std::min<std::size_t>(geometry->voxelCount(), 1 << 20)))
-                throw UsageError("--bricks " + std::to_string(bricks) +
-                                 " is more than the volume's " +
-                                 std::to_string(geometry->voxelCount()) + " samples");
-        }
+        // Bricks, or frames in parallel (README "Beyond one machine", chooseSequenceBricks).
+        const SequenceBricks choice =
+            chooseSequenceBricks(a->volume, settings, a->bricks, a->rankMemory);
+        const int bricks = choice.bricks;
+        const std::optional<Volume>& geometry = choice.geometry;
+        const bool alone = choice.alone;
         const bool bricked = bricks > 0;
         if (bricked && !alone && !workerProcess())
             warn(a->volume.spec +
