@@ -10,6 +10,7 @@
 
 #include "cli_util.h"
 #include "footprint/footprint_table.h"
+#include "footprint/kernel.h"
 #include "model/level_of_detail.h"
 #include "model/scene_impl.h"
 #include "splat/error.h"
@@ -450,4 +451,287 @@ TEST_CASE("lod: --lod on the command line and in scene files", "[lod][cli]") {
     CHECK(ref.status == 0);
     REQUIRE(ref.errLines().size() == 1);
     CHECK(ref.errLines()[0].find("--lod applies to the splatters") != std::string::npos);
+}
+
+// ---- --lod auto (issue 27): the level chosen from the error it adds, and the merged kernel
+// narrowed so that kernel, pyramid box and pixel filter together are what the pixel-filtered
+// reference sees (model/level_of_detail.h, lodFootprint).
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// exp(-|x - c|^2 / (2 b^2)) sampled on an n^3 grid of unit spacing, c the centre voxel.
+Volume gaussianBlob(int n, double b) {
+    Volume v = makeVolume({n, n, n}, {1.0, 1.0, 1.0}, "gaussian blob");
+    const double c = 0.5 * (n - 1);
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const double r2 = (i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c);
+                v.at(i, j, k) = float(std::exp(-0.5 * r2 / (b * b)));
+            }
+    return v;
+}
+
+}  // namespace
+
+TEST_CASE("lod auto: the coarsest level whose merged footprints still sum to a constant",
+          "[lod]") {
+    const double k2 = footprint::Kernel::defaultKernel().variance();  // 0.3279
+    CHECK(lodBoxVariance(0) == 0.0);
+    CHECK(lodBoxVariance(1) == 0.25);
+    CHECK(lodBoxVariance(2) == 1.25);
+    // (k^2 - B_L) v^2 + s^2 >= 0.3 (2^L v)^2: level 1 up to v = 0.472, level 2 up to 0.209.
+    auto edge = [&](int level) {
+        return std::sqrt(0.25 / (kLodAutoSmooth * std::ldexp(1.0, 2 * level) - k2 +
+                                 lodBoxVariance(level)));
+    };
+    CHECK(edge(1) == Approx(0.472).margin(1e-3));
+    CHECK(edge(2) == Approx(0.209).margin(1e-3));
+    for (double v : {2.0, 1.0, 0.9, 0.6, 0.48})
+        CHECK(lodAutoLevel(v, 0.5, k2, 16) == 0);
+    CHECK(lodAutoLevel(edge(1) * 0.999, 0.5, k2, 16) == 1);
+    CHECK(lodAutoLevel(edge(1) * 1.001, 0.5, k2, 16) == 0);
+    CHECK(lodAutoLevel(edge(2) * 0.999, 0.5, k2, 16) == 2);
+    CHECK(lodAutoLevel(edge(2) * 1.001, 0.5, k2, 16) == 1);
+    CHECK(lodAutoLevel(0.01, 0.5, k2, 3) == 3);  // at most maxLevel
+    CHECK(lodAutoLevel(0.0, 0.5, k2, 16) == 0);
+    CHECK(lodAutoLevel(INFINITY, 0.5, k2, 16) == 0);
+    // The merged footprint: kernel k^2 - B_L (level-0 voxels^2) with the full filter, or the
+    // least kernel with the rest taken from the screen low-pass; either way the footprint's
+    // variance in pixels^2 is (k^2 - B_L) v^2 + s^2.
+    for (int level : {1, 2, 3})
+        for (double v : {0.05, 0.1, 0.2}) {
+            const LodFootprint f = lodFootprint(k2, level, 0.5, v);
+            const double kernel = f.kernelScale * f.kernelScale * std::ldexp(k2, 2 * level);
+            INFO("level " << level << ", v " << v);
+            CHECK(kernel * v * v + f.lowPass * f.lowPass ==
+                  Approx((k2 - lodBoxVariance(level)) * v * v + 0.25).epsilon(1e-12));
+            CHECK(kernel >= kLodMinKernel * k2 * (1 - 1e-12));
+        }
+    CHECK(lodFootprint(k2, 1, 0.5, 0.3).kernelScale ==
+          Approx(std::sqrt((k2 - 0.25) / (4 * k2))).epsilon(1e-12));
+    CHECK(lodFootprint(k2, 1, 0.5, 0.3).lowPass == 0.5);
+}
+
+TEST_CASE("lod auto: X-ray of a Gaussian blob at level 1 is the filtered closed form, mass kept",
+          "[lod]") {
+    // f = exp(-r^2 / (2 b^2)) on 33^3 voxels, kernel Gaussian sigma 1 (radius 6: the taper is
+    // exp(-18)), a voxel covering 0.5 pixels: lodAutoLevel gives level 1 ((1 - 0.25) 0.25 +
+    // 0.25 >= 0.3 * 4 * 0.25; level 2 fails). Closed form: level 0 reconstructs f * h0, the
+    // Gaussian of variance s^2 = b^2 + 1, whose X-ray through the pixel filter (sigma 0.5
+    // pixels) is the 2D Gaussian of variance s^2 / p^2 + 0.25 pixels^2 holding the blob's mass
+    // M = (2 pi b^2)^(3/2). Level 1 renders f * D_1 * h_1 through the same filter, D_1 the
+    // cell mean (variance 0.25) and h_1 the kernel narrowed to 1 - 0.25: the same variance;
+    // it differs from the Gaussian by D_1's fourth cumulant (-1/8 per axis): at the peak
+    // 1 - exp(-1/4 / (2 V)) sqrt((V + 1/4) / V) = 6e-4 per axis (V = b^2 + 1 - 1/4 + 4 * 0.25,
+    // the filter in voxels), and by the coarse grid's aliasing of the blob, the first alias of
+    // its Poisson sum exp(-pi^2 (b^2 + 1) / 4 / 2) = 4e-5 (in coarse voxels^2: (b^2 + 0.25) /
+    // 4 of the blob, (1 - 0.25) / 4 + 0.25 of the footprint; b = 1.5 gives 5e-3).
+    const double b = 2.5, p = 2.0, sigma = 0.5;
+    const Volume v = gaussianBlob(33, b);
+    RenderSettings s;
+    s.mode = RenderMode::Xray;
+    s.kernel = "gaussian";
+    s.kernelSigma = 1.0;
+    s.kernelRadius = 6.0;
+    s.threads = 2;
+    s.camera.width = s.camera.height = 24;
+    s.camera.azimuthDeg = 30;
+    s.camera.elevationDeg = 20;
+    s.camera.pixelSize = p;
+    s.quality.earlyTermination = 0;
+    const Scene scene(v, s);
+    const double s2 = (b * b + 1.0) / (p * p) + sigma * sigma;
+    const double mass = std::pow(2 * kPi * b * b, 1.5);
+    const double peak = mass / (p * p) / (2 * kPi * s2);
+    const Camera cam(s.camera, v);
+    const glm::dvec3 c = cam.project(v.world(glm::dvec3(16, 16, 16)));
+    auto worst = [&](const Image& im, double& sum) {
+        double w = 0;
+        sum = 0;
+        for (int y = 0; y < im.height; ++y)
+            for (int x = 0; x < im.width; ++x) {
+                const double dx = x + 0.5 - c.x, dy = y + 0.5 - c.y;
+                const double e = peak * std::exp(-0.5 * (dx * dx + dy * dy) / s2);
+                w = std::max(w, std::abs(double(im.at(x, y).r) - e) / peak);
+                sum += im.at(x, y).r;
+            }
+        return w;
+    };
+    for (RendererKind kind : {RendererKind::Axis, RendererKind::Sheet}) {
+        INFO(toString(kind));
+        RenderSettings f = s;
+        f.renderer = kind;
+        f.quality.ewa = Ewa::On;  // level 0 through the same filter
+        RenderStats st0, st1, stOld;
+        double sum0 = 0, sum1 = 0, sumOld = 0;
+        const double e0 = worst(scene.render(f, &st0), sum0);
+        REQUIRE(st0.lodLevel == 0);
+        f.quality.ewa = Ewa::Off;  // auto low-passes a merged level itself
+        f.quality.lodAuto = true;
+        const double e1 = worst(scene.render(f, &st1), sum1);
+        REQUIRE(st1.lodLevel == 1);
+        CHECK(st1.ewaSigma == sigma);
+        // Numeric --lod at level 1: the doubled kernel, variance 4 + 0.25 instead of 1 - 0.25.
+        f.quality.lodAuto = false;
+        f.quality.lod = 1;
+        f.quality.ewa = Ewa::On;
+        const double eOld = worst(scene.render(f, &stOld), sumOld);
+        REQUIRE(stOld.lodLevel == 1);
+        WARN(toString(kind) << ": max |image - closed form| / peak: level 0 " << e0
+                            << ", level 1 auto " << e1 << ", level 1 --lod 1 " << eOld
+                            << "; mass " << sum0 / (mass / (p * p)) - 1 << ", "
+                            << sum1 / (mass / (p * p)) - 1);
+        CHECK(e0 < 2e-3);
+        CHECK(e1 < 1.5e-3);
+        CHECK(eOld > 20 * e1);
+        // Mass: the image's sum is the blob's mass over the pixel area (the footprints'
+        // energy kept through the narrowed kernel and the low-pass).
+        CHECK(sum0 == Approx(mass / (p * p)).epsilon(1e-3));
+        CHECK(sum1 == Approx(mass / (p * p)).epsilon(1e-3));
+    }
+}
+
+TEST_CASE("lod auto: a constant slab at level 1 equals full resolution inside", "[lod]") {
+    // No cracks and no double counting: every voxel of the slab z in [8, 40) is in exactly one
+    // merged cell, so the X-ray through the slab's interior is c T / |w_z| at either level.
+    // Level 0 (with EWA, the same filter) within its footprint's lattice ripple, level 1
+    // within the ripple its footprint variance allows: at least kLodAutoSmooth (0.3) of its
+    // grid spacing squared, 2 exp(-2 pi^2 0.3) = 0.54% per screen axis.
+    const int n = 48;
+    Volume v = makeVolume({n, n, n}, {1.0, 1.0, 1.0}, "slab");
+    const float value = 2.0f;
+    for (int k = 8; k < 40; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) v.at(i, j, k) = value;
+    RenderSettings s;
+    s.mode = RenderMode::Xray;
+    s.threads = 2;
+    s.camera.width = s.camera.height = 24;
+    s.camera.azimuthDeg = 25;
+    s.camera.elevationDeg = 60;  // through the slab's faces, obliquely
+    s.camera.pixelSize = 3.0;    // a voxel covers 0.33 pixels: level 1
+    s.quality.earlyTermination = 0;
+    const Scene scene(v, s);
+    const Camera cam(s.camera, v);
+    for (RendererKind kind : {RendererKind::Axis, RendererKind::Sheet}) {
+        RenderSettings f = s;
+        f.renderer = kind;
+        f.quality.ewa = Ewa::On;
+        const Image i0 = scene.render(f);
+        f.quality.ewa = Ewa::Off;
+        f.quality.lodAuto = true;
+        RenderStats st;
+        const Image i1 = scene.render(f, &st);
+        REQUIRE(st.lodLevel == 1);
+        double worst0 = 0, worst1 = 0;
+        int interior = 0;
+        for (int y = 0; y < 24; ++y)
+            for (int x = 0; x < 24; ++x) {
+                const Ray r = cam.ray(x + 0.5, y + 0.5);
+                // Where the ray crosses the slab's faces, 8 voxels (the merged kernels' and
+                // the filter's reach) inside the volume's sides.
+                bool inside = true;
+                for (double z : {7.5, 39.5}) {
+                    const glm::dvec3 q = r.origin + r.dir * ((z - r.origin.z) / r.dir.z);
+                    inside = inside && q.x > 8 && q.x < n - 9 && q.y > 8 && q.y < n - 9;
+                }
+                if (!inside) continue;
+                ++interior;
+                const double exact = value * 32.0 / std::abs(r.dir.z);
+                worst0 = std::max(worst0, std::abs(i0.at(x, y).r / exact - 1));
+                worst1 = std::max(worst1, std::abs(i1.at(x, y).r / exact - 1));
+            }
+        INFO(toString(kind) << ": " << interior << " interior pixels, level 0 " << worst0
+                            << ", level 1 " << worst1);
+        WARN(toString(kind) << ": slab interior relative error level 0 " << worst0
+                            << ", level 1 " << worst1);
+        CHECK(interior >= 20);
+        CHECK(worst0 < 4e-3);
+        CHECK(worst1 < 2 * 2 * std::exp(-2 * kPi * kPi * kLodAutoSmooth));
+    }
+}
+
+TEST_CASE("lod auto: deterministic, thread-count invariant, and lod 0 where it keeps level 0",
+          "[lod]") {
+    const Volume v = makeSynthetic("phantom", 32);
+    for (RendererKind kind : {RendererKind::Axis, RendererKind::Sheet}) {
+        for (RenderMode mode : {RenderMode::Xray, RenderMode::Dvr}) {
+            RenderSettings s;
+            s.renderer = kind;
+            s.mode = mode;
+            s.transfer = TransferFunction::preset("ct-soft");
+            s.camera.width = s.camera.height = 24;
+            s.camera.azimuthDeg = 30;
+            s.camera.elevationDeg = 15;
+            const Scene scene(v, s);
+            // A voxel covering 3, 1 and 0.33 pixels; and perspective.
+            for (double pixel : {1.0 / 3.0, 1.0, 3.0}) {
+                for (double fov : {0.0, 30.0}) {
+                    RenderSettings f = s;
+                    f.camera.pixelSize = pixel;
+                    f.camera.fovDeg = fov;
+                    if (fov > 0) f.camera.distance = 8.0 * 32 * pixel;
+                    f.threads = 1;
+                    const Image off = scene.render(f);
+                    f.quality.lodAuto = true;
+                    RenderStats st1, st3, again;
+                    const Image one = scene.render(f, &st1);
+                    f.threads = 3;
+                    const Image three = scene.render(f, &st3);
+                    const Image repeat = scene.render(f, &again);
+                    INFO(toString(kind) << " " << toString(mode) << " pixel " << pixel << " fov "
+                                        << fov << ": level " << st1.lodLevel);
+                    CHECK(st1.lodLevel == st3.lodLevel);
+                    CHECK(compareImages(one, three).maxAbs == 0.0);
+                    CHECK(compareImages(three, repeat).maxAbs == 0.0);
+                    // A pixel or more per voxel, or dvr (not measured free): level 0 and the
+                    // image of lod 0, bit for bit.
+                    const bool coarse = mode == RenderMode::Xray && pixel > 1.0;
+                    CHECK((st1.lodLevel > 0) == coarse);
+                    if (!coarse) CHECK(compareImages(one, off).maxAbs == 0.0);
+                }
+            }
+        }
+    }
+}
+
+TEST_CASE("lod auto: --lod auto on the command line, in scene files and as a study value",
+          "[lod][cli]") {
+    const std::filesystem::path dir = testTmpDir("lod_auto_cli");
+    const std::string out = (dir / "a.exr").string(), scene = (dir / "s.json").string();
+    // phantom:32 at 12^2: a voxel covers 0.22 pixels; X-ray takes level 1.
+    const RunResult r = runSplat({"render", "synthetic:phantom:32", "--mode", "xray", "--size",
+                                  "12x12", "--lod", "auto", "-o", out, "--write-scene", scene});
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(r.out.find("level of detail 1:") != std::string::npos);
+    CHECK(r.out.find("(--lod auto)") != std::string::npos);
+    const nlohmann::json j = nlohmann::json::parse(readTextFile(scene));
+    CHECK(j["lod"] == "auto");
+    const std::string first = readTextFile(out);
+    std::filesystem::remove(out);
+    const RunResult again = runSplat({"render", "--scene", scene});
+    INFO(again.err);
+    REQUIRE(again.status == 0);
+    CHECK(readTextFile(out) == first);
+    for (const char* bad : {"automatic", "1,2", ""}) {
+        const RunResult b = runSplat({"render", "synthetic:phantom:16", "--size", "16x16", "--lod",
+                                      bad, "-o", (dir / "bad.png").string()});
+        INFO(bad << ": " << b.err);
+        CHECK(b.status == 2);
+        CHECK(b.errLines().size() == 1);
+        CHECK(!std::filesystem::exists(dir / "bad.png"));
+    }
+    const std::filesystem::path report = dir / "study";
+    const RunResult st = runSplat({"study", "synthetic:phantom:32", "--mode", "xray", "--size",
+                                   "12x12", "--sweep", "lod=0,1,auto", "--views", "30",
+                                   "--repeats", "1", "--warmup", "0", "--pixel-filter", "0.5",
+                                   "--report", report.string(), "-q"});
+    INFO(st.err);
+    REQUIRE(st.status == 0);
+    const std::string text = readTextFile(report / "study.csv");
+    CHECK(text.find("\nauto,") != std::string::npos);
 }

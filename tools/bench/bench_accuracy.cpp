@@ -2,7 +2,8 @@
 //
 //   bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] [--classify pre|post]
 //                  [--azimuths 0,30,45] [--elevation E] [--early-termination EPS]
-//                  [--lod L] [--supersample N] [--pixel-filter SIGMA] [--ewa]
+//                  [--lod L|auto[,...]] [--supersample N] [--pixel-filter SIGMA] [--ewa]
+//                  [--axis-only]
 //
 // VOLUME defaults to synthetic:phantom:64, TF to ct-soft. For each azimuth renders the
 // reference, the axis-aligned splatter and the image-aligned splatter with slabs of 1, 0.5
@@ -11,7 +12,8 @@
 // built once per configuration; the time is that of render() alone). The splatters use the
 // default front-to-back early termination (1/256) unless --early-termination says otherwise.
 // --lod L adds the axis-aligned and slab-1 image-aligned splatters at level of detail L
-// (Quality::lod) and their level. --supersample N renders the reference with N x N rays per
+// (Quality::lod) and their level; --lod auto the same with Quality::lodAuto (README "Level of
+// detail"); with --ewa also both with EWA on; a list (--lod 1,auto) adds each in turn. --axis-only leaves out the image-aligned rows. --supersample N renders the reference with N x N rays per
 // pixel (at N times the size) and box-filters it: the pixel's area average rather than its
 // centre's value.
 //
@@ -25,6 +27,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <algorithm>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -44,6 +47,7 @@ struct Config {
     double slab;
     double lod = 0;
     Ewa ewa = Ewa::Off;
+    bool lodAuto = false;
 };
 
 std::vector<double> parseList(const std::string& s) {
@@ -58,8 +62,8 @@ void usage() {
     std::fprintf(stderr,
                  "usage: bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] "
                  "[--classify pre|post] [--azimuths 0,30,45] [--elevation E] "
-                 "[--early-termination EPS] [--lod L] [--supersample N] [--pixel-filter SIGMA] "
-                 "[--ewa]\n");
+                 "[--early-termination EPS] [--lod L|auto[,...]] [--supersample N] "
+                 "[--pixel-filter SIGMA] [--ewa] [--axis-only]\n");
 }
 
 }  // namespace
@@ -69,8 +73,9 @@ int main(int argc, char** argv) {
         std::string volumeSpec = "synthetic:phantom:64", tf = "ct-soft", mode = "dvr",
                     classify = "pre";
         int size = 256, supersample = 1;
-        double earlyTermination = -1, lod = 0, elevation = 0, pixelFilter = 0;
-        bool ewa = false;
+        double earlyTermination = -1, elevation = 0, pixelFilter = 0;
+        bool ewa = false, axisOnly = false;
+        std::vector<std::string> lods;
         std::vector<double> azimuths = {0, 30, 45};
         std::vector<std::string> positional;
         for (int a = 1; a < argc; ++a) {
@@ -91,8 +96,11 @@ int main(int argc, char** argv) {
                 earlyTermination = std::stod(value());
             else if (arg == "--supersample")
                 supersample = std::stoi(value());
-            else if (arg == "--lod")
-                lod = std::stod(value());
+            else if (arg == "--lod") {
+                std::stringstream list(value());
+                for (std::string item; std::getline(list, item, ',');) lods.push_back(item);
+            } else if (arg == "--axis-only")
+                axisOnly = true;
             else if (arg == "--elevation")
                 elevation = std::stod(value());
             else if (arg == "--pixel-filter")
@@ -138,18 +146,31 @@ int main(int argc, char** argv) {
                                        {"sheet, slab 1", RendererKind::Sheet, 1.0},
                                        {"sheet, slab 0.5", RendererKind::Sheet, 0.5},
                                        {"sheet, slab 0.25", RendererKind::Sheet, 0.25}};
-        if (lod > 0) {
-            char label[64];
-            std::snprintf(label, sizeof label, "axis, lod %g", lod);
-            configs.insert(configs.begin() + 1, {label, RendererKind::Axis, 1.0, lod});
-            std::snprintf(label, sizeof label, "sheet, slab 1, lod %g", lod);
-            configs.insert(configs.begin() + 3, {label, RendererKind::Sheet, 1.0, lod});
-        }
         if (ewa) {
             configs.insert(configs.begin() + 1, {"axis, EWA", RendererKind::Axis, 1.0, 0, Ewa::On});
             configs.insert(configs.begin() + 3,
                            {"sheet, slab 1, EWA", RendererKind::Sheet, 1.0, 0, Ewa::On});
         }
+        std::size_t at = ewa ? 2 : 1;  // after "axis" (and "axis, EWA")
+        for (const std::string& l : lods) {
+            const bool lodAuto = l == "auto";
+            const double lod = lodAuto ? 0 : std::stod(l);
+            if (!lodAuto && !(lod > 0)) continue;
+            std::vector<Config> add = {
+                {"axis, lod " + l, RendererKind::Axis, 1.0, lod, Ewa::Off, lodAuto}};
+            if (ewa)
+                add.push_back(
+                    {"axis, lod " + l + ", EWA", RendererKind::Axis, 1.0, lod, Ewa::On, lodAuto});
+            add.push_back(
+                {"sheet, slab 1, lod " + l, RendererKind::Sheet, 1.0, lod, Ewa::Off, lodAuto});
+            if (ewa)
+                add.push_back({"sheet, slab 1, lod " + l + ", EWA", RendererKind::Sheet, 1.0, lod,
+                               Ewa::On, lodAuto});
+            configs.insert(configs.begin() + std::ptrdiff_t(at), add.begin(), add.end());
+            at += add.size();
+        }
+        if (axisOnly)
+            std::erase_if(configs, [](const Config& c) { return c.kind != RendererKind::Axis; });
         std::printf(
             "Accuracy against the reference ray caster: %s, %dx%d, %s %s, transfer "
             "function %s, default kernel and reference settings (step %g voxels, "
@@ -225,6 +246,7 @@ int main(int argc, char** argv) {
                 s.renderer = c.kind;
                 s.quality.slab = c.slab;
                 s.quality.lod = c.lod;
+                s.quality.lodAuto = c.lodAuto;
                 s.quality.ewa = c.ewa;
                 s.camera.azimuthDeg = az;
                 const Renderer renderer(volume, s);

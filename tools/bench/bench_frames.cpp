@@ -5,8 +5,8 @@
 //       writes the volume as a float MetaImage with splat's world grid (origin, spacing),
 //       so that another renderer sees the same samples at the same world positions.
 //   bench_frames render VOLUME TF.json [--renderer axis|sheet|reference] [--slab S]
-//       [--lod L] [--size N] [--threads T] [--frames F] [--elevation E] [--warmup 0|1]
-//       [--save 0,4,..] [--out DIR]
+//       [--lod L|auto] [--mode dvr|mip|xray|iso] [--ewa off|on|auto] [--size N] [--threads T]
+//       [--frames F] [--elevation E] [--warmup 0|1] [--save 0,4,..] [--out DIR]
 //       renders a rotation of F frames (azimuth 360 k / F) and prints JSON: per frame its
 //       wall time, stage counters, level of detail used (Quality::lod) and the camera (target,
 //       right, up, view, pixel size), and the scene's build time, splat count and bytes per splat.
@@ -90,7 +90,11 @@ int renderRotation(const std::string& spec, const std::string& tfPath, const Opt
     s.renderer = splat::parseRenderer(o.get("--renderer", "axis"));
     s.transfer = splat::TransferFunction::load(tfPath);
     s.quality.slab = std::stod(o.get("--slab", "1"));
-    s.quality.lod = std::stod(o.get("--lod", "0"));
+    const std::string lod = o.get("--lod", "0");
+    s.quality.lodAuto = lod == "auto";
+    s.quality.lod = s.quality.lodAuto ? 0 : std::stod(lod);
+    s.mode = splat::parseMode(o.get("--mode", "dvr"));
+    s.quality.ewa = splat::parseEwa(o.get("--ewa", "off"));
     s.threads = std::stoi(o.get("--threads", "2"));
     const int size = std::stoi(o.get("--size", "512"));
     const int frames = std::max(1, std::stoi(o.get("--frames", "12")));
@@ -129,7 +133,10 @@ int renderRotation(const std::string& spec, const std::string& tfPath, const Opt
     const splat::SplatList& sp = scene.splats();
     json << "{\"renderer\": \"" << splat::toString(s.renderer) << "\", \"size\": " << size
          << ", \"threads\": " << s.threads << ", \"slab\": " << s.quality.slab
-         << ", \"lod\": " << s.quality.lod << ", \"scene_ms\": " << sceneMs
+         << ", \"lod\": " << s.quality.lod
+         << ", \"lod_auto\": " << (s.quality.lodAuto ? "true" : "false") << ", \"mode\": \""
+         << splat::toString(s.mode) << "\", \"ewa\": \"" << splat::toString(s.quality.ewa)
+         << "\", \"scene_ms\": " << sceneMs
          << ", \"splats\": " << sp.size() << ", \"splat_bytes\": " << sp.bytes()
          << ", \"voxels\": " << volume->voxelCount() << ", \"frames\": [";
     bool first = true;
@@ -208,7 +215,7 @@ int compare(const std::string& a, const std::string& b, int w, int h) {
 int usage() {
     std::cerr << "usage: bench_frames export VOLUME OUT.mha\n"
                  "       bench_frames render VOLUME TF.json [--renderer R] [--slab S] "
-                 "[--lod L] [--size N] [--threads T] [--frames F] [--elevation E] [--warmup 0|1] "
+                 "[--lod L|auto] [--mode M] [--ewa E] [--size N] [--threads T] [--frames F] [--elevation E] [--warmup 0|1] "
                  "[--save LIST] [--out DIR]\n"
                  "       bench_frames compare A B W H\n";
     return 2;

@@ -123,9 +123,12 @@ void registerRender(CLI::App& app) {
                  std::to_string(std::size_t(image.width) * std::size_t(image.height)) +
                  " pixels handed to the exact path: " + stats.exactReason);
         if (stats.lodLevel > 0)
-            std::printf("level of detail %d: %zu splats of %dx%dx%d voxels each (--lod %g)\n",
+            std::printf("level of detail %d: %zu splats of %dx%dx%d voxels each (--lod %s)\n",
                         stats.lodLevel, stats.lodSplats, 1 << stats.lodLevel, 1 << stats.lodLevel,
-                        1 << stats.lodLevel, settings.quality.lod);
+                        1 << stats.lodLevel,
+                        settings.quality.lodAuto
+                            ? "auto"
+                            : std::to_string(settings.quality.lod).c_str());
         finishRun(*cmd);
     });
 }

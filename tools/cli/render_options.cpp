@@ -69,7 +69,8 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool imageOutput) {
     addOption(cmd, "--tile-size", a.tileSize, "splatters: screen tile edge in pixels (8..64)", q);
     addOption(cmd, "--lod", a.lod,
               "splatters: level of detail, pixels per voxel below which 2x2x2 voxels are "
-              "merged into one splat of twice the size, repeatedly (0..64; 0 = off)",
+              "merged into one splat of twice the size, repeatedly (0..64; 0 = off), or auto: "
+              "the coarsest level whose merged voxels stay within the pixel filter (xray)",
               q);
     addOption(cmd, "--pixel-filter", a.pixelFilter,
               "Gaussian pixel filter sigma in pixels (0..4): the reference supersamples and "
@@ -196,8 +197,16 @@ RenderSettings parseSettings(const RenderArgs& a) {
     if (a.tileSize < 8 || a.tileSize > 64) throw Error("--tile-size must be between 8 and 64");
     s.threads = a.threads;
     s.quality.tileSize = a.tileSize;
-    requireIn(a.lod, 0, 64, "--lod (pixels per voxel; 0 = off)");
-    s.quality.lod = a.lod;
+    if (a.lod == "auto") {
+        s.quality.lodAuto = true;
+        s.quality.lod = 0;
+    } else {
+        const std::vector<double> l = parseNumbers(a.lod, "--lod");
+        if (l.size() != 1) throw Error("--lod needs one number of pixels per voxel, or auto");
+        const double lod = l[0];
+        requireIn(lod, 0, 64, "--lod (pixels per voxel; 0 = off; or auto)");
+        s.quality.lod = lod;
+    }
     requireIn(a.pixelFilter, 0, 4, "--pixel-filter (sigma in pixels; 0 = point sampling)");
     s.quality.pixelFilter = a.pixelFilter;
     try {

@@ -116,8 +116,15 @@ struct Quality {
     /// `lod` pixels (its largest spacing over the pixel size; perspective: at the volume's
     /// nearest depth), the splatters use the next level, 2x2x2 voxels merged into one splat
     /// of twice the size (Laur & Hanrahan). 0 = off: always the full-resolution list.
-    /// 0..64.
+    /// 0..64. Ignored when lodAuto is set.
     double lod = 0;
+    /// Level of detail chosen per view from the error it adds (`--lod auto`, README "Level of
+    /// detail"): in the modes where it was measured free in accuracy against the pixel-filtered
+    /// reference (lodAutoApplies, model/level_of_detail.h), the coarsest level whose merged
+    /// splats, low-passed to what the filtered reference sees (the level-0 kernel plus the
+    /// pixel filter, less the pyramid's box), still sum to a constant on their grid; a
+    /// pixel or more per voxel keeps level 0 (bit-identical to lod 0).
+    bool lodAuto = false;
     /// Pixel filter, a Gaussian of this standard deviation in pixels truncated at 4 sigma
     /// (README "Aliasing and EWA"). Reference ray caster: 0 samples each pixel at its centre;
     /// > 0 supersamples s x s rays per pixel (s = 2, 4, 8, 16) and filters, doubling s until

@@ -229,8 +229,10 @@ void applyKnob(RenderSettings& s, const std::string& n, const std::string& v) {
         q.slabDepthResolution = parseInt(n, v);
     else if (n == "poly-tol")
         q.polynomialTolerance = parseNumber(n, v);
-    else if (n == "lod")
-        q.lod = parseNumber(n, v);
+    else if (n == "lod") {
+        q.lodAuto = v == "auto";
+        q.lod = q.lodAuto ? 0 : parseNumber(n, v);
+    }
     else if (n == "ewa")
         q.ewa = parseEwa(v);
     else if (n == "pixel-filter")
@@ -532,6 +534,7 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         frame.quality.referenceTolerance = s.quality.referenceTolerance;
         frame.quality.tileSize = s.quality.tileSize;
         frame.quality.lod = s.quality.lod;
+        frame.quality.lodAuto = s.quality.lodAuto;
         frame.quality.ewa = s.quality.ewa;
         frame.quality.pixelFilter = s.quality.pixelFilter;
         frame.quality.pixelFilterTolerance = s.quality.pixelFilterTolerance;

@@ -21,7 +21,15 @@ bool ewaAutoApplies(RenderMode mode) { return mode == RenderMode::Xray; }
 }  // namespace
 
 FootprintFilter footprintFilter(const footprint::Kernel& kernel, const Quality& quality,
-                                RenderMode mode, const Camera& camera, const Volume& volume) {
+                                RenderMode mode, const Camera& camera, const Volume& volume,
+                                int level) {
+    if (quality.lodAuto && level > 0) {
+        const LodFootprint f = lodFootprint(
+            kernel.variance(), level,
+            quality.pixelFilter > 0 ? quality.pixelFilter : Quality::kEwaDefaultSigma,
+            std::ldexp(voxelPixels(camera, volume), -level));
+        return {kernel.variance(), f.lowPass, f.kernelScale};
+    }
     const bool on = quality.ewa == Ewa::On ||
                     (quality.ewa == Ewa::Auto && ewaAutoApplies(mode) &&
                      voxelPixels(camera, volume) < Quality::kEwaAutoPixels);
@@ -30,7 +38,7 @@ FootprintFilter footprintFilter(const footprint::Kernel& kernel, const Quality& 
             quality.pixelFilter > 0 ? quality.pixelFilter : Quality::kEwaDefaultSigma};
 }
 
-void projectSplats(const SplatList& splats, const Camera& camera, const glm::dvec3& spacing,
+void projectSplats(const SplatList& splats, const Camera& camera, const glm::dvec3& gridSpacing,
                    double radius, ProjectedSplats& p, const FootprintFilter& filter) {
     const std::size_t n = splats.size();
     p.sx.resize(n);
@@ -40,6 +48,7 @@ void projectSplats(const SplatList& splats, const Camera& camera, const glm::dve
     p.perspective = camera.perspective();
     // The kernel is the ellipsoid S * (ball of radius R); its extent along a unit
     // direction n is R |S n| (the support function of the ellipsoid).
+    const glm::dvec3 spacing = filter.kernelSpacing(gridSpacing);
     p.depthExtent = float(radius * glm::length(spacing * camera.view));
     if (!p.perspective) {
         p.shared = filter.apply(
@@ -82,7 +91,7 @@ SplatProjector::SplatProjector(const SplatList& splats, const Camera& camera,
                                const FootprintFilter& filter)
     : splats_(splats),
       camera_(camera),
-      spacing_(spacing),
+      spacing_(filter.kernelSpacing(spacing)),
       radius_(radius),
       filter_(filter),
       perspective_(camera.perspective()),
@@ -94,7 +103,7 @@ SplatProjector::SplatProjector(const SplatList& splats, const Camera& camera,
       ry_(camera.up / camera.pixelSize) {
     if (!perspective_)
         shared_ = filter_.apply(
-            footprint::ellipticalFootprint(spacing, camera.right * camera.pixelSize,
+            footprint::ellipticalFootprint(spacing_, camera.right * camera.pixelSize,
                                            -camera.up * camera.pixelSize, camera.view, radius),
             radius);
 }

@@ -39,11 +39,21 @@ inline PixelRect footprintRect(float sx, float sy, const footprint::EllipticalFo
 /// EWA resampling of the footprints (footprint::ewaFootprint): the kernel's per-axis
 /// variance and the screen low-pass sigma in pixels; lowPass 0 leaves the footprints as they
 /// are (bit-identical to a frame without it).
+///
+/// kernelScale (a merged level of `--lod auto`, lodFootprint in model/level_of_detail.h):
+/// the kernel is that fraction of the level's voxel (the footprints are those of the spacing
+/// times kernelScale) and its amplitude 1 / kernelScale^3, so every splat still integrates
+/// to one voxel of its level. 1 leaves the footprints as they are.
 struct FootprintFilter {
-    double kernelVariance = 1, lowPass = 0;
+    double kernelVariance = 1, lowPass = 0, kernelScale = 1;
+    /// The spacing the footprints are computed with: the grid's, times kernelScale.
+    glm::dvec3 kernelSpacing(const glm::dvec3& spacing) const { return spacing * kernelScale; }
     footprint::EllipticalFootprint apply(const footprint::EllipticalFootprint& e,
                                          double radius) const {
-        return lowPass > 0 ? footprint::ewaFootprint(e, kernelVariance, lowPass, radius) : e;
+        footprint::EllipticalFootprint f =
+            lowPass > 0 ? footprint::ewaFootprint(e, kernelVariance, lowPass, radius) : e;
+        if (kernelScale != 1) f.scale = float(f.scale / (kernelScale * kernelScale * kernelScale));
+        return f;
     }
 };
 
@@ -51,8 +61,13 @@ struct FootprintFilter {
 /// the modes where it was measured to lower the error against the pixel-filtered reference
 /// (ewaAutoApplies) while a voxel of `volume` (the grid of the splats: a level of detail's)
 /// covers fewer than Quality::kEwaAutoPixels pixels (voxelPixels, model/level_of_detail.h).
+/// A merged level `level` > 0 of `--lod auto` (Quality::lodAuto) is always low-passed (the
+/// pixel filter, as EWA) and splatted with the kernel of lodFootprint (README "Level of
+/// detail": kernel and low-pass together the level-0 kernel plus the pixel filter less the
+/// pyramid's box, not the doubled kernel).
 FootprintFilter footprintFilter(const footprint::Kernel& kernel, const Quality& quality,
-                                RenderMode mode, const Camera& camera, const Volume& volume);
+                                RenderMode mode, const Camera& camera, const Volume& volume,
+                                int level = 0);
 
 struct ProjectedSplats {
     std::vector<float> sx, sy;  ///< continuous pixel position of the centre

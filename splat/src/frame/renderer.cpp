@@ -48,8 +48,9 @@ Emission shade(const Scene::Impl& scene, const Camera& camera, FrameWorkspace& w
 void project(const Scene::Impl& scene, const Camera& camera, const Quality& quality,
              RenderMode mode, FrameWorkspace& work, RenderStats& stats) {
     const auto start = Clock::now();
-    projectSplats(scene.splats, camera, scene.volume->spacing, scene.kernel.radius(), work.proj,
-                  footprintFilter(scene.kernel, quality, mode, camera, *scene.volume));
+    projectSplats(
+        scene.splats, camera, scene.volume->spacing, scene.kernel.radius(), work.proj,
+        footprintFilter(scene.kernel, quality, mode, camera, *scene.volume, scene.level));
     stats.projectMs = msSince(start);
 }
 
@@ -128,7 +129,8 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
         s.renderer == RendererKind::Axis ? axisAlignedSplatter() : imageAlignedSplatter();
     const WorkspaceLease work(scene);
     stats.ewaSigma =
-        footprintFilter(scene.kernel, s.quality, s.mode, camera, *scene.volume).lowPass;
+        footprintFilter(scene.kernel, s.quality, s.mode, camera, *scene.volume, scene.level)
+            .lowPass;
     const Emission e = shade(scene, camera, *work, stats);
     if (!splatter.streams()) project(scene, camera, s.quality, s.mode, *work, stats);
     const SheetPlan plan = order(splatter, scene, camera, s, *work, stats);
@@ -225,8 +227,25 @@ bool needsExactPath(const Scene::Impl& scene, const Camera& camera) {
 
 /// The level of detail the splatters use for this view (Quality::lod): coarser while a voxel
 /// of the level covers fewer than `lod` pixels.
-const Scene::Impl& levelOfDetail(const Scene::Impl& scene, const Camera& camera, double lod) {
+/// Auto (Quality::lodAuto): lodAutoLevel of the level-0 voxel's size, in the modes where it
+/// was measured free (lodAutoApplies).
+const Scene::Impl& levelOfDetail(const Scene::Impl& scene, const Camera& camera,
+                                 const Quality& q, RenderMode mode) {
     const Scene::Impl* level = &scene;
+    if (q.lodAuto) {
+        if (!lodAutoApplies(mode)) return scene;
+        const int target = lodAutoLevel(
+            voxelPixels(camera, *scene.volume),
+            q.pixelFilter > 0 ? q.pixelFilter : Quality::kEwaDefaultSigma,
+            scene.kernel.variance(), 16);
+        while (level->level < target) {
+            const Scene::Impl* next = level->coarser();
+            if (!next) break;
+            level = next;
+        }
+        return *level;
+    }
+    const double lod = q.lod;
     if (lod > 0)
         while (voxelPixels(camera, *level->volume) < lod) {
             const Scene::Impl* next = level->coarser();
@@ -282,7 +301,7 @@ Image renderFrame(const Scene::Impl& scene, const RenderSettings& given, RenderS
         // when a dimension is odd.
         const Scene::Impl& level = s.renderer == RendererKind::Reference
                                        ? scene
-                                       : levelOfDetail(scene, camera, s.quality.lod);
+                                       : levelOfDetail(scene, camera, s.quality, s.mode);
         if (s.renderer == RendererKind::Reference) {
             image = s.quality.pixelFilter > 0
                         ? filteredReferenceFrame(scene, camera, s, local, depth)

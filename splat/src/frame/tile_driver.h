@@ -347,7 +347,7 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
     const SplatProjector projector(
         in.scene.splats, in.camera, in.scene.volume->spacing, in.scene.kernel.radius(),
         footprintFilter(in.scene.kernel, in.settings.quality, in.settings.mode, in.camera,
-                        *in.scene.volume));
+                        *in.scene.volume, in.scene.level));
     const std::vector<float> pathScale = perspectivePathScale(in.camera, in.plan.normal);
     constexpr bool surface = kSurfacePolicy<Policy>;
     const bool cull = Policy::kTerminates && in.settings.order == CompositeOrder::FrontToBack &&

@@ -173,4 +173,30 @@ double voxelPixels(const Camera& camera, const Volume& volume) {
     return voxel / pixel;
 }
 
+double lodBoxVariance(int level) { return (std::ldexp(1.0, 2 * level) - 1.0) / 12.0; }
+
+LodFootprint lodFootprint(double k2, int level, double sigma, double voxelPixels0) {
+    const double grid = std::ldexp(1.0, 2 * level);  // level voxel^2 in level-0 voxels^2
+    const double narrowed = k2 - lodBoxVariance(level);
+    if (narrowed >= kLodMinKernel * k2) return {std::sqrt(narrowed / (grid * k2)), sigma};
+    const double rest = sigma * sigma - (lodBoxVariance(level) - (1.0 - kLodMinKernel) * k2) *
+                                            voxelPixels0 * voxelPixels0;
+    return {std::sqrt(kLodMinKernel / grid), std::sqrt(std::max(rest, 1e-6))};
+}
+
+bool lodAutoApplies(RenderMode mode) { return mode == RenderMode::Xray; }
+
+int lodAutoLevel(double voxelPixels, double sigma, double kernelVariance, int maxLevel) {
+    if (!(voxelPixels > 0) || !std::isfinite(voxelPixels)) return 0;
+    const double v2 = voxelPixels * voxelPixels, s2 = sigma * sigma;
+    int level = 0;
+    while (level < maxLevel) {
+        const int next = level + 1;
+        const double footprint = (kernelVariance - lodBoxVariance(next)) * v2 + s2;
+        if (!(footprint >= kLodAutoSmooth * std::ldexp(v2, 2 * next))) break;
+        level = next;
+    }
+    return level;
+}
+
 }  // namespace splat
