@@ -98,9 +98,10 @@ int renderRotation(const std::string& spec, const std::string& tf,
     for (std::size_t i = 0; i + 1 < args.size(); ++i)
         if (args[i] == "--size" && args[i + 1].find_first_of("xX") == std::string::npos)
             args[i + 1] += "x" + args[i + 1];
-    std::reverse(args.begin(), args.end());
+    std::vector<const char*> argv = {"bench_frames render"};
+    for (const std::string& arg : args) argv.push_back(arg.c_str());
     try {
-        app.parse(args);
+        app.parse(int(argv.size()), argv.data());
     } catch (const CLI::ParseError& e) {
         std::cerr << "bench_frames: error: " << e.what() << '\n';
         return 2;
