@@ -4,14 +4,18 @@
 //   bench_frames export VOLUME OUT.mha
 //       writes the volume as a float MetaImage with splat's world grid (origin, spacing),
 //       so that another renderer sees the same samples at the same world positions.
-//   bench_frames render VOLUME TF.json [--renderer axis|sheet|reference] [--slab S]
-//       [--lod L|auto] [--mode dvr|mip|xray|iso] [--ewa off|on|auto] [--size N] [--threads T]
-//       [--frames F] [--elevation E] [--warmup 0|1] [--save 0,4,..] [--out DIR]
-//       renders a rotation of F frames (azimuth 360 k / F) and prints JSON: per frame its
-//       wall time, stage counters, level of detail used (Quality::lod) and the camera (target,
-//       right, up, view, pixel size), and the scene's build time, splat count and bytes per splat.
-//       Frames listed in
-//       --save are written to DIR/frame_K.f32 (float RGBA, row 0 at the top).
+//   bench_frames render VOLUME TF [RENDER OPTIONS] [--frames F] [--warmup 0|1]
+//       [--save 0,4,..] [--out DIR]
+//       renders a rotation of F frames (azimuth 360 k / F, default 12) and prints JSON: per
+//       frame its wall and CPU time, stage counters, level of detail used, pixel-filter passes
+//       (the filtered reference) and the camera (target, right, up, view, pixel size), and the
+//       scene's build time, splat count and bytes per splat. RENDER OPTIONS are `splat
+//       render`'s own (tools/cli/render_options.h: --renderer, --mode, --slab, --lod, --ewa,
+//       --pixel-filter, --size WxH or N, --threads (default 2), --elevation (default 15), ...),
+//       parsed by the same code, so any value the command line accepts (e.g. a new `--lod`
+//       mode) works here too; TF is the --tf value (a preset or a JSON file). Frames listed in
+//       --save are written to DIR/frame_K.f32 (float RGBA, row 0 at the top); the reference
+//       renders only those.
 //   bench_frames compare A B W H
 //       RMSE and max abs difference of the RGB of two W x H images over black, each a .f32
 //       (float RGBA premultiplied, top row first) or .rgb8 (8-bit RGB, bottom row first, as
@@ -30,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "render_options.h"
 #include "splat/error.h"
 #include "splat/scene.h"
 #include "splat/volume_io.h"
@@ -57,16 +62,6 @@ std::string vec(const glm::dvec3& v) {
     return o.str();
 }
 
-/// "--name value" options after the positional arguments.
-struct Options {
-    std::vector<std::string> args;
-    std::string get(const std::string& name, const std::string& fallback) const {
-        for (std::size_t i = 0; i + 1 < args.size(); ++i)
-            if (args[i] == name) return args[i + 1];
-        return fallback;
-    }
-};
-
 int exportVolume(const std::string& spec, const std::string& out) {
     const splat::Volume v = splat::loadVolume(spec);
     splat::saveMetaImage(out, v);
@@ -85,32 +80,47 @@ void writeFloats(const std::string& path, const splat::Image& image) {
     if (!f) throw splat::Error(path + ": cannot write");
 }
 
-int renderRotation(const std::string& spec, const std::string& tfPath, const Options& o) {
-    splat::RenderSettings s;
-    s.renderer = splat::parseRenderer(o.get("--renderer", "axis"));
-    s.transfer = splat::TransferFunction::load(tfPath);
-    s.quality.slab = std::stod(o.get("--slab", "1"));
-    const std::string lod = o.get("--lod", "0");
-    s.quality.lodAuto = lod == "auto";
-    s.quality.lod = s.quality.lodAuto ? 0 : std::stod(lod);
-    s.mode = splat::parseMode(o.get("--mode", "dvr"));
-    s.quality.ewa = splat::parseEwa(o.get("--ewa", "off"));
-    s.threads = std::stoi(o.get("--threads", "2"));
-    const int size = std::stoi(o.get("--size", "512"));
-    const int frames = std::max(1, std::stoi(o.get("--frames", "12")));
-    const double elevation = std::stod(o.get("--elevation", "15"));
-    const bool warmup = o.get("--warmup", "1") != "0";
-    const std::string out = o.get("--out", ".");
+int renderRotation(const std::string& spec, const std::string& tf,
+                   std::vector<std::string> args) {
+    CLI::App app{"bench_frames render"};
+    splat::cli::RenderArgs r;
+    r.tf = tf;
+    r.threads = 2;
+    r.elevation = 15;
+    splat::cli::addRenderOptions(app, r, false);
+    int frames = 12, warmupFlag = 1;
+    std::string saveList, out = ".";
+    app.add_option("--frames", frames, "frames of the rotation");
+    app.add_option("--warmup", warmupFlag, "1: render two frames before timing");
+    app.add_option("--save", saveList, "frames to write as DIR/frame_K.f32");
+    app.add_option("--out", out, "folder of the saved frames");
+    // --size N means N x N.
+    for (std::size_t i = 0; i + 1 < args.size(); ++i)
+        if (args[i] == "--size" && args[i + 1].find_first_of("xX") == std::string::npos)
+            args[i + 1] += "x" + args[i + 1];
+    std::vector<const char*> argv = {"bench_frames render"};
+    for (const std::string& arg : args) argv.push_back(arg.c_str());
+    try {
+        app.parse(int(argv.size()), argv.data());
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "bench_frames: error: " << e.what() << '\n';
+        return 2;
+    }
+    splat::RenderSettings s = splat::cli::settingsFromArgs(r, splat::cli::RenderUse{});
+    frames = std::max(1, frames);
+    const double elevation = s.camera.elevationDeg;
+    const bool warmup = warmupFlag != 0;
+    const int size = s.camera.width;
     std::vector<int> save;
     {
-        std::stringstream list(o.get("--save", ""));
+        std::stringstream list(saveList);
         for (std::string item; std::getline(list, item, ',');)
             if (!item.empty()) save.push_back(std::stoi(item));
     }
-    s.camera.width = s.camera.height = size;
 
     auto volume = std::make_shared<const splat::Volume>(splat::loadVolume(spec));
     const auto built = Clock::now();
+    s = splat::cli::withFreeCameraTarget(s, *volume);
     const splat::Scene scene(volume, s);
     const double sceneMs = msSince(built);
     const bool onlySaved = s.renderer == splat::RendererKind::Reference;
@@ -133,12 +143,12 @@ int renderRotation(const std::string& spec, const std::string& tfPath, const Opt
     const splat::SplatList& sp = scene.splats();
     json << "{\"renderer\": \"" << splat::toString(s.renderer) << "\", \"size\": " << size
          << ", \"threads\": " << s.threads << ", \"slab\": " << s.quality.slab
-         << ", \"lod\": " << s.quality.lod
-         << ", \"lod_auto\": " << (s.quality.lodAuto ? "true" : "false") << ", \"mode\": \""
-         << splat::toString(s.mode) << "\", \"ewa\": \"" << splat::toString(s.quality.ewa)
-         << "\", \"scene_ms\": " << sceneMs
+         << ", \"mode\": \"" << splat::toString(s.mode) << "\", \"lod\": " << s.quality.lod
+         << ", \"ewa\": \"" << splat::toString(s.quality.ewa)
+         << "\", \"pixel_filter\": " << s.quality.pixelFilter << ", \"scene_ms\": " << sceneMs
          << ", \"splats\": " << sp.size() << ", \"splat_bytes\": " << sp.bytes()
-         << ", \"voxels\": " << volume->voxelCount() << ", \"frames\": [";
+         << ", \"voxels\": " << volume->voxelCount() << ", \"spacing\": " << vec(volume->spacing)
+         << ", \"frames\": [";
     bool first = true;
     for (int f = 0; f < frames; ++f) {
         if (!wanted(f)) continue;
@@ -159,6 +169,8 @@ int renderRotation(const std::string& spec, const std::string& tfPath, const Opt
              << ", \"footprint_pixels\": " << st.footprintPixels
              << ", \"culled_splats\": " << st.culledSplats << ", \"sheets\": " << st.sheets
              << ", \"lod_level\": " << st.lodLevel << ", \"lod_splats\": " << st.lodSplats
+             << ", \"pixel_samples\": " << st.pixelSamples
+             << ", \"pixel_filter_change\": " << st.pixelFilterChange
              << ", \"target\": " << vec(cam.target) << ", \"right\": " << vec(cam.right)
              << ", \"up\": " << vec(cam.up) << ", \"view\": " << vec(cam.view)
              << ", \"pixel_size\": " << cam.pixelSize << ", \"radius\": " << cam.boundingRadius
@@ -214,9 +226,8 @@ int compare(const std::string& a, const std::string& b, int w, int h) {
 
 int usage() {
     std::cerr << "usage: bench_frames export VOLUME OUT.mha\n"
-                 "       bench_frames render VOLUME TF.json [--renderer R] [--slab S] "
-                 "[--lod L|auto] [--mode M] [--ewa E] [--size N] [--threads T] [--frames F] [--elevation E] [--warmup 0|1] "
-                 "[--save LIST] [--out DIR]\n"
+                 "       bench_frames render VOLUME TF [splat render's options] [--frames F] "
+                 "[--warmup 0|1] [--save LIST] [--out DIR]\n"
                  "       bench_frames compare A B W H\n";
     return 2;
 }
@@ -228,7 +239,7 @@ int main(int argc, char** argv) {
     try {
         if (a.size() == 3 && a[0] == "export") return exportVolume(a[1], a[2]);
         if (a.size() >= 3 && a[0] == "render")
-            return renderRotation(a[1], a[2], Options{{a.begin() + 3, a.end()}});
+            return renderRotation(a[1], a[2], {a.begin() + 3, a.end()});
         if (a.size() == 5 && a[0] == "compare")
             return compare(a[1], a[2], std::stoi(a[3]), std::stoi(a[4]));
         return usage();
