@@ -105,10 +105,21 @@ void registerPopping(CLI::App& app) {
             throw UsageError(
                 "popping --bricks runs on one process; under mpirun popping is frame-parallel "
                 "(leave out --bricks)");
+        if (a->bricks > 0 && o.truth == Truth::Point && settings.quality.pixelFilter > 0)
+            throw UsageError(
+                "popping --bricks --truth point: --pixel-filter would filter the bricks' "
+                "reference too (leave one out)");
+        // The Scene's settings carry the reference's pixel filter that --truth asks for
+        // (splat/popping.h poppingSettings), so that the sweep renders views in parallel.
+        auto judged = [&](const RenderSettings& s, const Volume& v) {
+            Sweep views = sweep;
+            views.base = s.camera;
+            return poppingSettings(s, v, poppingViews(a->popping, views), o.truth);
+        };
         if (workerProcess())  // under mpirun: render the frames rank 0 asks for (parallel.h)
             return serveFrames([&] {
                 auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
-                return Scene(v, withDataDefaults(a->render, settings, *v));
+                return Scene(v, judged(withDataDefaults(a->render, settings, *v), *v));
             });
         beginRun(*cmd);
         // The frames rendered so far are journaled, so that --resume after an interruption
@@ -125,7 +136,7 @@ void registerPopping(CLI::App& app) {
         std::unique_ptr<BrickedFrames> bricked;
         if (a->bricks > 0) {
             geometry = brickedGeometry(a->volume);
-            settings = withFreeCameraTarget(settings, *geometry);
+            settings = judged(withFreeCameraTarget(settings, *geometry), *geometry);
             group = brickGroup();
             bricked = std::make_unique<BrickedFrames>(*geometry, brickLoader(a->volume), settings,
                                                       a->bricks, *group);
@@ -135,7 +146,7 @@ void registerPopping(CLI::App& app) {
             settings = bricked->settings();
         } else {
             volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
-            settings = withDataDefaults(a->render, settings, *volume);
+            settings = judged(withDataDefaults(a->render, settings, *volume), *volume);
             scene.emplace(volume, settings);
         }
         installInterruptHandler();

@@ -53,6 +53,9 @@ struct FootprintFilter {
 /// covers fewer than Quality::kEwaAutoPixels pixels (voxelPixels, model/level_of_detail.h).
 FootprintFilter footprintFilter(const footprint::Kernel& kernel, const Quality& quality,
                                 RenderMode mode, const Camera& camera, const Volume& volume);
+/// Its low-pass sigma in pixels (0: off); splat::ewaLowPass (splat/render.h) for a frame.
+double ewaLowPass(const Quality& quality, RenderMode mode, const Camera& camera,
+                  const Volume& volume);
 
 struct ProjectedSplats {
     std::vector<float> sx, sy;  ///< continuous pixel position of the centre
