@@ -5,9 +5,9 @@
 // signal, is_event, truth. One row per renderer and interval (e and flipRef at angle_from); a
 // value that was not measured (no reference, no FLIP) is an empty cell. truth: the reference
 // J, e and flipRef are against, "point" (one ray per pixel centre) or "filtered SIGMA" (the
-// pixel-filtered reference, PoppingResult::truthFilter); empty without a reference. When the cross jump C was
-// measured, rows with renderer "axis-sheet" follow: C in the J and signal columns, is_event
-// 1 when any renderer has an event on that interval, the other columns empty.
+// pixel-filtered reference, PoppingResult::truthFilter); empty without a reference. When the cross
+// jump C was measured, rows with renderer "axis-sheet" follow: C in the J and signal columns,
+// is_event 1 when any renderer has an event on that interval, the other columns empty.
 //
 // The folder: created when missing; refused when it is not a folder, or when it holds
 // anything but a previous report's three files (and the hidden temporaries of an
@@ -386,8 +386,7 @@ std::string metricsCsv(const PoppingResult& r) {
         for (std::size_t n = 0; n < intervals; ++n)
             s << "axis-sheet," << n << ',' << csvNumber(r.angles[n]) << ','
               << csvNumber(r.angles[n + 1]) << ",," << csvNumber(at(r.crossJump, n)) << ",,,,"
-              << csvNumber(at(r.crossJump, n)) << ',' << (isEvent(r, nullptr, n) ? 1 : 0)
-              << ",\n";
+              << csvNumber(at(r.crossJump, n)) << ',' << (isEvent(r, nullptr, n) ? 1 : 0) << ",\n";
     return s.str();
 }
 
