@@ -10,6 +10,7 @@
 #include "footprint/kernel.h"
 #include "reference/pixel_filter.h"
 #include "reference_util.h"
+#include "splat/image_io.h"
 #include "splat/render.h"
 #include "splat/synthetic.h"
 
@@ -194,6 +195,7 @@ TEST_CASE("ewa: both splatters' X-ray of a blob is the filtered closed form",
         for (double voxelPixels : {0.5, 2.0}) {
             INFO(toString(kind) << ", voxel covers " << voxelPixels << " pixels");
             RenderSettings s = blobXray(kind, voxelPixels, 24);
+            s.quality.ewa = Ewa::Off;  // the point-sampled splatters (auto would filter 0.5)
             const double plain = worstAgainstClosedForm(Renderer(v, s).render(), v, s, 0.5);
             s.quality.ewa = Ewa::On;
             RenderStats st;
@@ -260,4 +262,65 @@ TEST_CASE("cli: --pixel-filter and --ewa refuse bad values with one line and sta
                                    "reference", "--pixel-filter", "0.5", "-o", out});
     CHECK(ok.status == 0);
     CHECK(std::filesystem::exists(out));
+}
+
+TEST_CASE("ewa: the default (auto) filters sub-pixel X-ray, and is off elsewhere bit for bit",
+          "[ewa][splatters][cli]") {
+    CHECK(Quality{}.ewa == Ewa::Auto);
+    const std::filesystem::path dir = testTmpDir("ewa_default");
+    // phantom:32 at 16x16 (a voxel covers 0.29 pixels) and at 64x64 (1.15 pixels), through
+    // the command line: the default against --ewa off and --ewa on.
+    for (const char* size : {"16x16", "64x64"})
+        for (const char* renderer : {"axis", "sheet"}) {
+            INFO(renderer << " at " << size);
+            auto frame = [&](const std::vector<std::string>& extra) {
+                const std::string out = (dir / (std::string(renderer) + "_" + size + "_" +
+                                                std::to_string(extra.size()) +
+                                                (extra.empty() ? "" : extra.back()) + ".exr"))
+                                            .string();
+                std::vector<std::string> args{"render", "synthetic:phantom:32", "--tf", "ct-soft",
+                                              "--mode", "xray", "--renderer", renderer,
+                                              "--size", size, "--azimuth", "30", "-o", out};
+                args.insert(args.end(), extra.begin(), extra.end());
+                const RunResult r = runSplat(args);
+                INFO(r.err);
+                REQUIRE(r.status == 0);
+                return readImage(out);
+            };
+            const Image byDefault = frame({}), off = frame({"--ewa", "off"}),
+                        on = frame({"--ewa", "on"});
+            const bool subPixel = std::string(size) == "16x16";
+            CHECK((compareImages(byDefault, off).maxAbs == 0.0) == !subPixel);
+            if (subPixel) CHECK(compareImages(byDefault, on).maxAbs == 0.0);
+        }
+}
+
+TEST_CASE("truth: the reference an analysis judges against follows the splatters' filter",
+          "[ewa][truth]") {
+    const Volume v = makeSynthetic("phantom", 32);
+    RenderSettings s;
+    s.mode = RenderMode::Xray;
+    s.camera.width = s.camera.height = 16;  // a voxel covers 0.29 pixels
+    const std::vector<CameraParams> views{s.camera};
+    CHECK(ewaLowPass(s, v) == Quality::kEwaDefaultSigma);
+    CHECK(truthFilter(s, v, views, Truth::Auto) == Quality::kEwaDefaultSigma);
+    CHECK(truthFilter(s, v, views, Truth::Point) == 0.0);
+    s.quality.ewa = Ewa::Off;  // point-sampled splatters: the point-sampled truth
+    CHECK(ewaLowPass(s, v) == 0.0);
+    CHECK(truthFilter(s, v, views, Truth::Auto) == 0.0);
+    CHECK(truthFilter(s, v, views, Truth::Filtered) == Quality::kEwaDefaultSigma);
+    s.quality.ewa = Ewa::Auto;
+    s.quality.pixelFilter = 1.0;  // a pixel filter given is the filter of both
+    CHECK(ewaLowPass(s, v) == 1.0);
+    CHECK(truthFilter(s, v, views, Truth::Auto) == 1.0);
+    s.quality.pixelFilter = 0;
+    s.mode = RenderMode::Dvr;  // auto leaves dvr alone: its truth stays point-sampled
+    CHECK(truthFilter(s, v, views, Truth::Auto) == 0.0);
+    s.mode = RenderMode::Xray;
+    s.camera.width = s.camera.height = 64;  // 1.15 pixels per voxel
+    CHECK(truthFilter(s, v, {s.camera}, Truth::Auto) == 0.0);
+    // Any view of a sweep with EWA on makes the sweep's truth filtered.
+    CameraParams small = s.camera;
+    small.width = small.height = 16;
+    CHECK(truthFilter(s, v, {s.camera, small}, Truth::Auto) == Quality::kEwaDefaultSigma);
 }

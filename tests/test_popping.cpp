@@ -154,3 +154,48 @@ TEST_CASE("popping: bad sweeps are refused with one line", "[popping]") {
     o.progress = [](std::size_t done, std::size_t, const std::string&) { return done < 3; };
     CHECK_THROWS_AS(analyzePopping(scene, sweep, o), Cancelled);
 }
+
+TEST_CASE("popping: a sub-pixel X-ray sweep is judged against the pixel-filtered reference",
+          "[popping][ewa][truth]") {
+    // phantom:32 at 16x16: a voxel covers 0.29 pixels, so the splatters' frames are filtered
+    // (EWA, the default auto) and the truth is the pixel-filtered reference (sigma 0.5).
+    RenderSettings s;
+    s.mode = RenderMode::Xray;
+    s.transfer = TransferFunction::preset("ct-soft");
+    s.camera.width = s.camera.height = 16;
+    Sweep sweep;
+    sweep.from = 40;
+    sweep.to = 42;
+    sweep.step = 1;
+    sweep.base = s.camera;
+    PoppingOptions o;
+    o.renderers = {RendererKind::Axis, RendererKind::Reference};
+    o.refine = 0;
+    o.flip = false;
+    const Volume v = makeSynthetic("phantom", 32);
+    const std::vector<CameraParams> views{sweep.camera(40), sweep.camera(41), sweep.camera(42)};
+    const Scene filteredScene(v, poppingSettings(s, v, views, Truth::Auto));
+    CHECK(filteredScene.settings().quality.pixelFilter == Quality::kEwaDefaultSigma);
+    const PoppingResult filtered = analyzePopping(filteredScene, sweep, o);
+    CHECK(filtered.truthFilter == Quality::kEwaDefaultSigma);
+    // The same sweep judged against the point-sampled reference (--truth point).
+    o.truth = Truth::Point;
+    const Scene pointScene(v, poppingSettings(s, v, views, Truth::Point));
+    const PoppingResult point = analyzePopping(pointScene, sweep, o);
+    CHECK(point.truthFilter == 0.0);
+    const std::vector<double>& ef = series(filtered, RendererKind::Axis).e;
+    const std::vector<double>& ep = series(point, RendererKind::Axis).e;
+    REQUIRE(ef.size() == 3);
+    REQUIRE(ep.size() == 3);
+    for (std::size_t n = 0; n < ef.size(); ++n) {
+        INFO("view " << n << ": filtered " << ef[n] << ", point " << ep[n]);
+        CHECK(ef[n] < 0.1 * ep[n]);
+    }
+    // A library Scene without the filter in its settings: the analyser renders the filtered
+    // reference itself (view by view), with the same figures.
+    o.truth = Truth::Auto;
+    const PoppingResult own = analyzePopping(pointScene, sweep, o);
+    CHECK(own.truthFilter == Quality::kEwaDefaultSigma);
+    for (std::size_t n = 0; n < ef.size(); ++n)
+        CHECK(series(own, RendererKind::Axis).e[n] == Approx(ef[n]).epsilon(1e-9));
+}

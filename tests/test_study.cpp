@@ -149,3 +149,39 @@ TEST_CASE("frames model only what the scene needs, and say so", "[study][stats]"
         CHECK(st.exactPixels == 0);  // the eye is far from every kernel
     }
 }
+
+TEST_CASE("study: a setting with EWA on is judged against the pixel-filtered reference",
+          "[study][ewa][truth]") {
+    // phantom:32 X-ray at 16x16: a voxel covers 0.29 pixels, so ewa=auto filters the frames.
+    auto v = std::make_shared<const Volume>(makeSynthetic("phantom", 32));
+    RenderSettings base;
+    base.mode = RenderMode::Xray;
+    base.camera.width = base.camera.height = 16;
+    base.transfer = TransferFunction::preset("ct-soft");
+    StudyOptions o;
+    o.sweeps = {parseKnob("renderer=axis"), parseKnob("ewa=off,auto")};
+    o.repeats = 1;
+    o.warmup = 0;
+    o.referenceStep = 0.25;
+    o.referenceTolerance = 1e-4;
+    auto byEwa = [](const StudyResult& r, const std::string& value) -> const StudyPoint& {
+        for (const StudyPoint& p : r.points)
+            for (const auto& [k, val] : p.knobs)
+                if (k == "ewa" && val == value) return p;
+        FAIL("no point ewa=" << value);
+        return r.points.front();
+    };
+    const StudyResult judged = runStudy(v, base, o);
+    REQUIRE(judged.points.size() == 2);
+    const StudyPoint &off = byEwa(judged, "off"), &ewa = byEwa(judged, "auto");
+    CHECK(off.truthFilter == 0.0);  // point-sampled frames, point-sampled truth
+    CHECK(ewa.truthFilter == Quality::kEwaDefaultSigma);
+    o.truth = Truth::Point;
+    const StudyResult point = runStudy(v, base, o);
+    REQUIRE(point.points.size() == 2);
+    CHECK(byEwa(point, "auto").truthFilter == 0.0);
+    CHECK(byEwa(point, "off").rmse == off.rmse);
+    // The filtered frames are far closer to the filtered truth than to the point-sampled one.
+    INFO("against filtered " << ewa.rmse << ", against point " << byEwa(point, "auto").rmse);
+    CHECK(ewa.rmse < 0.1 * byEwa(point, "auto").rmse);
+}

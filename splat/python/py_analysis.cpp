@@ -103,6 +103,7 @@ py::dict pointDict(const StudyPoint& p) {
     d["max_abs"] = p.maxAbs;
     d["flip"] = p.flip;
     d["pareto"] = p.pareto;
+    d["truth_filter"] = p.truthFilter;  // the reference's pixel filter (0: point-sampled)
     return d;
 }
 
@@ -148,6 +149,9 @@ void bindAnalysis(py::module_& m) {
                 return out;
             },
             "The events, as dicts (summary.json's fields, and 'refinement').")
+        .def_readonly("truth_filter", &PoppingResult::truthFilter,
+                      "The reference's pixel filter sigma, pixels (0: the point-sampled "
+                      "reference; truth=).")
         .def_readonly("total_ms", &PoppingResult::totalMs)
         .def(
             "write_report",
@@ -172,6 +176,9 @@ void bindAnalysis(py::module_& m) {
                     cli::poppingFromArgs(app, pa, s, sweep, o);
                 });
             settings.renderer = o.renderers.front();
+            Sweep views = sweep;
+            views.base = settings.camera;
+            settings = poppingSettings(settings, *v.volume, cli::poppingViews(pa, views), o.truth);
             PyScene scene = makeSceneFrom(v.volume, settings);
             Interrupt in(progress);
             o.progress = in.progress();
@@ -241,7 +248,7 @@ void bindAnalysis(py::module_& m) {
            const std::vector<std::string>& sweeps,
            const std::vector<std::pair<double, double>>& views, int repeats, int warmup,
            double truthStep, double truthTolerance, double ppd, bool convergence,
-           const std::string& cacheDir, const py::object& progress) {
+           const std::string& cacheDir, const std::string& truth, const py::object& progress) {
             RenderSettings settings = parseRenderSettings(argv, tfJson, v.volume.get(), false);
             StudyOptions o;
             for (const std::string& s : sweeps) o.sweeps.push_back(parseKnob(s));
@@ -260,6 +267,7 @@ void bindAnalysis(py::module_& m) {
             o.referenceTolerance = truthTolerance;
             o.pixelsPerDegree = ppd;
             o.cacheDir = cacheDir;
+            o.truth = parseTruth(truth);
             Interrupt in(progress);
             o.progress = in.progress();
             settings.progress = in.progress();
@@ -275,7 +283,8 @@ void bindAnalysis(py::module_& m) {
         },
         py::arg("volume"), py::arg("argv"), py::arg("tf_json"), py::arg("sweeps"), py::arg("views"),
         py::arg("repeats"), py::arg("warmup"), py::arg("truth_step"), py::arg("truth_tolerance"),
-        py::arg("ppd"), py::arg("convergence"), py::arg("cache_dir"), py::arg("progress"));
+        py::arg("ppd"), py::arg("convergence"), py::arg("cache_dir"), py::arg("truth"),
+        py::arg("progress"));
     m.def("study_knobs", &studyKnobNames, "Knob names splat.study sweeps.");
 
     py::class_<Mesh>(m, "Mesh", "A triangle mesh in world coordinates (splat.iso_surface).")

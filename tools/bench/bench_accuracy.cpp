@@ -3,7 +3,7 @@
 //   bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] [--classify pre|post]
 //                  [--azimuths 0,30,45] [--elevation E] [--early-termination EPS]
 //                  [--lod L|auto[,...]] [--supersample N] [--pixel-filter SIGMA] [--ewa]
-//                  [--axis-only]
+//                  [--axis-only] [--truth auto|point|filtered]
 //
 // VOLUME defaults to synthetic:phantom:64, TF to ct-soft. For each azimuth renders the
 // reference, the axis-aligned splatter and the image-aligned splatter with slabs of 1, 0.5
@@ -17,12 +17,17 @@
 // pixel (at N times the size) and box-filters it: the pixel's area average rather than its
 // centre's value.
 //
-// --pixel-filter SIGMA also renders the pixel-filtered reference (Quality::pixelFilter: s x s
-// rays per pixel through a Gaussian of SIGMA pixels, converged; README "Aliasing and EWA") and
-// gives every row two sets of columns: RMSE against the point-sampled reference (one ray at
-// each pixel centre, the columns above) and RMSE, PSNR and max abs against the filtered one.
-// The splatters' rows are without EWA (Quality::ewa off); --ewa adds the axis-aligned and
-// slab-1 image-aligned splatters with EWA on (low-pass SIGMA, or 0.5 pixels).
+// Where a voxel covers fewer than one pixel (or with --pixel-filter SIGMA, or --truth
+// filtered), it also renders the pixel-filtered reference (Quality::pixelFilter: s x s rays
+// per pixel through a Gaussian of SIGMA pixels, default 0.5, converged; README "Aliasing and
+// EWA") and gives every row two sets of columns: RMSE against the point-sampled reference
+// (one ray at each pixel centre, the columns above) and RMSE, PSNR and max abs against the
+// filtered one. --truth point leaves the filtered reference out (it costs s^2 reference
+// frames and more). The splatters' rows use the default EWA setting (Quality::ewa auto: on
+// in xray below a pixel per voxel; the label says ", EWA" where it was on); --ewa adds the
+// axis-aligned and slab-1 image-aligned splatters with EWA off and with EWA on (low-pass
+// SIGMA, or 0.5 pixels).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -46,7 +51,7 @@ struct Config {
     RendererKind kind;
     double slab;
     double lod = 0;
-    Ewa ewa = Ewa::Off;
+    Ewa ewa = Ewa::Auto;
     bool lodAuto = false;
 };
 
@@ -63,7 +68,7 @@ void usage() {
                  "usage: bench_accuracy [VOLUME] [TF] [--size N] [--mode dvr|mip|xray] "
                  "[--classify pre|post] [--azimuths 0,30,45] [--elevation E] "
                  "[--early-termination EPS] [--lod L|auto[,...]] [--supersample N] "
-                 "[--pixel-filter SIGMA] [--ewa] [--axis-only]\n");
+                 "[--pixel-filter SIGMA] [--ewa] [--axis-only] [--truth auto|point|filtered]\n");
 }
 
 }  // namespace
@@ -71,7 +76,7 @@ void usage() {
 int main(int argc, char** argv) {
     try {
         std::string volumeSpec = "synthetic:phantom:64", tf = "ct-soft", mode = "dvr",
-                    classify = "pre";
+                    classify = "pre", truth = "auto";
         int size = 256, supersample = 1;
         double earlyTermination = -1, elevation = 0, pixelFilter = 0;
         bool ewa = false, axisOnly = false;
@@ -107,6 +112,8 @@ int main(int argc, char** argv) {
                 pixelFilter = std::stod(value());
             else if (arg == "--ewa")
                 ewa = true;
+            else if (arg == "--truth")
+                truth = value();
             else if (arg == "-h" || arg == "--help") {
                 usage();
                 return 0;
@@ -127,6 +134,7 @@ int main(int argc, char** argv) {
             throw std::runtime_error("--supersample must be between 1 and 16");
         if (!(pixelFilter >= 0 && pixelFilter <= 4))
             throw std::runtime_error("--pixel-filter must be between 0 and 4 pixels");
+        const Truth judge = parseTruth(truth);
 
         const Volume volume = loadVolume(volumeSpec);
         const VolumeStats vs = volumeStats(volume);
@@ -140,16 +148,26 @@ int main(int argc, char** argv) {
         base.camera.elevationDeg = elevation;
         if (earlyTermination >= 0) base.quality.earlyTermination = earlyTermination;
         base.quality.pixelFilter = pixelFilter;
-        base.quality.ewa = Ewa::Off;
+        // Pixels per voxel (its largest spacing over the pixel size): below 1, the
+        // point-sampled reference is aliased and the filtered one is the truth (auto).
+        const double voxel =
+            std::max(volume.spacing.x, std::max(volume.spacing.y, volume.spacing.z));
+        const double voxelPixels = voxel / Camera(base.camera, volume).pixelSize;
+        const bool withFiltered = judge == Truth::Filtered ||
+                                  (judge == Truth::Auto && (pixelFilter > 0 || voxelPixels < 1));
+        const double filterSigma = pixelFilter > 0 ? pixelFilter : Quality::kEwaDefaultSigma;
 
         std::vector<Config> configs = {{"axis", RendererKind::Axis, 1.0},
                                        {"sheet, slab 1", RendererKind::Sheet, 1.0},
                                        {"sheet, slab 0.5", RendererKind::Sheet, 0.5},
                                        {"sheet, slab 0.25", RendererKind::Sheet, 0.25}};
         if (ewa) {
-            configs.insert(configs.begin() + 1, {"axis, EWA", RendererKind::Axis, 1.0, 0, Ewa::On});
-            configs.insert(configs.begin() + 3,
-                           {"sheet, slab 1, EWA", RendererKind::Sheet, 1.0, 0, Ewa::On});
+            configs.insert(configs.begin() + 1,
+                           {{"axis, EWA off", RendererKind::Axis, 1.0, 0, Ewa::Off},
+                            {"axis, EWA on", RendererKind::Axis, 1.0, 0, Ewa::On}});
+            configs.insert(configs.begin() + 4,
+                           {{"sheet, slab 1, EWA off", RendererKind::Sheet, 1.0, 0, Ewa::Off},
+                            {"sheet, slab 1, EWA on", RendererKind::Sheet, 1.0, 0, Ewa::On}});
         }
         std::size_t at = ewa ? 2 : 1;  // after "axis" (and "axis, EWA")
         for (const std::string& l : lods) {
@@ -175,16 +193,17 @@ int main(int argc, char** argv) {
             "Accuracy against the reference ray caster: %s, %dx%d, %s %s, transfer "
             "function %s, default kernel and reference settings (step %g voxels, "
             "tolerance %g, %d x %d rays per pixel box-filtered), splatter early termination "
-            "%g.\n\n",
+            "%g; %.3g pixels per voxel.\n\n",
             volumeSpec.c_str(), size, size, mode.c_str(), classify.c_str(), tf.c_str(),
             base.quality.referenceStep, base.quality.referenceTolerance, supersample, supersample,
-            base.quality.earlyTermination);
-        if (pixelFilter > 0) {
+            base.quality.earlyTermination, voxelPixels);
+        if (withFiltered) {
             std::printf(
                 "Columns 'point': against the point-sampled reference (one ray per pixel "
                 "centre); 'filtered': against the reference through a Gaussian pixel filter of "
-                "sigma %g pixels (tolerance %g).\n\n",
-                pixelFilter, base.quality.pixelFilterTolerance);
+                "sigma %g pixels (tolerance %g)%s.\n\n",
+                filterSigma, base.quality.pixelFilterTolerance,
+                voxelPixels < 1 ? ", the truth where a voxel covers less than a pixel" : "");
             std::printf(
                 "| azimuth | renderer | RMSE point | RMSE filtered | PSNR filtered (dB) | max abs "
                 "filtered | ms/frame |\n");
@@ -219,10 +238,11 @@ int main(int argc, char** argv) {
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count();
             Image filtered;
-            if (pixelFilter > 0) {
+            if (withFiltered) {
                 RenderSettings fs = base;
                 fs.renderer = RendererKind::Reference;
                 fs.camera.azimuthDeg = az;
+                fs.quality.pixelFilter = filterSigma;
                 RenderStats fst;
                 const auto f0 = std::chrono::steady_clock::now();
                 filtered = Renderer(volume, fs).render(&fst);
@@ -259,10 +279,11 @@ int main(int argc, char** argv) {
                         .count();
                 const ImageMetrics m = compareImages(im, ref);
                 const std::string label =
-                    c.label + (st.lodLevel ? " (level " + std::to_string(st.lodLevel) + ", " +
-                                                 std::to_string(st.lodSplats) + " splats)"
-                                           : "");
-                if (pixelFilter > 0) {
+                    c.label + (c.ewa == Ewa::Auto && st.ewaSigma > 0 ? ", EWA" : "") +
+                    (st.lodLevel ? " (level " + std::to_string(st.lodLevel) + ", " +
+                                       std::to_string(st.lodSplats) + " splats)"
+                                 : "");
+                if (withFiltered) {
                     const ImageMetrics f = compareImages(im, filtered);
                     std::printf("| %g | %s | %.3g | %.3g | %.1f | %.3g | %.1f |\n", az,
                                 label.c_str(), m.rmse, f.rmse, f.psnr, f.maxAbs, ms);

@@ -135,10 +135,21 @@ void registerPopping(CLI::App& app) {
         const std::optional<Volume>& geometry = choice.geometry;
         const bool alone = choice.alone;
         const bool bricked = bricks > 0;
+        if (bricked && o.truth == Truth::Point && settings.quality.pixelFilter > 0)
+            throw UsageError(
+                "popping in bricks with --truth point: --pixel-filter would filter the bricks' "
+                "reference too (leave one out)");
+        // The Scene's settings carry the reference's pixel filter that --truth asks for
+        // (splat/popping.h poppingSettings), so that the sweep renders views in parallel.
+        auto judged = [&](const RenderSettings& s, const Volume& v) {
+            Sweep views = sweep;
+            views.base = s.camera;
+            return poppingSettings(s, v, poppingViews(a->popping, views), o.truth);
+        };
         if (!bricked && workerProcess())  // under mpirun: render the frames rank 0 asks for
             return serveFrames([&] {
                 auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
-                return Scene(v, withDataDefaults(a->render, settings, *v));
+                return Scene(v, judged(withDataDefaults(a->render, settings, *v), *v));
             });
         const bool sheet = std::find(o.renderers.begin(), o.renderers.end(), RendererKind::Sheet) !=
                            o.renderers.end();
@@ -163,6 +174,7 @@ void registerPopping(CLI::App& app) {
         std::unique_ptr<BrickGroup> group;
         std::unique_ptr<BrickedFrames> frames;
         if (bricked) {
+            settings = judged(settings, *geometry);
             group = brickGroup(a->compositor);
             frames = std::make_unique<BrickedFrames>(
                 *geometry, brickLoader(a->volume), settings, bricks, *group,
@@ -189,7 +201,7 @@ void registerPopping(CLI::App& app) {
             };
         } else {
             volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
-            settings = withDataDefaults(a->render, settings, *volume);
+            settings = judged(withDataDefaults(a->render, settings, *volume), *volume);
             scene.emplace(volume, settings);
         }
         installInterruptHandler();

@@ -30,6 +30,7 @@ struct StudyCommand {
     std::string report, views;
     int repeats = 5, warmup = 1;
     double truthStep = 0.125, truthTolerance = 1e-5, ppd = 67;
+    std::string truth = "auto";
     bool convergence = false, quiet = false, resume = false;
 };
 
@@ -87,6 +88,12 @@ void registerStudy(CLI::App& app) {
     addOption(*cmd, "--truth-step", a->truthStep, "reference ray caster step for the ground truth",
               st);
     addOption(*cmd, "--truth-tolerance", a->truthTolerance, "... and its refinement tolerance", st);
+    addOption(*cmd, "--truth", a->truth,
+              "the ground truth each setting is judged against: point (one ray per pixel "
+              "centre) | filtered (through the pixel filter, pixel-filter or 0.5) | auto "
+              "(filtered where the setting's frames are: EWA on, e.g. xray below a pixel per "
+              "voxel, or a pixel filter); default auto",
+              st);
     addOption(*cmd, "--ppd", a->ppd, "LDR-FLIP pixels per degree", st);
     addFlag(*cmd, "--convergence", a->convergence,
             "also fit the observed convergence orders (slab, reference step, pixel size)", st);
@@ -119,6 +126,7 @@ void registerStudy(CLI::App& app) {
                 throw Error(
                     "--truth-step must be in [0.001, 64], --truth-tolerance and --ppd finite and "
                     "> 0");
+            o.truth = parseTruth(a->truth);
         });
         loadOptionsFromArgs(a->volume);
         o.repeats = a->repeats;

@@ -37,6 +37,19 @@ void addPoppingOptions(CLI::App& cmd, PoppingArgs& a) {
     addOption(cmd, "--threshold-floor", a.floor, "... and at least FLOOR * median", sw);
     addOption(cmd, "--ppd", a.ppd, "LDR-FLIP pixels per degree", sw);
     addFlag(cmd, "--no-flip", a.noFlip, "skip the perceptual (LDR-FLIP) columns", sw);
+    addOption(cmd, "--truth", a.truth,
+              "the reference the splatters are judged against: point (one ray per pixel "
+              "centre) | filtered (through the pixel filter, --pixel-filter or 0.5) | auto "
+              "(filtered where the splatters' frames are: EWA on, e.g. xray below a pixel per "
+              "voxel); default auto",
+              sw);
+}
+
+std::vector<CameraParams> poppingViews(const PoppingArgs& a, const Sweep& sweep) {
+    if (!a.path.empty()) return CameraPath::fromJson(a.path, sweep.base, a.frames).views;
+    std::vector<CameraParams> views;
+    for (double angle : sweep.angles()) views.push_back(sweep.camera(angle));
+    return views;
 }
 
 void poppingFromArgs(const CLI::App& cmd, const PoppingArgs& a, const RenderSettings& settings,
@@ -64,6 +77,7 @@ void poppingFromArgs(const CLI::App& cmd, const PoppingArgs& a, const RenderSett
         for (double v : {a.k, a.floor, a.ppd})
             if (!std::isfinite(v) || v < 0)
                 throw Error("--threshold-k, --threshold-floor and --ppd must be finite and >= 0");
+        o.truth = parseTruth(a.truth);
     });
     o.refine = a.refine;
     o.madK = a.k;

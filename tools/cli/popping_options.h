@@ -1,6 +1,7 @@
 #pragma once
 // The sweep options of `splat popping` (--from, --to, --step, --sweep, --path, --frames,
-// --renderers, --refine, --threshold-k, --threshold-floor, --ppd, --no-flip), shared with the
+// --renderers, --refine, --threshold-k, --threshold-floor, --ppd, --no-flip, --truth), shared
+// with the
 // Python module's splat.popping (splat/python), whose keywords are these options.
 #include <CLI/CLI.hpp>
 #include <string>
@@ -17,6 +18,7 @@ struct PoppingArgs {
     double from = 40, to = 50, step = 0.5, k = 5, floor = 2, ppd = 67;
     int refine = 10;
     bool noFlip = false;
+    std::string truth = "auto";  ///< --truth: the reference the splatters are judged against
 };
 
 /// Adds the options to the group "Sweep".
@@ -27,6 +29,9 @@ void addPoppingOptions(CLI::App& cmd, PoppingArgs& args);
 /// and the frame journal unset; with --path the caller analyses the path instead.
 void poppingFromArgs(const CLI::App& cmd, const PoppingArgs& args, const RenderSettings& settings,
                      Sweep& sweep, PoppingOptions& options);
+
+/// The sweep's (or --path's) views, for poppingSettings (splat/popping.h).
+std::vector<CameraParams> poppingViews(const PoppingArgs& args, const Sweep& sweep);
 
 /// "axis,sheet" -> {Axis, Sheet}; throws splat::Error on an unknown or empty list.
 std::vector<RendererKind> parseRenderers(const std::string& text);

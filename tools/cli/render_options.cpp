@@ -79,7 +79,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool imageOutput) {
               q);
     addOption(cmd, "--ewa", a.ewa,
               "splatters: EWA resampling, footprints convolved with the pixel filter: off | on | "
-              "auto (on in xray while a voxel covers fewer than 1 pixel); default off",
+              "auto (on in xray while a voxel covers fewer than 1 pixel); default auto",
               q);
     addTechniqueOptions(cmd, a.technique, imageOutput);
     if (imageOutput)

@@ -23,7 +23,7 @@ struct RenderArgs {
     std::string eye, lookAt, up;  // free camera: X,Y,Z world (--eye with --look-at, --up)
     double earlyTermination = 1.0 / 256.0, refStep = 0.25, refTolerance = 1e-4;
     double pixelFilter = 0;
-    std::string ewa = "off";
+    std::string ewa = "auto";
     std::string lod = "0";  ///< pixels per voxel, or "auto"
     int threads = 0, tileSize = 32;
     bool shade = false;

@@ -66,6 +66,14 @@ struct PoppingOptions {
     /// rendered through it, one after another (parallelFrames does not apply). The findings
     /// depend only on the images.
     std::function<Image(const RenderSettings&, RenderStats*)> renderFrame;
+    /// The reference e, J and flipRef are measured against (truthFilter, splat/render.h):
+    /// auto (the default) the pixel-filtered reference where the splatters' frames are
+    /// filtered (EWA on at some view of the sweep, e.g. X-ray below a pixel per voxel, or a
+    /// pixel filter given), else the point-sampled one. The reference's frames get that
+    /// pixel filter; the splatters' frames the settings' own. Where the Scene's settings
+    /// (poppingSettings) carry it, the sweep renders as fast as without; else view by view.
+    /// With renderFrame, the frames are what it renders (build it from poppingSettings).
+    Truth truth = Truth::Auto;
 };
 
 /// A change measured at one interval width while refining an event.
@@ -133,6 +141,9 @@ struct PoppingResult {
     std::vector<double> crossJump;          ///< C per interval (axis and sheet both present)
     std::vector<double> predictedSwitches;  ///< angles where the sheet axis changes
     std::vector<PoppingEvent> events;
+    /// The pixel filter sigma of the reference's frames, pixels: 0 the point-sampled
+    /// reference (one ray per pixel centre), > 0 the pixel-filtered one (PoppingOptions::truth).
+    double truthFilter = 0;
     double totalMs = 0;
     const RendererSeries* find(RendererKind k) const;
 };
@@ -161,6 +172,13 @@ PoppingResult analyzePopping(const Volume& geometry, const RenderSettings& setti
 /// The same over explicit cameras.
 PoppingResult analyzePopping(const Scene& scene, const std::vector<CameraParams>& views,
                              const PoppingOptions& options);
+
+/// `settings` with the pixel filter of the reference that `truth` asks for at `views` over
+/// `volume` (truthFilter, splat/render.h), to build the analysis's Scene (or bricks) with:
+/// the splatters' frames do not change (their EWA low-pass is that sigma either way), and
+/// the sweep renders its views in parallel. Unchanged where the truth is point-sampled.
+RenderSettings poppingSettings(const RenderSettings& settings, const Volume& volume,
+                               const std::vector<CameraParams>& views, Truth truth);
 
 /// The angles in (from, to) where the axis-aligned splatter's sheet axis (the major axis of
 /// S^-1 view) changes along the sweep, to 1e-9 degrees.

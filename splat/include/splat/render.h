@@ -6,7 +6,9 @@
 // and the reference ray caster of the same model. See splat/scene.h to render many views
 // or several renderers from one classification.
 #include <memory>
+#include <vector>
 
+#include "splat/camera.h"
 #include "splat/scene.h"
 #include "splat/settings.h"
 
@@ -36,5 +38,21 @@ class Renderer {
 
 /// One-shot convenience: Renderer(volume, settings).render(stats).
 Image render(const Volume& volume, const RenderSettings& settings, RenderStats* stats = nullptr);
+
+/// The screen low-pass sigma, pixels, that the splatters convolve their footprints with (EWA
+/// resampling, Quality::ewa) in a frame of `settings` (its mode, quality and camera) over
+/// `volume` at full resolution (a level of detail's coarser grid may leave auto off); 0 where
+/// EWA is off. RenderStats::ewaSigma says the same after the frame.
+double ewaLowPass(const RenderSettings& settings, const Volume& volume);
+
+/// The pixel filter sigma (pixels; 0: one ray at each pixel centre) of the reference that
+/// `truth` asks for, to judge the splatters' frames of `settings` at `views` over `volume`
+/// (README "Aliasing and EWA"): Point 0; Filtered the pixel filter given
+/// (Quality::pixelFilter), else Quality::kEwaDefaultSigma; Auto the pixel filter given, else
+/// kEwaDefaultSigma where EWA is on in any of `views` (ewaLowPass: a filtered image is judged
+/// against a filtered truth), else 0. The filtered reference traces s x s rays per pixel (s
+/// >= 2, converged): at least 4x the point-sampled reference's time.
+double truthFilter(const RenderSettings& settings, const Volume& volume,
+                   const std::vector<CameraParams>& views, Truth truth);
 
 }  // namespace splat

@@ -35,6 +35,12 @@ enum class CompositeOrder { FrontToBack, BackToFront };
 /// EWA resampling in the splatters (Quality::ewa): off, on, or (auto) on in xray while a
 /// voxel covers fewer than Quality::kEwaAutoPixels pixels.
 enum class Ewa { Off, On, Auto };
+/// The reference an analysis judges the splatters against (popping, study, bench_accuracy;
+/// README "Aliasing and EWA"): the point-sampled reference (one ray per pixel centre), the
+/// pixel-filtered one (Quality::pixelFilter, or Quality::kEwaDefaultSigma), or (auto) the
+/// filtered one where the splatters' frames are filtered (EWA on, or a pixel filter given)
+/// and the point-sampled one elsewhere.
+enum class Truth { Auto, Point, Filtered };
 
 /// Blinn-Phong shading, one model for every renderer and mode (splat/DESIGN.md "Shading"):
 ///   c' = c (ambient + diffuse |n.l|) + specular |n.h|^shininess
@@ -135,9 +141,10 @@ struct Quality {
     /// EWA resampling in the splatters (Zwicker et al. 2001): each footprint convolved with
     /// the Gaussian pixel filter, energy kept (footprint/ellipse.h, ewaFootprint). Auto: on in
     /// xray while a voxel covers fewer than kEwaAutoPixels pixels (measured to lower the error
-    /// against the filtered reference there, and to raise it in dvr). Default off (README
-    /// "Aliasing and EWA").
-    Ewa ewa = Ewa::Off;
+    /// against the filtered reference there, and to raise it in dvr): the default, which
+    /// leaves every other mode and image size bit-identical to off (README "Aliasing and
+    /// EWA").
+    Ewa ewa = Ewa::Auto;
     /// The EWA low-pass when pixelFilter is 0, pixels (pbrt-v4's Gaussian pixel filter).
     static constexpr double kEwaDefaultSigma = 0.5;
     /// Ewa::Auto turns EWA on while a voxel covers fewer pixels than this (measured, README).
@@ -221,6 +228,7 @@ const char* toString(Classification);
 const char* toString(CompositeOrder);
 const char* toString(Projection);
 const char* toString(Ewa);
+const char* toString(Truth);
 /// Parse a name; throw splat::Error listing the accepted names otherwise.
 RendererKind parseRenderer(std::string_view);
 RenderMode parseMode(std::string_view);
@@ -228,6 +236,7 @@ Classification parseClassification(std::string_view);
 CompositeOrder parseOrder(std::string_view);
 Projection parseProjection(std::string_view);
 Ewa parseEwa(std::string_view);
+Truth parseTruth(std::string_view);
 
 /// One line per setting that does not apply to the chosen mode/classification (e.g.
 /// shading in xray): the command line prints them as warnings.

@@ -58,6 +58,11 @@ struct StudyOptions {
     /// each point; a point found there (by label) is not measured again, so an interrupted
     /// study resumes where it stopped. The caller removes it when the study changes.
     std::string pointJournal;
+    /// The reference each point is judged against (truthFilter, splat/render.h): auto (the
+    /// default) the pixel-filtered reference where the point's frames are filtered (EWA on,
+    /// e.g. xray below a pixel per voxel, or a pixel filter given), else the point-sampled
+    /// one; point always at the pixel centres; filtered always through the pixel filter.
+    Truth truth = Truth::Auto;
 };
 
 /// One setting of the study.
@@ -77,6 +82,9 @@ struct StudyPoint {
     /// Frames (views x repeats) whose pixels the splatter handed to the reference
     /// (RenderStats::exactPixels > 0): their error says nothing about the splatter.
     std::size_t exactFrames = 0;
+    /// The pixel filter sigma of the reference it was judged against, pixels (0: the
+    /// point-sampled reference; StudyOptions::truth), the largest over the views.
+    double truthFilter = 0;
     std::string label() const;  ///< "renderer=sheet slab=0.5"
 };
 

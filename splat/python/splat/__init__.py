@@ -261,11 +261,14 @@ result.write_report(folder) writes report.html, metrics.csv and summary.json.
 
 def study(volume: Volume, *, sweep=(), views=(), repeats: int = 5, warmup: int = 1,
           truth_step: float = 0.125, truth_tolerance: float = 1e-5, ppd: float = 67.0,
-          convergence: bool = False, cache_dir: str | None = None, progress=None,
-          **options) -> StudyResult:
+          convergence: bool = False, cache_dir: str | None = None, truth: str = "auto",
+          progress=None, **options) -> StudyResult:
     """`splat study`: every combination of the swept knobs (sweep={'slab': [0.5, 1, 2]} or
     ['slab=0.5,1,2', ...]; knobs: study_knobs()), timed and compared with the reference ray
-    caster; views: [(azimuth, elevation), ...]. Render options as splat.render's.
+    caster; views: [(azimuth, elevation), ...]. truth: the reference each setting is judged
+    against, 'point' | 'filtered' | 'auto' (filtered where the frames are: EWA on, e.g. xray
+    below a pixel per voxel; each point's 'truth_filter' says which). Render options as
+    splat.render's.
     result.write_report(folder) writes study.csv, study.json, pareto.svg, pareto.png."""
     if isinstance(sweep, dict):
         sweeps = [f"{k.replace('_', '-')}=" + ",".join(_text(k, v) if not isinstance(v, str)
@@ -277,4 +280,4 @@ def study(volume: Volume, *, sweep=(), views=(), repeats: int = 5, warmup: int =
     argv, tf_json = _argv(options)
     return _splat._study(volume, argv, tf_json, sweeps, views, int(repeats), int(warmup),
                          float(truth_step), float(truth_tolerance), float(ppd),
-                         bool(convergence), cache_dir or "", progress)
+                         bool(convergence), cache_dir or "", str(truth), progress)

@@ -377,6 +377,8 @@ class PoppingResult:
     @property
     def events(self) -> list[dict[str, Any]]: ...
     @property
+    def truth_filter(self) -> float: ...
+    @property
     def total_ms(self) -> float: ...
     def write_report(self, folder: str, command_line: str = ...) -> None: ...
 
@@ -396,6 +398,7 @@ def popping(
     threshold_floor: float = ...,
     ppd: float = ...,
     no_flip: bool = ...,
+    truth: str = ...,
     mode: str | None = ...,
     classify: str | None = ...,
     tf: str | TransferFunction | ArrayLike | None = ...,
@@ -467,6 +470,7 @@ def study(
     ppd: float = ...,
     convergence: bool = ...,
     cache_dir: str | None = ...,
+    truth: str = ...,
     progress: Progress | None = ...,
     mode: str | None = ...,
     classify: str | None = ...,

@@ -15,6 +15,7 @@
 #include "frame_journal.h"
 #include "splat/flip.h"
 #include "splat/image_io.h"
+#include "splat/render.h"
 #include "splatters/splatter.h"
 
 namespace splat {
@@ -65,8 +66,8 @@ class Analyzer {
     /// `positions` are the views' sweep angles or path positions, `cameraAt` the camera at
     /// any position between the first and the last.
     /// `scene` null: frames from options.renderFrame, of `settings`.
-    Analyzer(const Scene* scene, const RenderSettings& settings, const Sweep& sweep,
-             std::size_t pathViews, std::vector<double> positions,
+    Analyzer(const Scene* scene, const Volume& geometry, const RenderSettings& settings,
+             const Sweep& sweep, std::size_t pathViews, std::vector<double> positions,
              std::function<CameraParams(double)> cameraAt, std::vector<double> predicted,
              const PoppingOptions& options)
         : scene_(scene),
@@ -92,6 +93,9 @@ class Analyzer {
             throw Error("popping: the event threshold's k and floor must be >= 0");
         if (options.refine < 0 || options.refine > 40)
             throw Error("popping: --refine must be between 0 and 40 levels");
+        std::vector<CameraParams> views;
+        for (double p : positions_) views.push_back(cameraAt_(p));
+        truthFilter_ = truthFilter(settings_, geometry, views, options.truth);
     }
 
     PoppingResult run() {
@@ -105,6 +109,7 @@ class Analyzer {
         r.renderers = kinds_;
         r.angles = positions_;
         r.predictedSwitches = predicted_;
+        r.truthFilter = ref_ >= 0 ? truthFilter_ : 0;
         const std::size_t views = r.angles.size();
         totalUnits_ = views * kinds_.size();
         const CameraParams& base = cameraAt_(r.angles.front());
@@ -146,7 +151,11 @@ class Analyzer {
         auto readUpTo = [&](std::size_t end) {
             while (next < end) consume(next, renderView(r.angles[next]));
         };
-        if (!options_.renderFrame)  // else every view by renderView, below
+        // The Scene renders the sweep (in parallel) when its reference is the truth asked
+        // for; else, and with renderFrame, every view by renderView, below.
+        const bool sceneTruth =
+            ref_ < 0 || (scene_ && scene_->settings().quality.pixelFilter == truthFilter_);
+        if (!options_.renderFrame && sceneTruth)
             renderSequence(*scene_, kinds_, path, so, [&](SequenceFrame&& f) {
                 readUpTo(f.view);
                 View cur{std::move(f.images), std::move(f.stats)};
@@ -330,6 +339,9 @@ class Analyzer {
         const bool journaling = !options_.frameJournal.empty();
         for (std::size_t k = 0; k < kinds_.size(); ++k) {
             s.renderer = kinds_[k];
+            s.quality.pixelFilter = kinds_[k] == RendererKind::Reference
+                                        ? truthFilter_
+                                        : settings_.quality.pixelFilter;
             const std::filesystem::path file = journaling ? journalFile(angle, k) : "";
             if (!journaling || !journal::loadFrame(file, s.camera.width, s.camera.height,
                                                    v.images[k], v.stats[k])) {
@@ -395,6 +407,7 @@ class Analyzer {
     const PoppingOptions& options_;
     std::vector<RendererKind> kinds_;
     int ref_ = -1, axis_ = -1, sheet_ = -1;
+    double truthFilter_ = 0;  ///< the reference's pixel filter (PoppingOptions::truth)
     std::size_t done_ = 0, totalUnits_ = 0;
     std::mutex progressMutex_;
     float windowScale_ = 1.0f;
@@ -486,6 +499,14 @@ std::vector<double> sheetSwitches(const std::vector<double>& positions,
 
 }  // namespace
 
+RenderSettings poppingSettings(const RenderSettings& settings, const Volume& volume,
+                               const std::vector<CameraParams>& views, Truth truth) {
+    RenderSettings s = settings;
+    const double filter = truthFilter(settings, volume, views, truth);
+    if (filter > 0) s.quality.pixelFilter = filter;
+    return s;
+}
+
 std::vector<double> predictSheetSwitches(const Sweep& sweep, const Volume& volume) {
     return sheetSwitches(
         sweep.angles(), [&](double a) { return sweep.camera(a); }, volume);
@@ -504,8 +525,8 @@ PoppingResult analyzePopping(const Scene& scene, const Sweep& sweep,
                     std::to_string(angles.size()) + ")");
     auto cameraAt = [&sweep](double a) { return sweep.camera(a); };
     std::vector<double> predicted = sheetSwitches(angles, cameraAt, scene.volume());
-    return Analyzer(&scene, scene.settings(), sweep, 0, std::move(angles), cameraAt,
-                    std::move(predicted), options)
+    return Analyzer(&scene, scene.volume(), scene.settings(), sweep, 0, std::move(angles),
+                    cameraAt, std::move(predicted), options)
         .run();
 }
 
@@ -517,8 +538,8 @@ PoppingResult analyzePopping(const Volume& geometry, const RenderSettings& setti
                     std::to_string(angles.size()) + ")");
     auto cameraAt = [&sweep](double a) { return sweep.camera(a); };
     std::vector<double> predicted = sheetSwitches(angles, cameraAt, geometry);
-    return Analyzer(nullptr, settings, sweep, 0, std::move(angles), cameraAt, std::move(predicted),
-                    options)
+    return Analyzer(nullptr, geometry, settings, sweep, 0, std::move(angles), cameraAt,
+                    std::move(predicted), options)
         .run();
 }
 
@@ -528,8 +549,8 @@ PoppingResult analyzePopping(const Scene& scene, const CameraPath& path,
     auto cameraAt = [&path](double x) { return pathCamera(path, x); };
     std::vector<double> predicted = sheetSwitches(u, cameraAt, scene.volume());
     const Sweep none;
-    return Analyzer(&scene, scene.settings(), none, path.views.size(), std::move(u), cameraAt,
-                    std::move(predicted), options)
+    return Analyzer(&scene, scene.volume(), scene.settings(), none, path.views.size(),
+                    std::move(u), cameraAt, std::move(predicted), options)
         .run();
 }
 

@@ -2,10 +2,12 @@
 // summary.json in one folder.
 //
 // metrics.csv columns: renderer, interval, angle_from, angle_to, T, J, flipT, e, flipRef,
-// signal, is_event. One row per renderer and interval (e and flipRef at angle_from); a value
-// that was not measured (no reference, no FLIP) is an empty cell. When the cross jump C was
-// measured, rows with renderer "axis-sheet" follow: C in the J and signal columns, is_event
-// 1 when any renderer has an event on that interval, the other columns empty.
+// signal, is_event, truth. One row per renderer and interval (e and flipRef at angle_from); a
+// value that was not measured (no reference, no FLIP) is an empty cell. truth: the reference
+// J, e and flipRef are against, "point" (one ray per pixel centre) or "filtered SIGMA" (the
+// pixel-filtered reference, PoppingResult::truthFilter); empty without a reference. When the cross
+// jump C was measured, rows with renderer "axis-sheet" follow: C in the J and signal columns,
+// is_event 1 when any renderer has an event on that interval, the other columns empty.
 //
 // The folder: created when missing; refused when it is not a folder, or when it holds
 // anything but a previous report's three files (and the hidden temporaries of an
@@ -247,7 +249,10 @@ json settingsJson(const RenderSettings& s) {
                     {"polynomial_tolerance", q.polynomialTolerance},
                     {"reference_step", q.referenceStep},
                     {"reference_tolerance", q.referenceTolerance},
-                    {"tile_size", q.tileSize}};
+                    {"tile_size", q.tileSize},
+                    {"lod", q.lod},
+                    {"pixel_filter", q.pixelFilter},
+                    {"ewa", toString(q.ewa)}};
     return j;
 }
 
@@ -259,6 +264,7 @@ json optionsJson(const PoppingOptions& o) {
     j["pixels_per_degree"] = o.pixelsPerDegree;
     j["flip"] = o.flip;
     j["thumbnail"] = o.thumbnail;
+    j["truth"] = toString(o.truth);
     return j;
 }
 
@@ -312,6 +318,12 @@ json summaryJson(const PoppingResult& r) {
                       {"step", r.sweep.step},
                       {"views", r.angles.size()}};
     j["options"] = optionsJson(r.options);
+    // The reference J, e and flipRef are measured against (null without one).
+    if (r.find(RendererKind::Reference))
+        j["truth"] = {{"reference", r.truthFilter > 0 ? "filtered" : "point"},
+                      {"pixel_filter", r.truthFilter}};
+    else
+        j["truth"] = nullptr;
     json renderers = json::object();
     for (const RendererSeries& s : r.series) {
         json o;
@@ -357,7 +369,10 @@ json summaryJson(const PoppingResult& r) {
 
 std::string metricsCsv(const PoppingResult& r) {
     std::ostringstream s;
-    s << "renderer,interval,angle_from,angle_to,T,J,flipT,e,flipRef,signal,is_event\n";
+    s << "renderer,interval,angle_from,angle_to,T,J,flipT,e,flipRef,signal,is_event,truth\n";
+    const std::string truth = !r.find(RendererKind::Reference) ? ""
+                              : r.truthFilter > 0 ? "filtered " + csvNumber(r.truthFilter)
+                                                  : "point";
     const std::size_t intervals = r.angles.size() > 1 ? r.angles.size() - 1 : 0;
     for (const RendererSeries& x : r.series)
         for (std::size_t n = 0; n < intervals; ++n)
@@ -365,12 +380,13 @@ std::string metricsCsv(const PoppingResult& r) {
               << csvNumber(r.angles[n + 1]) << ',' << csvNumber(at(x.T, n)) << ','
               << csvNumber(at(x.J, n)) << ',' << csvNumber(at(x.flipT, n)) << ','
               << csvNumber(at(x.e, n)) << ',' << csvNumber(at(x.flipRef, n)) << ','
-              << csvNumber(at(x.signal, n)) << ',' << (isEvent(r, &x.renderer, n) ? 1 : 0) << '\n';
+              << csvNumber(at(x.signal, n)) << ',' << (isEvent(r, &x.renderer, n) ? 1 : 0) << ','
+              << truth << '\n';
     if (!r.crossJump.empty())
         for (std::size_t n = 0; n < intervals; ++n)
             s << "axis-sheet," << n << ',' << csvNumber(r.angles[n]) << ','
               << csvNumber(r.angles[n + 1]) << ",," << csvNumber(at(r.crossJump, n)) << ",,,,"
-              << csvNumber(at(r.crossJump, n)) << ',' << (isEvent(r, nullptr, n) ? 1 : 0) << '\n';
+              << csvNumber(at(r.crossJump, n)) << ',' << (isEvent(r, nullptr, n) ? 1 : 0) << ",\n";
     return s.str();
 }
 
@@ -470,6 +486,14 @@ std::string headerSection(const PoppingResult& r, const std::string& commandLine
     for (std::size_t i = 0; i < r.renderers.size(); ++i)
         names += (i ? ", " : "") + std::string(toString(r.renderers[i]));
     row("renderers", escapeHtml(names));
+    if (r.find(RendererKind::Reference))
+        row("truth",
+            escapeHtml(r.truthFilter > 0
+                           ? "the pixel-filtered reference (Gaussian pixel filter, sigma " +
+                                 formatNumber(r.truthFilter, 4) +
+                                 " pixels): the splatters' frames are filtered (EWA)"
+                           : std::string("the point-sampled reference (one ray per pixel "
+                                         "centre)")));
     row("events", std::to_string(r.events.size()) + " detected, " +
                       std::to_string(r.predictedSwitches.size()) + " predicted sheet switches");
     for (const RendererSeries& x : r.series) {

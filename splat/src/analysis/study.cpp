@@ -17,6 +17,7 @@
 #include "splat/frame_farm.h"
 #include "splat/image_io.h"
 #include "splat/metrics.h"
+#include "splat/render.h"
 #include "splat/scene.h"
 
 #if __has_include("splat/flip.h")
@@ -130,7 +131,8 @@ nlohmann::json pointJson(const StudyPoint& p) {
             {"psnr", num(p.psnr)},
             {"max_abs", num(p.maxAbs)},
             {"flip", num(p.flip)},
-            {"exact_frames", p.exactFrames}};
+            {"exact_frames", p.exactFrames},
+            {"truth_filter", p.truthFilter}};
 }
 
 void restorePoint(StudyPoint& p, const nlohmann::json& j) {
@@ -143,6 +145,7 @@ void restorePoint(StudyPoint& p, const nlohmann::json& j) {
     p.splats = j.at("splats").get<std::size_t>();
     p.footprintPixels = j.at("footprint_pixels").get<std::size_t>();
     p.exactFrames = j.value("exact_frames", std::size_t(0));
+    p.truthFilter = j.value("truth_filter", 0.0);
     p.footprintPixelRate = num("footprint_pixel_rate");
     p.rmse = num("rmse");
     p.psnr = num("psnr");
@@ -322,6 +325,17 @@ RenderSettings studyReferenceSettings(const RenderSettings& base, const StudyOpt
     return r;
 }
 
+namespace {
+/// The reference that judges `frame` (a point's frame at one view): the study's reference
+/// settings, through the pixel filter options.truth asks for (truthFilter).
+RenderSettings judgingReference(const RenderSettings& base, const StudyOptions& options,
+                                const RenderSettings& frame, const Volume& volume) {
+    RenderSettings r = studyReferenceSettings(base, options, frame.camera, &frame.quality);
+    r.quality.pixelFilter = truthFilter(frame, volume, {frame.camera}, options.truth);
+    return r;
+}
+}  // namespace
+
 StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings& base,
                      const StudyOptions& options) {
     const auto start = Clock::now();
@@ -423,8 +437,7 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         return referenceScene->render(r);
     };
     auto referenceFor = [&](const RenderSettings& frame) -> const Image& {
-        const RenderSettings r =
-            studyReferenceSettings(base, options, frame.camera, &frame.quality);
+        const RenderSettings r = judgingReference(base, options, frame, *volume);
         const std::string key = referenceKey(r, options);
         if (auto it = references.find(key); it != references.end()) return it->second;
         if (auto it = prefetched.find(key); it != prefetched.end()) {
@@ -449,7 +462,8 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
                 CameraParams c = view;
                 c.width = s.camera.width;
                 c.height = s.camera.height;
-                const RenderSettings r = studyReferenceSettings(base, options, c, &s.quality);
+                s.camera = c;
+                const RenderSettings r = judgingReference(base, options, s, *volume);
                 // The farm's Scenes render the base pixel filter; a swept one stays on rank 0.
                 if (r.quality.pixelFilter != base.quality.pixelFilter ||
                     r.quality.pixelFilterTolerance != base.quality.pixelFilterTolerance)
@@ -584,6 +598,9 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
             const double peakHere = peakMemoryMiB();
             point.peakMiB = std::max(point.peakMiB, peakHere);
             const Image& ref = referenceFor(frame);
+            point.truthFilter = std::max(
+                point.truthFilter,
+                judgingReference(base, options, frame, *volume).quality.pixelFilter);
             const ImageMetrics m = compareImages(img, ref);
             sumSq += m.rmse * m.rmse;
             sumMax = std::max(sumMax, m.maxAbs);

@@ -196,7 +196,7 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
     std::ostringstream csv;
     for (const auto& k : knobNames) csv << k << ',';
     csv << "ms_median,ms_min,ms_max,ms_mad,peak_mib,splats,footprint_pixels,"
-           "footprint_pixels_per_s,rmse,psnr,max_abs,flip,pareto,exact_frames\n";
+           "footprint_pixels_per_s,rmse,psnr,max_abs,flip,pareto,exact_frames,truth\n";
     for (const auto& p : r.points) {
         for (const auto& k : knobNames) {
             std::string v;
@@ -208,7 +208,9 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
             << ',' << num(p.peakMiB) << ',' << p.splats << ',' << p.footprintPixels << ','
             << num(p.footprintPixelRate) << ',' << num(p.rmse) << ',' << num(p.psnr) << ','
             << num(p.maxAbs) << ',' << num(p.flip) << ',' << (p.pareto ? 1 : 0) << ','
-            << p.exactFrames << '\n';
+            << p.exactFrames << ','
+            << (p.truthFilter > 0 ? "filtered " + num(p.truthFilter) : std::string("point"))
+            << '\n';
     }
     const std::string csvText = csv.str();
 
@@ -245,6 +247,9 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
         o["pareto"] = p.pareto;
         // Frames the splatter handed to the reference: their error says nothing.
         o["exact_frames"] = p.exactFrames;
+        // The reference it was judged against: point-sampled, or pixel-filtered (sigma).
+        o["truth"] = p.truthFilter > 0 ? "filtered" : "point";
+        o["truth_filter"] = p.truthFilter;
         j["points"].push_back(o);
     }
     for (const auto& c : r.convergence) {

@@ -20,6 +20,15 @@ bool ewaAutoApplies(RenderMode mode) { return mode == RenderMode::Xray; }
 
 }  // namespace
 
+double ewaLowPass(const Quality& quality, RenderMode mode, const Camera& camera,
+                  const Volume& volume) {
+    const bool on = quality.ewa == Ewa::On ||
+                    (quality.ewa == Ewa::Auto && ewaAutoApplies(mode) &&
+                     voxelPixels(camera, volume) < Quality::kEwaAutoPixels);
+    if (!on) return 0;
+    return quality.pixelFilter > 0 ? quality.pixelFilter : Quality::kEwaDefaultSigma;
+}
+
 FootprintFilter footprintFilter(const footprint::Kernel& kernel, const Quality& quality,
                                 RenderMode mode, const Camera& camera, const Volume& volume,
                                 int level) {
@@ -30,12 +39,9 @@ FootprintFilter footprintFilter(const footprint::Kernel& kernel, const Quality& 
             std::ldexp(voxelPixels(camera, volume), -level));
         return {kernel.variance(), f.lowPass, f.kernelScale};
     }
-    const bool on = quality.ewa == Ewa::On ||
-                    (quality.ewa == Ewa::Auto && ewaAutoApplies(mode) &&
-                     voxelPixels(camera, volume) < Quality::kEwaAutoPixels);
-    if (!on) return {};
-    return {kernel.variance(),
-            quality.pixelFilter > 0 ? quality.pixelFilter : Quality::kEwaDefaultSigma};
+    const double lowPass = ewaLowPass(quality, mode, camera, volume);
+    if (!(lowPass > 0)) return {};
+    return {kernel.variance(), lowPass};
 }
 
 void projectSplats(const SplatList& splats, const Camera& camera, const glm::dvec3& gridSpacing,

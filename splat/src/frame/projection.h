@@ -68,6 +68,9 @@ struct FootprintFilter {
 FootprintFilter footprintFilter(const footprint::Kernel& kernel, const Quality& quality,
                                 RenderMode mode, const Camera& camera, const Volume& volume,
                                 int level = 0);
+/// Its low-pass sigma in pixels (0: off); splat::ewaLowPass (splat/render.h) for a frame.
+double ewaLowPass(const Quality& quality, RenderMode mode, const Camera& camera,
+                  const Volume& volume);
 
 struct ProjectedSplats {
     std::vector<float> sx, sy;  ///< continuous pixel position of the centre

@@ -27,6 +27,8 @@ constexpr Names<CompositeOrder, 2> kOrders{
 constexpr Names<Projection, 2> kProjections{
     {{Projection::Orthographic, "ortho"}, {Projection::Perspective, "perspective"}}};
 constexpr Names<Ewa, 3> kEwas{{{Ewa::Off, "off"}, {Ewa::On, "on"}, {Ewa::Auto, "auto"}}};
+constexpr Names<Truth, 3> kTruths{
+    {{Truth::Auto, "auto"}, {Truth::Point, "point"}, {Truth::Filtered, "filtered"}}};
 
 template <class E, std::size_t N>
 const char* nameOf(const Names<E, N>& names, E value) {
@@ -55,6 +57,8 @@ const char* toString(CompositeOrder v) { return nameOf(kOrders, v); }
 const char* toString(Projection v) { return nameOf(kProjections, v); }
 const char* toString(Ewa v) { return nameOf(kEwas, v); }
 Ewa parseEwa(std::string_view s) { return parseName(kEwas, s, "EWA setting"); }
+const char* toString(Truth v) { return nameOf(kTruths, v); }
+Truth parseTruth(std::string_view s) { return parseName(kTruths, s, "reference (truth)"); }
 RendererKind parseRenderer(std::string_view s) { return parseName(kRenderers, s, "renderer"); }
 RenderMode parseMode(std::string_view s) { return parseName(kModes, s, "mode"); }
 Classification parseClassification(std::string_view s) {
