@@ -41,9 +41,7 @@ RenderSettings sheetSettings(RenderMode mode) {
     s.camera.elevationDeg = 15;
     s.quality.earlyTermination = 0;  // a bricked frame integrates every brick
     s.quality.tileSize = 16;         // several tiles, some cut by the image's edge
-    // A voxel covers < 1 pixel here: EWA auto would filter the one-process xray frame, which
-    // the bricks' exact slab sheets do not (yet) do; these tests are about the bricks.
-    s.quality.ewa = Ewa::Off;
+    // A voxel covers < 1 pixel here: xray renders with EWA (auto), in the bricks too.
     if (mode == RenderMode::Dvr) s.transfer = TransferFunction::preset("ct-bone");
     return s;
 }

@@ -48,11 +48,8 @@ TEST_CASE("mpi: exact sheet bricks on 2 and 3 ranks match one process within 1e-
                                         "0",
                                         "--tile-size",
                                         "16",
-                                        // A voxel covers < 1 pixel: EWA auto would filter the
-                                        // one-process xray, which the bricks' exact slab
-                                        // sheets do not (yet); the test is about the bricks.
-                                        "--ewa",
-                                        "off",
+                                        // A voxel covers < 1 pixel: xray with
+                                        // EWA (auto), in the bricks too.
                                         "--bricks",
                                         bricks,
                                         "--brick-composite",

@@ -560,7 +560,7 @@ PoppingResult analyzePopping(const Volume& geometry, const RenderSettings& setti
     auto cameraAt = [&path](double x) { return pathCamera(path, x); };
     std::vector<double> predicted = sheetSwitches(u, cameraAt, geometry);
     const Sweep none;
-    return Analyzer(nullptr, settings, none, path.views.size(), std::move(u), cameraAt,
+    return Analyzer(nullptr, geometry, settings, none, path.views.size(), std::move(u), cameraAt,
                     std::move(predicted), options)
         .run();
 }

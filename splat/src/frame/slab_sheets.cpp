@@ -72,8 +72,11 @@ BrickSheets::BrickSheets(const Scene& scene, const RenderSettings& frame, const 
         if (m.scene.shaded())
             shadeEmission(list, m.scene.settings.shading, m.camera.view, m.work->r, m.work->g,
                           m.work->b);
+        // The same footprints as the one-process frame: EWA's low-pass (Quality::ewa) too.
         projectSplats(list, m.camera, m.scene.volume->spacing, m.scene.kernel.radius(),
-                      m.work->proj);
+                      m.work->proj,
+                      footprintFilter(m.scene.kernel, m.s.quality, m.s.mode, m.camera,
+                                      *m.scene.volume, m.scene.level));
     });
     m.owned.resize(list.size());
     const ProjectedSplats& proj = m.work->proj;
