@@ -519,7 +519,7 @@ TEST_CASE("reference: panel adaptivity refines where the integrand is sharp, not
     // form to the tolerance, and a tighter tolerance refines (more samples, finer step).
     const Volume v = singleVoxel({1.0, 1.0, 1.0});
     RenderSettings s = settingsFor(RenderMode::Dvr, 24, 30.0, 20.0);
-    s.quality.referenceStep = 1.0;  // coarse: the kernel's sigma is 0.57 voxels
+    s.quality.referenceStep = 0;  // automatic: 1 voxel, the kernel's sigma is 0.57 voxels
     const footprint::Kernel kernel = kernelOf(s);
     const footprint::FootprintTable fp(kernel);
     const SplatList splats = splatsByHand(v, 8.0f, glm::vec3(1.0f, 0.5f, 0.25f));

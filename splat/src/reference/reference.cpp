@@ -24,8 +24,9 @@
 // referenceStep, or when it is 0 referenceStepFor() (dvr with panel adaptivity: 1.75 kernel
 // deviations in [0.25, 1], i.e. 1 voxel for the default Gaussian; else 0.25).
 //
-// Panel adaptivity (dvr, ReferenceAcceleration::panelAdaptive; the other modes halve the
-// whole ray as above): each segment is cut into panels of two first steps h0; a panel p
+// Panel adaptivity (dvr with the automatic first step, referenceStep = 0, and
+// ReferenceAcceleration::panelAdaptive; the other modes and explicit steps halve the whole ray
+// as above): each segment is cut into panels of two first steps h0; a panel p
 // holds its samples at spacing h0 / 2^L_p (L_p >= 1) and the Simpson values of its optical
 // depth tau_p and of its emission attenuated from its start E_p, at L_p and at L_p - 1. The
 // pixel is C = sum_p T_p E_p, T_p = exp(-sum_{q<p} tau_q), alpha = 1 - T_end. Changing one
@@ -180,8 +181,11 @@ class Caster {
         if (depth) *depth = Image(w, h);
         std::atomic<int> finest{0};
         std::atomic<std::size_t> samples{0};
-        const bool panels =
-            settings_.mode == RenderMode::Dvr && field_.acceleration().panelAdaptive;
+        // Panels with the automatic first step only: an explicit step keeps the whole-ray
+        // scheme (at small steps the summed shares over many panels refine further).
+        const bool panels = settings_.mode == RenderMode::Dvr &&
+                            field_.acceleration().panelAdaptive &&
+                            settings_.quality.referenceStep == 0;
         FrameProgress progress(settings_.progress, std::size_t(h), "rows");
         auto body = [&](const tbb::blocked_range<int>& rows) {
             RayScratch<4> s4;
