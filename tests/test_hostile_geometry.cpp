@@ -70,11 +70,14 @@ TEST_CASE("a reference step of 1e-9 voxels is refused, not coarsened", "[hostile
     tiny.quality.referenceStep = 1e-9;
     CHECK_THAT(errorOf([&] { scene.render(tiny); }),
                Catch::Contains("referenceStep must be finite and >= 0.001 voxels"));
-    for (double step : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    for (double step : {-1.0, std::numeric_limits<double>::quiet_NaN()}) {
         RenderSettings f = s;
         f.quality.referenceStep = step;
         CHECK_THAT(errorOf([&] { scene.render(f); }), Catch::Contains("reference step"));
     }
+    RenderSettings automatic = s;  // 0: the automatic first step (referenceStepFor)
+    automatic.quality.referenceStep = 0.0;
+    CHECK_NOTHROW(scene.render(automatic));
     RenderSettings ok = s;
     ok.quality.referenceStep = 1e-3;
     ok.quality.referenceTolerance = 1e9;

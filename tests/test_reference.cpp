@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "footprint/footprint_table.h"
+#include "model/scene_impl.h"
 #include "reference/reference_frame.h"
 #include "reference_util.h"
 #include "splat/error.h"
@@ -363,18 +364,30 @@ TEST_CASE("reference: perspective camera and empty volumes", "[reference]") {
     const Image empty = renderReference(v, none, kernel, cam, s);
     for (const auto& p : empty.pixels) REQUIRE(p == glm::vec4(0, 0, 0, 1));
     RenderSettings bad = s;
-    bad.quality.referenceStep = 0;
+    bad.quality.referenceStep = -1;
     CHECK_THROWS_AS(renderReference(v, none, kernel, cam, bad), Error);
 }
 
 namespace {
 
 // The reference image of `v` under `s` from a field with the given accelerations.
-Image referenceWith(const Volume& v, const RenderSettings& s, ReferenceAcceleration acc) {
+Image referenceWith(const Volume& v, const RenderSettings& s, ReferenceAcceleration acc,
+                    RenderStats* stats = nullptr, std::size_t* samples = nullptr) {
     const footprint::Kernel kernel = kernelOf(s);
     const SplatList splats = classify(v, s.transfer, s.mode, s.classification, kernel.radius());
     const ReferenceField field(v, splats, kernel, fieldLayout(s, splats), acc);
-    return renderReference(v, field, Camera(s.camera, v), s, nullptr, nullptr);
+    Image image;
+    runOnThreads(s.threads, [&] {
+        image = renderReference(v, field, Camera(s.camera, v), s, stats, nullptr, 0, nullptr,
+                                samples);
+    });
+    return image;
+}
+
+ReferenceAcceleration wholeRay() {
+    ReferenceAcceleration a;
+    a.panelAdaptive = false;
+    return a;
 }
 
 double maxAbsDiff(const Image& a, const Image& b) {
@@ -447,4 +460,110 @@ TEST_CASE("reference: fast paths give the plain path's image within the toleranc
             CHECK(maxAbsDiff(fast, plain) <= 0.2 * tol);
             CHECK(compareImages(fast, plain).rmse <= 0.02 * tol);
         }
+}
+
+TEST_CASE("reference: panel adaptivity is within the tolerance of a tight truth, pre-classified "
+          "with fewer samples than whole-ray halving",
+          "[reference]") {
+    // phantom:32 under ct-soft (sharp opacity ramps: the integrand has kinks where the field
+    // crosses them) and the smooth blob under a gray ramp; pre- and post-classified.
+    struct Case {
+        const char* volume;
+        const char* tf;
+        Classification cls;
+    };
+    for (const Case c : {Case{"phantom", "ct-soft", Classification::Pre},
+                         Case{"phantom", "ct-soft", Classification::Post},
+                         Case{"blob", "gray-ramp", Classification::Pre}}) {
+        const Volume v = makeSynthetic(c.volume, 32);
+        RenderSettings s = settingsFor(RenderMode::Dvr, 32, 30.0, 10.0);
+        s.classification = c.cls;
+        s.transfer = resolvedFor(TransferFunction::preset(c.tf), v);
+        RenderSettings tight = s;
+        tight.quality.referenceStep = 0.05;
+        tight.quality.referenceTolerance = 1e-7;
+        const Image truth = referenceWith(v, tight, wholeRay());
+        RenderStats panelStats, wholeStats;
+        std::size_t panelSamples = 0, wholeSamples = 0;
+        RenderSettings automatic = s;
+        automatic.quality.referenceStep = 0;  // panels: 1 voxel for the default Gaussian
+        const Image panels = referenceWith(v, automatic, {}, &panelStats, &panelSamples);
+        const Image whole = referenceWith(v, s, wholeRay(), &wholeStats, &wholeSamples);
+        const double tol = s.quality.referenceTolerance;
+        const double panelErr = maxAbsDiff(panels, truth), wholeErr = maxAbsDiff(whole, truth);
+        INFO(c.volume << " " << c.tf << " classification " << int(c.cls) << ": max abs error "
+                      << panelErr << " (panels, first step 1, " << panelSamples << " samples) vs " << wholeErr
+                      << " (whole ray, first step 0.25, " << wholeSamples << " samples)");
+        CHECK(panelErr <= tol);
+        CHECK(panelErr <= 2.0 * wholeErr + 0.05 * tol);
+        CHECK(compareImages(panels, truth).rmse <= 0.1 * tol);
+        REQUIRE(wholeSamples > 0);
+        if (c.cls == Classification::Pre) {
+            CHECK(panelSamples < wholeSamples);
+        } else {
+            // Post-classified the transfer function's ramps make the integrand kink inside
+            // panels: the whole-ray test accepts early (its error can exceed the tolerance),
+            // the panel test refines them.
+            CHECK(panelErr < wholeErr);
+        }
+        CHECK(panelStats.referenceStep < 1.0);
+        CHECK(wholeStats.referenceStep <= 0.125);
+    }
+}
+
+TEST_CASE("reference: panel adaptivity refines where the integrand is sharp, not where it is "
+          "smooth",
+          "[reference]") {
+    // One opaque-ish kernel (optical depth ~2.5 through the centre, a sharp feature at a
+    // coarse step) in a volume otherwise empty: every ray through it converges to the closed
+    // form to the tolerance, and a tighter tolerance refines (more samples, finer step).
+    const Volume v = singleVoxel({1.0, 1.0, 1.0});
+    RenderSettings s = settingsFor(RenderMode::Dvr, 24, 30.0, 20.0);
+    s.quality.referenceStep = 0;  // automatic: 1 voxel, the kernel's sigma is 0.57 voxels
+    const footprint::Kernel kernel = kernelOf(s);
+    const footprint::FootprintTable fp(kernel);
+    const SplatList splats = splatsByHand(v, 8.0f, glm::vec3(1.0f, 0.5f, 0.25f));
+    const Camera cam(s.camera, v);
+    const ReferenceField field(v, splats, kernel, FieldLayout::Emission);
+    RenderStats loose, tight;
+    std::size_t looseSamples = 0, tightSamples = 0;
+    const Image a =
+        renderReference(v, field, cam, s, &loose, nullptr, 0, nullptr, &looseSamples);
+    RenderSettings t = s;
+    t.quality.referenceTolerance = 1e-7;
+    const Image b =
+        renderReference(v, field, cam, t, &tight, nullptr, 0, nullptr, &tightSamples);
+    double worstA = 0, worstB = 0;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) {
+            const double T = std::exp(-exactOpticalDepth(v, splats, fp, cam.ray(x + 0.5, y + 0.5)));
+            worstA = std::max(worstA, std::abs(double(a.at(x, y).r) - (1.0 - T)));
+            worstB = std::max(worstB, std::abs(double(b.at(x, y).r) - (1.0 - T)));
+        }
+    INFO("max abs error " << worstA << " (tolerance 1e-4, " << looseSamples
+                          << " samples, finest step " << loose.referenceStep << "), " << worstB
+                          << " (1e-7, " << tightSamples << " samples, finest step "
+                          << tight.referenceStep << ")");
+    CHECK(worstA <= s.quality.referenceTolerance);
+    CHECK(worstB <= 1e-6);
+    CHECK(loose.referenceStep < 0.5);  // the feature was refined below the first pass
+    CHECK(tightSamples > looseSamples);
+    CHECK(tight.referenceStep < loose.referenceStep);
+}
+
+TEST_CASE("reference: panel adaptivity gives the same image on any thread count",
+          "[reference]") {
+    const Volume v = makeSynthetic("phantom", 32);
+    RenderSettings s = settingsFor(RenderMode::Dvr, 32, 45.0, 20.0);
+    s.transfer = resolvedFor(TransferFunction::preset("ct-soft"), v);
+    s.threads = 1;
+    s.quality.referenceStep = 0;  // automatic: 1 voxel
+    RenderStats one, two;
+    std::size_t samplesOne = 0, samplesTwo = 0;
+    const Image a = referenceWith(v, s, {}, &one, &samplesOne);
+    s.threads = 2;
+    const Image b = referenceWith(v, s, {}, &two, &samplesTwo);
+    REQUIRE(a.pixels == b.pixels);
+    CHECK(samplesOne == samplesTwo);
+    CHECK(one.referenceStep == two.referenceStep);
 }

@@ -62,7 +62,7 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool imageOutput) {
     addOption(cmd, "--slab", a.slab, "sheet renderer: slab thickness, voxels", q);
     addOption(cmd, "--early-termination", a.earlyTermination,
               "splatters, front-to-back: stop when opacity >= 1 - EPS (0 = off)", q);
-    addOption(cmd, "--ref-step", a.refStep, "reference renderer: initial step, voxels", q);
+    addOption(cmd, "--ref-step", a.refStep, "reference renderer: first step, voxels (0: automatic, dvr 1 for the default kernel, else 0.25)", q);
     addOption(cmd, "--ref-tolerance", a.refTolerance,
               "reference renderer: step refinement tolerance", q);
     addOption(cmd, "--threads", a.threads, "worker threads (0 = all cores)", q);
@@ -214,7 +214,7 @@ RenderSettings parseSettings(const RenderArgs& a) {
     } catch (const Error& e) {
         throw Error(std::string("--ewa: ") + e.what());
     }
-    requireIn(a.refStep, 1e-3, 64, "--ref-step (voxels)");
+    if (a.refStep != 0) requireIn(a.refStep, 1e-3, 64, "--ref-step (voxels; 0 = automatic)");
     if (!std::isfinite(a.refTolerance) || !(a.refTolerance > 0) || a.refTolerance > 1)
         throw Error("--ref-tolerance must be a finite number in (0, 1]");
     s.quality.referenceStep = a.refStep;

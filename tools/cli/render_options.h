@@ -21,7 +21,7 @@ struct RenderArgs {
     nlohmann::json tfInline;  ///< a transfer function given inline in a scene file
     double azimuth = 0, elevation = 0, pixelSize = 0, fov = 30, slab = 1, sigma = 0, radius = 0;
     std::string eye, lookAt, up;  // free camera: X,Y,Z world (--eye with --look-at, --up)
-    double earlyTermination = 1.0 / 256.0, refStep = 0.25, refTolerance = 1e-4;
+    double earlyTermination = 1.0 / 256.0, refStep = 0, refTolerance = 1e-4;
     double pixelFilter = 0;
     std::string ewa = "auto";
     std::string lod = "0";  ///< pixels per voxel, or "auto"

@@ -275,8 +275,8 @@ void validateFrame(const RenderSettings& s) {
         throw Error("pixel filter tolerance must be a positive number");
     if (s.threads < 0 || s.threads > 1024)
         throw Error("thread count must be between 0 (all) and 1024");
-    if (!(q.referenceStep > 0) || !(q.referenceTolerance > 0))
-        throw Error("reference step and tolerance must be positive");
+    if (!(q.referenceStep >= 0) || !(q.referenceTolerance > 0))
+        throw Error("reference step must be >= 0 (0: automatic) and tolerance positive");
     for (int c = 0; c < 4; ++c)
         if (!(s.background[c] >= 0 && s.background[c] <= 1))
             throw Error("background must be in [0, 1]");

@@ -9,6 +9,7 @@ ReferenceField::ReferenceField(const Volume& volume, const SplatList& splats,
     : lut_(kernel),
       acceleration_(acceleration),
       radius_(kernel.radius()),
+      kernelDeviation_(std::sqrt(kernel.variance())),
       layout_(layout),
       background_(splats.background) {
     if (acceleration.separableKernel && kernel.type() == footprint::KernelType::Gaussian)

@@ -578,6 +578,10 @@ struct ReferenceAcceleration {
     /// dvr rays stop once the light still to come cannot change the pixel by more than a
     /// hundredth of the tolerance (reference.cpp, "Early termination"); off: at T < 1e-7.
     bool toleranceTermination = true;
+    /// dvr rays refine only the panels (two first steps long) whose own change moves the
+    /// pixel (reference.cpp, "Panel adaptivity"); off: every sample of the ray is halved
+    /// until the whole ray's pixel changes by at most the tolerance.
+    bool panelAdaptive = true;
 };
 
 /// The fields of one classified scene (see FieldLayout). Not copyable (the grids point at
@@ -605,6 +609,8 @@ class ReferenceField {
     const FieldGrid<4>& grid4() const { return grid4_; }
     const FieldGrid<1>& grid1() const { return grid1_; }
     double radius() const { return radius_; }
+    /// The kernel's standard deviation along a line, voxels (sqrt of Kernel::variance).
+    double kernelDeviation() const { return kernelDeviation_; }
     const ReferenceAcceleration& acceleration() const { return acceleration_; }
     /// Emission layout: max over voxels and channels of e_i / rho_i, which bounds e(x) / rho(x)
     /// everywhere (h >= 0, so e / rho is a weighted mean of the voxels' ratios); infinite when
@@ -617,6 +623,7 @@ class ReferenceField {
     ReferenceAcceleration acceleration_;
     double emissionRatioBound_ = std::numeric_limits<double>::infinity();
     double radius_;
+    double kernelDeviation_ = 0.5;
     FieldLayout layout_;
     float background_ = 0.0f;  ///< b (the grids hold d_i - b, SplatList::background)
     FieldGrid<4> grid4_;

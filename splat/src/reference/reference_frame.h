@@ -22,11 +22,18 @@ inline FieldLayout fieldLayout(const RenderSettings& s, const SplatList& splats)
 
 /// Renders `field` as seen by `camera` on the calling thread's arena; with `depth`, iso
 /// hit depths as well (see renderReferenceDepth).
-/// `gradientScale`: the splat list's G (edge enhancement).
+/// `gradientScale`: the splat list's G (edge enhancement). `samples`: the field samples the
+/// rays took (tests of the error control).
 Image renderReference(const Volume& volume, const ReferenceField& field, const Camera& camera,
                       const RenderSettings& settings, RenderStats* stats, Image* depth,
-                      float gradientScale = 0, const LabelLookup* labels = nullptr);
+                      float gradientScale = 0, const LabelLookup* labels = nullptr,
+                      std::size_t* samples = nullptr);
 
 void validateReferenceKernel(const footprint::Kernel& kernel);
+
+/// The automatic first step (Quality::referenceStep = 0), voxels: for dvr with panel
+/// adaptivity 1.75 kernel standard deviations (sqrt of Kernel::variance) clamped to
+/// [0.25, 1] (1 for the default Gaussian, 0.57 voxels), else 0.25.
+double referenceStepFor(RenderMode mode, double kernelDeviation, bool panelAdaptive);
 
 }  // namespace splat
