@@ -482,12 +482,14 @@ class Bench:
                 "analysis_total_ms": summary["timings"]["total_ms"]}
 
     def accuracy(self):
-        """bench_accuracy ch2 mri-head 256^2, azimuths 30 and 45 (COMMON accuracy check):
+        """bench_accuracy ch2 mri-head 256^2, azimuths 30 and 45 (COMMON accuracy check;
+        --truth point: the point-sampled reference the baseline was measured against):
         {renderer label: [RMSE per azimuth]}."""
         exe = f"{self.bin}/bench_accuracy"
         if not os.access(exe, os.X_OK) or not os.path.exists(CH2):
             return None
-        r = subprocess.run([exe, CH2, "mri-head", "--size", "256", "--azimuths", "30,45"],
+        r = subprocess.run([exe, CH2, "mri-head", "--size", "256", "--azimuths", "30,45",
+                            "--truth", "point"],
                            capture_output=True, text=True)
         if r.returncode != 0:
             sys.exit(f"vs_vtk: bench_accuracy failed: {r.stderr.strip()}")
