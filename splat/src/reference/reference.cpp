@@ -296,19 +296,28 @@ class Caster {
         }
     }
 
+    /// The ray through pixel (x, y)'s centre in voxel units (p0 + t v, t in world units) and
+    /// its segments through the field's occupied bricks; clipping cuts the ray to the kept
+    /// region (the field itself is whole).
+    template <int C>
+    void pixelRay(const FieldGrid<C>& g, int x, int y, glm::dvec3& p0, glm::dvec3& v,
+                  std::vector<Segment>& segments) const {
+        const Ray ray = camera_.ray(x + 0.5, y + 0.5);
+        p0 = (ray.origin - volume_.origin) * invSpacing_;
+        v = ray.dir * invSpacing_;
+        const double inf = std::numeric_limits<double>::infinity();
+        double t0 = camera_.perspective() ? 0.0 : -inf, t1 = inf;
+        if (!clips_ || keptInterval(settings_.clipping, ray.origin, ray.dir, t0, t1))
+            raySegments(g, p0, v, t0, t1, segments);
+        else
+            segments.clear();
+    }
+
     template <int C>
     glm::vec4 pixel(const FieldGrid<C>& g, RayScratch<C>& sc, int x, int y, int& levelUsed,
                     double& hitDepth) const {
-        const Ray ray = camera_.ray(x + 0.5, y + 0.5);
-        const glm::dvec3 p0 = (ray.origin - volume_.origin) * invSpacing_;
-        const glm::dvec3 v = ray.dir * invSpacing_;
-        const double inf = std::numeric_limits<double>::infinity();
-        // Clipping: the ray is cut to the kept region (the field itself is whole).
-        double t0 = camera_.perspective() ? 0.0 : -inf, t1 = inf;
-        if (!clips_ || keptInterval(settings_.clipping, ray.origin, ray.dir, t0, t1))
-            raySegments(g, p0, v, t0, t1, sc.segments);
-        else
-            sc.segments.clear();
+        glm::dvec3 p0, v;
+        pixelRay(g, x, y, p0, v, sc.segments);
         const RenderMode mode = settings_.mode;
         const glm::vec4 bg = settings_.background;
         auto finish = [&](glm::dvec4 c) -> glm::vec4 {
@@ -399,15 +408,8 @@ class Caster {
     template <int C>
     glm::vec4 pixelPanels(const FieldGrid<C>& g, PanelScratch& sc, int x, int y,
                           int& levelUsed) const {
-        const Ray ray = camera_.ray(x + 0.5, y + 0.5);
-        const glm::dvec3 p0 = (ray.origin - volume_.origin) * invSpacing_;
-        const glm::dvec3 v = ray.dir * invSpacing_;
-        const double inf = std::numeric_limits<double>::infinity();
-        double t0 = camera_.perspective() ? 0.0 : -inf, t1 = inf;
-        if (!clips_ || keptInterval(settings_.clipping, ray.origin, ray.dir, t0, t1))
-            raySegments(g, p0, v, t0, t1, sc.segments);
-        else
-            sc.segments.clear();
+        glm::dvec3 p0, v;
+        pixelRay(g, x, y, p0, v, sc.segments);
         levelUsed = 0;
         sc.panels.clear();
         for (const Segment& seg : sc.segments) {
