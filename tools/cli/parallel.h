@@ -44,7 +44,7 @@ void printError(const std::string& line);
 /// Ranks > 0: build the Scene and render the frames rank 0 asks for, until it stops.
 void serveFrames(const std::function<Scene()>& build);
 
-/// `--compositor direct|icet|auto` of render and rotate: how the ranks composite the partial
+/// `--compositor direct|icet|auto` of render, rotate and popping: how the ranks composite the partial
 /// images of bricks (splat/mpi/brick_group.h; direct by default, chosen from measurement:
 /// README "Direct-send beside IceT"). auto: icet when this splat was built with IceT
 /// (SPLAT_ICET), else direct. A name that is none of the three, or icet in a splat built
