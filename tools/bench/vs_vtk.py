@@ -221,7 +221,7 @@ class Bench:
         frames `wanted` of a `frames`-frame rotation: {frame: path of its .f32}, read from the
         cache folder when an earlier run made it (keyed by volume, size, view, transfer
         function and settings), else rendered and stored there."""
-        out, todo = {}, []
+        out, uncached = {}, []
         tf_text = open(tf or self.tf).read() if os.path.exists(tf or self.tf) else (tf or self.tf)
         for k in wanted:
             key = {"volume": spec, "volume_file": file_id(spec), "size": size, "frames": frames,
@@ -233,16 +233,16 @@ class Bench:
             if os.path.exists(path) and os.path.exists(path[:-4] + ".json"):
                 self.computed.append(dict(json.load(open(path[:-4] + ".json")), cached=True))
             else:
-                todo.append((k, key, path))
-        if todo:
+                uncached.append((k, key, path))
+        if uncached:
             os.makedirs(self.args.cache, exist_ok=True)
             tmp = self.path("filtered", "tmp")
             tmp = os.path.dirname(tmp)
             run = self.splat(spec, "reference", size, 2, frames,
-                             [k for k, _, _ in todo], tmp, extra=["--mode", mode,
+                             [k for k, _, _ in uncached], tmp, extra=["--mode", mode,
                              "--pixel-filter", str(FILTER_SIGMA)], tf=tf, warmup=False)
             by_frame = {f["frame"]: f for f in run["frames"]}
-            for k, key, path in todo:
+            for k, key, path in uncached:
                 f = by_frame[k]
                 info = dict(key, tf=None, ms=f["ms"], cpu_ms=f["cpu_ms"],
                             pixel_samples=f["pixel_samples"],
