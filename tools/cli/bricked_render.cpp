@@ -47,8 +47,40 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
     return c.bricks;
 }
 
-SequenceBricks chooseSequenceBricks(const VolumeArgs& volume, RenderSettings& settings,
-                                    int bricks, double rankMiB, double extraSampleBytes) {
+void addSequenceBrickOptions(CLI::App& cmd, SequenceBrickArgs& b, const std::string& group,
+                             const std::string& frames) {
+    addOption(cmd, "--bricks", b.bricks,
+              "sort-last: cut the volume into K bricks, loaded and built once, " + frames +
+                  " rendered by them and composited (0: off; under mpirun chosen from "
+                  "--rank-memory when the volume does not fit one process)",
+              group);
+    addOption(cmd, "--rank-memory", b.rankMemory,
+              "bricks: memory per process in MiB (default under mpirun: 80% of the physical "
+              "memory / processes on the node); frames in parallel when the volume fits",
+              group);
+    addOption(cmd, "--brick-composite", b.composite,
+              "bricks of the image-aligned splatter: exact (slab sheets summed across bricks: "
+              "the same as one process) or fast (partial images, approximate at brick faces)",
+              group);
+    addOption(cmd, "--compositor", b.compositor,
+              "bricks under mpirun: direct (sparse direct-send, the default) | icet (IceT "
+              "radix-k, when built with it) | auto (icet when built with it, else direct)",
+              group);
+}
+
+void checkSequenceBrickOptions(const CLI::App& cmd, const SequenceBrickArgs& b) {
+    if (b.bricks < 0 || b.bricks > 4096) throw UsageError("--bricks must be between 0 and 4096");
+    if (!(b.rankMemory >= 0 && b.rankMemory <= 1e9))
+        throw UsageError("--rank-memory must be between 0 and 1e9 MiB");
+    if (b.composite != "exact" && b.composite != "fast")
+        throw UsageError("--brick-composite must be exact or fast (got '" + b.composite + "')");
+    checkCompositor(b.compositor);
+    if (given(cmd, "compositor") && !fromScene(cmd, "compositor") && processCount() == 1)
+        warn("--compositor applies to bricks under mpirun: ignored");
+}
+
+SequenceBricks chooseSequenceBricks(const VolumeArgs& volume, RenderSettings& settings, int bricks,
+                                    double rankMiB, double extraSampleBytes) {
     SequenceBricks c;
     c.bricks = bricks;
     const std::uint64_t rankBytes = std::uint64_t(rankMiB * 1048576.0);

@@ -29,6 +29,20 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
                      std::uint64_t rankBytes, bool* wholeFits = nullptr, bool quiet = false,
                      double extraSampleBytes = 0);
 
+/// The options of a sequence in bricks (`rotate`, `popping`; README "Beyond one machine").
+struct SequenceBrickArgs {
+    int bricks = 0;         ///< --bricks K (0: off, or chosen from the budget under mpirun)
+    double rankMemory = 0;  ///< --rank-memory MiB; 0: the default under mpirun
+    std::string composite = "exact";    ///< --brick-composite exact|fast
+    std::string compositor = "direct";  ///< --compositor (parallel.h)
+};
+/// Registers --bricks, --rank-memory, --brick-composite and --compositor in `group`;
+/// `frames`: what the bricks render ("every frame", "every frame of the analysis").
+void addSequenceBrickOptions(CLI::App& cmd, SequenceBrickArgs& b, const std::string& group,
+                             const std::string& frames);
+/// Their values' checks (UsageError), and the warning for --compositor without mpirun.
+void checkSequenceBrickOptions(const CLI::App& cmd, const SequenceBrickArgs& b);
+
 /// Whether a sequence (`rotate`, `popping`) renders in bricks, README "Beyond one machine":
 /// when asked (`bricks` > 0), or when the budget per process (`rankMiB`, 0: defaultRankBytes)
 /// says the volume does not fit one (mpirun, --rank-memory; `extraSampleBytes` as in
@@ -39,8 +53,8 @@ struct SequenceBricks {
     std::optional<Volume> geometry;  ///< read when bricks were asked for or under mpirun
     bool alone = true;               ///< whether the samples are read by brick
 };
-SequenceBricks chooseSequenceBricks(const VolumeArgs& volume, RenderSettings& settings,
-                                    int bricks, double rankMiB, double extraSampleBytes = 0);
+SequenceBricks chooseSequenceBricks(const VolumeArgs& volume, RenderSettings& settings, int bricks,
+                                    double rankMiB, double extraSampleBytes = 0);
 
 /// What `splat popping` in bricks holds per sample beyond the samples and one splat list: one
 /// Scene per renderer of `renderers` over the same samples — another splat list each (26

@@ -31,10 +31,7 @@ struct PoppingCommand {
     RenderArgs render;
     PoppingArgs popping;
     std::string report;
-    int bricks = 0;
-    double rankMemory = 0;  ///< MiB; 0: the default under mpirun, off otherwise
-    std::string compositor = "direct";  ///< --compositor (parallel.h)
-    std::string brickComposite = "exact";
+    SequenceBrickArgs brick;
     bool quiet = false, resume = false;
 };
 
@@ -82,24 +79,7 @@ void registerPopping(CLI::App& app) {
     addFlag(*cmd, "--resume", a->resume,
             "finish an interrupted run: reuse the frames it left in REPORT/.frames", out);
     addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
-    addOption(*cmd, "--bricks", a->bricks,
-              "sort-last: cut the volume into K bricks, loaded and built once, every frame of "
-              "the analysis rendered by them and composited, exact sheets (0: off; under mpirun "
-              "chosen from --rank-memory when the volume does not fit one process)",
-              out);
-    addOption(*cmd, "--rank-memory", a->rankMemory,
-              "bricks: memory per process in MiB (default under mpirun: 80% of the physical "
-              "memory / processes on the node); frames in parallel when the volume fits",
-              out);
-    addOption(*cmd, "--brick-composite", a->brickComposite,
-              "bricks of the image-aligned splatter: exact (slab sheets summed across bricks: "
-              "the findings do not change with K) or fast (partial images, approximate at brick "
-              "faces)",
-              out);
-    addOption(*cmd, "--compositor", a->compositor,
-              "bricks under mpirun: direct (sparse direct-send, the default) | icet (IceT "
-              "radix-k, when built with it) | auto (icet when built with it, else direct)",
-              out);
+    addSequenceBrickOptions(*cmd, a->brick, out, "every frame of the analysis");
     cmd->footer(
         "Examples:\n"
         "  splat popping synthetic:phantom:64 --from 40 --to 50 --step 0.5 --report pop\n"
@@ -117,20 +97,12 @@ void registerPopping(CLI::App& app) {
         loadOptionsFromArgs(a->volume);
         // The Scene is validated against its first renderer (iso: the reference alone).
         settings.renderer = o.renderers.front();
-        if (a->bricks < 0 || a->bricks > 4096)
-            throw UsageError("--bricks must be between 0 and 4096");
-        if (!(a->rankMemory >= 0 && a->rankMemory <= 1e9))
-            throw UsageError("--rank-memory must be between 0 and 1e9 MiB");
-        if (a->brickComposite != "exact" && a->brickComposite != "fast")
-            throw UsageError("--brick-composite must be exact or fast (got '" + a->brickComposite +
-                             "')");
-        checkCompositor(a->compositor);
-        if (given(*cmd, "compositor") && !fromScene(*cmd, "compositor") && processCount() == 1)
-            warn("--compositor applies to bricks under mpirun: ignored");
+        checkSequenceBrickOptions(*cmd, a->brick);
         // Bricks, or frames in parallel under mpirun (README "Beyond one machine",
         // chooseSequenceBricks); each renderer holds its own Scenes of the same samples.
-        const SequenceBricks choice = chooseSequenceBricks(
-            a->volume, settings, a->bricks, a->rankMemory, poppingSampleBytes(o.renderers));
+        const SequenceBricks choice =
+            chooseSequenceBricks(a->volume, settings, a->brick.bricks, a->brick.rankMemory,
+                                 poppingSampleBytes(o.renderers));
         const int bricks = choice.bricks;
         const std::optional<Volume>& geometry = choice.geometry;
         const bool alone = choice.alone;
@@ -158,7 +130,7 @@ void registerPopping(CLI::App& app) {
             warn(
                 "--brick-composite applies to popping in bricks (--bricks, or a volume beyond "
                 "--rank-memory) with the image-aligned splatter (sheet): ignored");
-        else if (bricked && sheet && a->brickComposite == "fast")
+        else if (bricked && sheet && a->brick.composite == "fast")
             warn(
                 "--brick-composite fast: the image-aligned splatter is approximate where its "
                 "slabs cross a brick face, so its findings may change with the bricks (README "
@@ -175,10 +147,10 @@ void registerPopping(CLI::App& app) {
         std::unique_ptr<BrickedFrames> frames;
         if (bricked) {
             settings = judged(settings, *geometry);
-            group = brickGroup(a->compositor);
+            group = brickGroup(a->brick.compositor);
             frames = std::make_unique<BrickedFrames>(
                 *geometry, brickLoader(a->volume), settings, bricks, *group,
-                a->brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
+                a->brick.composite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
             settings = frames->settings();
         }
         std::optional<BrickedFrameRequests> requests;

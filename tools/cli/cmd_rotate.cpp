@@ -48,10 +48,9 @@ struct RotateCommand {
     RenderArgs render;
     std::string outDir, gif, contact, mp4, format = "png", name = "frame_%04d", sweep = "azimuth",
                                            path;
-    int frames = 36, fps = 12, parallelFrames = 0, bricks = 0;
-    double from = 0, to = 360, rankMemory = 0;
-    std::string brickComposite = "exact";
-    std::string compositor = "direct";
+    int frames = 36, fps = 12, parallelFrames = 0;
+    double from = 0, to = 360;
+    SequenceBrickArgs brick;
     bool resume = false, overwrite = false, quiet = false;
 };
 
@@ -262,13 +261,13 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
                          ProgressReporter& progress,
                          const std::function<void(std::size_t, const Image&, double)>& emit) {
     const bool leader = group.rank() == 0;
-    if (leader && settings.renderer == RendererKind::Sheet && a.brickComposite == "fast")
+    if (leader && settings.renderer == RendererKind::Sheet && a.brick.composite == "fast")
         warn(
             "--renderer sheet with --brick-composite fast is approximate where its slabs cross a "
             "brick face (README \"Beyond one machine\"); --brick-composite exact is not");
     BrickedFrames frames(
         geometry, brickLoader(a.volume), settings, bricks, group,
-        a.brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
+        a.brick.composite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
     std::size_t pending = 0, done = 0;
     for (bool k : keep) pending += k ? 0 : 1;
     std::string failure;
@@ -325,23 +324,7 @@ void registerRotate(CLI::App& app) {
               seq, PathKind::Input);
     addOption(*cmd, "--parallel-frames", a->parallelFrames,
               "frames rendered at once, one thread each (0: automatic)", seq);
-    addOption(*cmd, "--bricks", a->bricks,
-              "sort-last: cut the volume into K bricks, loaded and built once, every frame "
-              "rendered by them and composited (0: off; under mpirun chosen from "
-              "--rank-memory when the volume does not fit one process)",
-              seq);
-    addOption(*cmd, "--rank-memory", a->rankMemory,
-              "bricks: memory per process in MiB (default under mpirun: 80% of the physical "
-              "memory / processes on the node); frames in parallel when the volume fits",
-              seq);
-    addOption(*cmd, "--brick-composite", a->brickComposite,
-              "bricks of --renderer sheet: exact (slab sheets summed across bricks) or fast "
-              "(partial images, approximate at brick faces)",
-              seq);
-    addOption(*cmd, "--compositor", a->compositor,
-              "bricks under mpirun: direct (sparse direct-send, the default) | icet (IceT "
-              "radix-k, when built with it) | auto (icet when built with it, else direct)",
-              seq);
+    addSequenceBrickOptions(*cmd, a->brick, seq, "every frame");
     addOption(*cmd, "-o,--output", a->outDir, "output folder for the frames (created)", out,
               PathKind::Output);
     addOption(*cmd, "--name", a->name, "frame file name pattern (printf %d of the frame index)",
@@ -389,13 +372,6 @@ void registerRotate(CLI::App& app) {
                 throw Error(a->mp4 + ": --mp4 needs a .mp4 file name");
             if (!a->mp4.empty() && a->format != "png")
                 throw Error("--mp4 is made from png frames (--format png)");
-            if (a->bricks < 0 || a->bricks > 4096)
-                throw Error("--bricks must be between 0 and 4096");
-            if (a->brickComposite != "exact" && a->brickComposite != "fast")
-                throw Error("--brick-composite must be exact or fast (got '" + a->brickComposite +
-                            "')");
-            if (!(a->rankMemory >= 0 && a->rankMemory <= 1e9))
-                throw Error("--rank-memory must be between 0 and 1e9 MiB");
         });
         if (!a->path.empty())
             for (const char* k : {"from", "to", "sweep"})
@@ -404,16 +380,14 @@ void registerRotate(CLI::App& app) {
                          "set the views); ignored");
         if (a->gif.empty() && a->mp4.empty() && given(*cmd, "fps") && !fromScene(*cmd, "fps"))
             warn("--fps applies to --gif and --mp4 only; ignored");
-        checkCompositor(a->compositor);
-        if (given(*cmd, "compositor") && !fromScene(*cmd, "compositor") && processCount() == 1)
-            warn("--compositor applies to bricks under mpirun: ignored");
+        checkSequenceBrickOptions(*cmd, a->brick);
         RenderUse use;
         use.imageExt = "." + a->format;
         RenderSettings settings = settingsFromArgs(a->render, use);
         loadOptionsFromArgs(a->volume);
         // Bricks, or frames in parallel (README "Beyond one machine", chooseSequenceBricks).
         const SequenceBricks choice =
-            chooseSequenceBricks(a->volume, settings, a->bricks, a->rankMemory);
+            chooseSequenceBricks(a->volume, settings, a->brick.bricks, a->brick.rankMemory);
         const int bricks = choice.bricks;
         const std::optional<Volume>& geometry = choice.geometry;
         const bool alone = choice.alone;
@@ -435,7 +409,8 @@ void registerRotate(CLI::App& app) {
         // Rank 0 prepares the outputs; a bricked run's other ranks learn whether it could,
         // and which frames are kept (--resume), before rendering with it.
         const bool leader = !workerProcess();
-        const std::unique_ptr<BrickGroup> group = bricked ? brickGroup(a->compositor) : nullptr;
+        const std::unique_ptr<BrickGroup> group =
+            bricked ? brickGroup(a->brick.compositor) : nullptr;
         std::string ffmpeg;
         const bool keepImages = !a->gif.empty() || !a->contact.empty();
         const CameraPath path =
