@@ -4,32 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "chebyshev.h"
+
 namespace footprint {
-
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-
-// Monomial coefficients (ascending) of the degree-d polynomial interpolating f at the
-// d + 1 Chebyshev nodes of [-1, 1] (Newton divided differences, then expansion).
-template <class F>
-std::array<double, FootprintPoly::kMaxCoefficients> chebyshevInterpolant(F&& f, int d) {
-    const int n = d + 1;
-    double x[FootprintPoly::kMaxCoefficients] = {}, y[FootprintPoly::kMaxCoefficients] = {};
-    for (int k = 0; k < n; ++k) {
-        x[k] = std::cos(kPi * (k + 0.5) / n);
-        y[k] = f(x[k]);
-    }
-    for (int j = 1; j < n; ++j)
-        for (int k = n - 1; k >= j; --k) y[k] = (y[k] - y[k - 1]) / (x[k] - x[k - j]);
-    std::array<double, FootprintPoly::kMaxCoefficients> p{};  // ascending powers
-    p[0] = y[n - 1];
-    for (int k = n - 2; k >= 0; --k) {  // p = p * (u - x_k) + y_k
-        for (int m = n - 1; m >= 1; --m) p[m] = p[m - 1] - x[k] * p[m];
-        p[0] = -x[k] * p[0] + y[k];
-    }
-    return p;
-}
-}  // namespace
 
 FootprintPoly::FootprintPoly(const FootprintTable& table) {
     r2Max_ = table.r2Max();
@@ -42,7 +19,7 @@ FootprintPoly::FootprintPoly(const FootprintTable& table) {
             auto f = [&](double u) {
                 return double(table.lookup(float(width * (s + 0.5 * (u + 1)))));
             };
-            const auto p = chebyshevInterpolant(f, degree_);
+            const auto p = detail::chebyshevInterpolant<kMaxCoefficients>(f, degree_);
             // Stored highest degree first, padded so Horner always runs kMaxCoefficients steps.
             for (int k = 0; k <= degree_; ++k) c_[kMaxCoefficients - 1 - k][s] = float(p[k]);
         }

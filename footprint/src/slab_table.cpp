@@ -10,7 +10,11 @@
 namespace footprint {
 
 SlabTable::SlabTable(const Kernel& kernel, int radialResolution, int depthResolution)
-    : kernel_(kernel), footprint_(kernel), nr_(radialResolution), nz_(depthResolution) {
+    : kernel_(kernel),
+      footprint_(kernel),
+      nr_(radialResolution),
+      nz_(depthResolution),
+      closed_(GaussianSlab::of(kernel)) {
     if (nr_ < 2 || nr_ > (1 << 14) || nz_ < 2 || nz_ > (1 << 14))
         throw std::invalid_argument("SlabTable: resolutions must be in [2, 2^14], got " +
                                     std::to_string(nr_) + " x " + std::to_string(nz_));

@@ -5,7 +5,9 @@
 //   FootprintLanes: fp(r^2) of FootprintTable::lookup, from the table (two gathers) or from
 //                   a FootprintPoly (permutes and fused multiply-adds, no gathers);
 //   FractionLanes:  F(r^2, z) of SlabTable::fraction, bilinear (one 16-byte load per lane
-//                   from the interleaved table rows, transposed).
+//                   from the interleaved table rows, transposed);
+//   GaussianSlabLanes: GaussianSlab's radial part and P(r^2, z) (exp and erf by polynomials,
+//                   permutes and fused multiply-adds, no loads).
 // Both reproduce the scalar lookups' clamping. On x86-64 (FOOTPRINT_HAVE_LANES defined)
 // they are compiled for AVX2 + FMA whatever the translation unit targets: code between
 // FOOTPRINT_LANES_BEGIN and FOOTPRINT_LANES_END is, so a portable build carries the vector
@@ -26,6 +28,7 @@
 #endif
 
 #include "footprint/footprint_poly.h"
+#include "footprint/gaussian_slab.h"
 #include "footprint/footprint_table.h"
 #include "footprint/slab_table.h"
 
@@ -140,6 +143,92 @@ class FractionLanes {
     const float* values_;  // SlabTable::values_ (rows interleaved in pairs)
     __m256 invR_, invZ_, zMin_, nr_, nz_;
     __m256i stride_;
+};
+
+class GaussianSlabLanes {
+  public:
+    /// Lanes of N P (the kernel's normalisation N times GaussianSlab's P), so that
+    /// N P(r^2, L) is half the footprint fp(r^2).
+    explicit GaussianSlabLanes(const GaussianSlab& g)
+        : r2Max_(_mm256_set1_ps(g.r2Max_)),
+          k_(_mm256_set1_ps(g.k_)),
+          eR_(_mm256_set1_ps(g.eR_ * g.norm_)),
+          eRk_(_mm256_set1_ps(g.eR_ * g.norm_ * g.k_)),
+          alpha_(_mm256_set1_ps(g.alpha_ * g.norm_)),
+          s_(_mm256_set1_ps(g.s_)),
+          c3_(_mm256_set1_ps(g.c3_ * g.norm_)),
+          xMax_(_mm256_set1_ps(g.xMax_)),
+          seg_(_mm256_set1_ps(g.segScale_)),
+          lastSeg_(_mm256_set1_ps(float(GaussianSlab::kSegments - 1))) {
+        for (int d = 0; d < GaussianSlab::kCoefficients; ++d)
+            coef_[d] = _mm256_loadu_ps(g.c_[std::size_t(d)].data());
+    }
+    /// The radial part, N times GaussianSlab::Radial's a and b, with the chord's square
+    /// l2 = L^2 and pl = N P(r^2, L), which the caller gives as half the footprint fp(r^2)
+    /// (from its table or polynomial: the sections then sum to exactly that footprint).
+    struct Radial {
+        __m256 a, b, l2, pl;
+    };
+    Radial radial(__m256 r2, __m256 halfFootprint) const {
+        const __m256 zero = _mm256_setzero_ps();
+        const __m256 r = _mm256_max_ps(r2, zero);
+        Radial out;
+        out.l2 = _mm256_max_ps(_mm256_sub_ps(r2Max_, r), zero);
+        out.a = _mm256_mul_ps(alpha_, exp(_mm256_mul_ps(_mm256_sub_ps(zero, k_), r)));
+        out.b = _mm256_fmadd_ps(eRk_, out.l2, eR_);
+        out.pl = halfFootprint;
+        return out;
+    }
+    /// N P(r^2, z) with z clamped to the chord [-L, L] (NaN -> -L).
+    __m256 operator()(const Radial& r, __m256 z) const {
+        const __m256 l = _mm256_sqrt_ps(r.l2);
+        const __m256 zc = _mm256_min_ps(_mm256_max_ps(z, _mm256_sub_ps(_mm256_setzero_ps(), l)), l);
+        return inside(r, zc, erf(_mm256_mul_ps(zc, s_)), _mm256_mul_ps(c3_, _mm256_mul_ps(zc, _mm256_mul_ps(zc, zc))));
+    }
+    /// N P at a depth z inside the chord whose erf(z / (sigma sqrt 2)) is e and whose cubic
+    /// term N e_R k z^3 / 3 is q: a e - b z + q.
+    static __m256 inside(const Radial& r, __m256 z, __m256 e, __m256 q) {
+        return _mm256_fmadd_ps(r.a, e, _mm256_fnmadd_ps(r.b, z, q));
+    }
+    /// GaussianSlab::erf, 8 lanes.
+    __m256 erf(__m256 x) const {
+        const __m256 sign = _mm256_and_ps(x, _mm256_set1_ps(-0.0f));
+        const __m256 ax = _mm256_min_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), x), xMax_);
+        const __m256 t = _mm256_mul_ps(ax, seg_);
+        const __m256 tf = _mm256_min_ps(_mm256_floor_ps(t), lastSeg_);
+        const __m256i seg = _mm256_cvttps_epi32(tf);
+        const __m256 u =
+            _mm256_fmsub_ps(_mm256_set1_ps(2.0f), _mm256_sub_ps(t, tf), _mm256_set1_ps(1.0f));
+        __m256 p = _mm256_permutevar8x32_ps(coef_[0], seg);
+        for (int d = 1; d < GaussianSlab::kCoefficients; ++d)
+            p = _mm256_fmadd_ps(p, u, _mm256_permutevar8x32_ps(coef_[d], seg));
+        return _mm256_or_ps(p, sign);
+    }
+    /// N e_R k / 3, the cubic term's coefficient.
+    __m256 cubic() const { return c3_; }
+    /// e^x for x <= 0 (relative error < 2e-7; about 1e-38 below -87, where it stops).
+    static __m256 exp(__m256 x) {
+        x = _mm256_max_ps(x, _mm256_set1_ps(-87.0f));
+        const __m256 n = _mm256_round_ps(_mm256_mul_ps(x, _mm256_set1_ps(1.44269504088896341f)),
+                                         _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+        __m256 r = _mm256_fnmadd_ps(n, _mm256_set1_ps(0.693359375f), x);
+        r = _mm256_fnmadd_ps(n, _mm256_set1_ps(-2.12194440e-4f), r);
+        // e^r on |r| <= ln2 / 2: Taylor to degree 6 (remainder < 1.7e-7 relative).
+        __m256 p = _mm256_set1_ps(1.0f / 720.0f);
+        p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.0f / 120.0f));
+        p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.0f / 24.0f));
+        p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.0f / 6.0f));
+        p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(0.5f));
+        p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.0f));
+        p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.0f));
+        const __m256i e = _mm256_slli_epi32(
+            _mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
+        return _mm256_mul_ps(p, _mm256_castsi256_ps(e));
+    }
+
+  private:
+    __m256 r2Max_, k_, eR_, eRk_, alpha_, s_, c3_, xMax_, seg_, lastSeg_;
+    __m256 coef_[GaussianSlab::kCoefficients] = {};
 };
 
 FOOTPRINT_LANES_END

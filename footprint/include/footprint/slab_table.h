@@ -22,9 +22,11 @@
 // 1e-4: its u^3 term is not smooth in r^2 at the centre); see tools/bench/bench_footprint for other
 // resolutions.
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "footprint/footprint_table.h"
+#include "footprint/gaussian_slab.h"
 #include "footprint/kernel.h"
 
 namespace footprint {
@@ -77,6 +79,10 @@ class SlabTable {
     /// C(r, z) by direct adaptive quadrature (slow; for tests).
     double exact(double r, double z) const;
 
+    /// The kernel's closed form (gaussian_slab.h), exact where the grid interpolates; null
+    /// for kernels without one (the image-aligned splatter then reads the grid).
+    const GaussianSlab* closedForm() const { return closed_ ? &*closed_ : nullptr; }
+
     const Kernel& kernel() const { return kernel_; }
     const FootprintTable& footprint() const { return footprint_; }
     double radius() const { return kernel_.radius(); }
@@ -97,6 +103,7 @@ class SlabTable {
     // lane instead of four gathered floats).
     std::vector<float> values_;
     std::vector<Saturation> saturation_;  // per grid row 0..nr (the row below r^2)
+    std::optional<GaussianSlab> closed_;
 };
 
 }  // namespace footprint

@@ -136,6 +136,130 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
 }
+
+/// Most boundaries of the Flat closed-form path (splatSectionsClosedLanes); kernels
+/// crossing more slabs take the general one.
+constexpr int kMaxFlat = 64;
+
+/// splatSectionsLanes with the kernel's closed form (footprint/gaussian_slab.h) instead of
+/// the table's fraction: per pixel the radial part of N P (exp, and half the footprint from
+/// the same table or polynomial as the axis-aligned splatter, so that the sections sum to
+/// it), per boundary N P(z) and the section scale |N P(above) - N P(below)|. Flat: the
+/// boundaries' depths are the same for every pixel (tx = ty = 0), so N P at a boundary
+/// inside the chord is a erf(z) - b z + q with erf(z), z and q per splat, and +-fp / 2
+/// outside it; no erf per pixel.
+template <int NCh, bool Flat>
+int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh],
+                             float sx, float sy, const footprint::EllipticalFootprint& e,
+                             const PixelRect& rect, const footprint::FootprintTable& fpTable,
+                             const footprint::GaussianSlab& slab,
+                             const footprint::FootprintPoly* poly, const float* tb) {
+    const int ox = sheets[0]->originX(), oy = sheets[0]->originY();
+    const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
+    for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
+    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), vZero = _mm256_setzero_ps();
+    const __m256 signBit = _mm256_set1_ps(-0.0f), vHalf = _mm256_set1_ps(0.5f);
+    const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
+    const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
+    const footprint::FootprintLanes footprintOf(fpTable, poly);
+    const footprint::GaussianSlabLanes section(slab);
+    const __m256 vds = _mm256_set1_ps(e.depthScale), vtx = _mm256_set1_ps(e.tx);
+    __m256 vv[NCh];
+    for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+    // Flat: per boundary z, z^2, erf(z / (sigma sqrt 2)) and the cubic term, 8 at a time.
+    alignas(32) float fz[Flat ? kMaxFlat + 8 : 1], fzz[Flat ? kMaxFlat + 8 : 1],
+        fe[Flat ? kMaxFlat + 8 : 1], fq[Flat ? kMaxFlat + 8 : 1];
+    if constexpr (Flat) {
+        for (int b = 0; b <= n; ++b) fz[b] = e.depthScale * tb[b];
+        for (int b = n + 1; b % 8; ++b) fz[b] = 0.0f;
+        const __m256 vs = _mm256_set1_ps(slab.erfScale());
+        for (int b = 0; b <= n; b += 8) {
+            const __m256 z = _mm256_load_ps(fz + b), zz = _mm256_mul_ps(z, z);
+            _mm256_store_ps(fzz + b, zz);
+            _mm256_store_ps(fe + b, section.erf(_mm256_mul_ps(z, vs)));
+            _mm256_store_ps(fq + b, _mm256_mul_ps(section.cubic(), _mm256_mul_ps(zz, z)));
+        }
+    }
+    // As splatSectionsLanes: per row, the boundaries before the kernel's chord at the row's
+    // smallest r^2 (N P = -fp / 2 front to back) and behind it (+fp / 2) are a prefix and
+    // a suffix.
+    const bool ascending = tb[n] > tb[0];
+    float* rows[kMaxSpan];
+    std::ptrdiff_t planes[kMaxSpan];
+    for (int y = y0; y <= y1; ++y) {
+        const float dy = float(y + oy) + 0.5f - sy;
+        const float gyy = e.gamma * dy * dy;
+        if (!(gyy < fpTable.r2Max())) continue;
+        const float chord = std::sqrt(std::max(slab.r2Max() - gyy, 0.0f));
+        const float dxA = float(x0 + ox) + 0.5f - sx, dxB = float(x1 + ox) + 0.5f - sx;
+        const float tcA = e.tx * dxA + e.ty * dy, tcB = e.tx * dxB + e.ty * dy;
+        const float tcLo = std::min(tcA, tcB), tcHi = std::max(tcA, tcB);
+        auto before = [&](int b) { return e.depthScale * (tb[b] - tcLo) <= -chord; };
+        auto behind = [&](int b) { return e.depthScale * (tb[b] - tcHi) >= chord; };
+        int pre = 0, suf = n + 1;
+        if (ascending) {
+            while (pre <= n && before(pre)) ++pre;
+            while (suf > pre && behind(suf - 1)) --suf;
+        } else {
+            while (pre <= n && behind(pre)) ++pre;
+            while (suf > pre && before(suf - 1)) --suf;
+        }
+        const int jBegin = std::max(pre - 1, 0), jEnd = std::min(suf, n);
+        if (jBegin >= jEnd) continue;
+        for (int j = jBegin; j < jEnd; ++j) {
+            rows[j] = sheets[j]->row(0, y);
+            if constexpr (NCh > 1)
+                planes[j] = sheets[j]->row(1, y) - rows[j];
+            else
+                planes[j] = 0;
+        }
+        const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(e.beta * dy);
+        const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
+        const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
+        for (int x = x0; x <= x1; x += 8) {
+            const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
+            const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
+            const __m256 q = _mm256_add_ps(dx, vshift);
+            const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), vZero);
+            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
+                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
+            // Outside the kernel (and beyond the rectangle) the chord and fp are 0: so is N P.
+            footprint::GaussianSlabLanes::Radial radial = section.radial(
+                r2, _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vHalf)));
+            radial.l2 = _mm256_and_ps(inside, radial.l2);
+            const __m256 plus = radial.pl, minus = _mm256_sub_ps(vZero, radial.pl);
+            const __m256 vPre = ascending ? minus : plus, vSuf = ascending ? plus : minus;
+            const __m256 tc = _mm256_fmadd_ps(vtx, dx, vtyy);
+            auto pAt = [&](int b) {
+                if (b < pre) return vPre;
+                if (b >= suf) return vSuf;
+                if constexpr (Flat) {
+                    const __m256 in =
+                        _mm256_cmp_ps(radial.l2, _mm256_broadcast_ss(fzz + b), _CMP_GT_OQ);
+                    const __m256 p = footprint::GaussianSlabLanes::inside(
+                        radial, _mm256_broadcast_ss(fz + b), _mm256_broadcast_ss(fe + b),
+                        _mm256_broadcast_ss(fq + b));
+                    return _mm256_blendv_ps(fz[b] > 0.0f ? plus : minus, p, in);
+                } else {
+                    return section(radial,
+                                   _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
+                }
+            };
+            __m256 below = pAt(jBegin);
+            for (int j = jBegin; j < jEnd; ++j) {
+                const __m256 above = pAt(j + 1);
+                const __m256 w =
+                    _mm256_mul_ps(vScale, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
+                below = above;
+                float* p = rows[j] + x;
+                for (int c = 0; c < NCh; ++c, p += planes[j]) {
+                    _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
+                }
+            }
+        }
+    }
+    return n * (x1 - x0 + 1) * (y1 - y0 + 1);
+}
 FOOTPRINT_LANES_END
 #endif
 
@@ -146,10 +270,15 @@ int splatSectionsScalar(SheetBuffer<NCh>* const* sheets, int n, const float (&va
                         const footprint::FootprintPoly*, const float* tb) {
     int visited = 0;
     const float ds = e.depthScale, tx = e.tx, ty = e.ty, scale = e.scale;
+    const footprint::GaussianSlab* closed = table.closedForm();
+    const footprint::FootprintTable& fp = table.footprint();
     for (int j = 0; j < n; ++j) {
         const float t0 = std::min(tb[j], tb[j + 1]), t1 = std::max(tb[j], tb[j + 1]);
         visited += sheets[j]->splat(values, sx, sy, e, rect, [&](float r2, float dx, float dy) {
             const float tc = tx * dx + ty * dy;
+            if (closed)
+                return fp.lookup(r2) * closed->fraction(r2, ds * (t0 - tc), ds * (t1 - tc)) *
+                       scale;
             return table.section(r2, ds * (t0 - tc), ds * (t1 - tc)) * scale;
         });
     }
@@ -163,8 +292,19 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
                   const float* tb) {
 #if defined(FOOTPRINT_HAVE_LANES)
     if constexpr (NCh != kLabelChannels)  // labels select by max: the scalar loop
-        if (footprint::cpuHasLanes())
-            return splatSectionsLanes(sheets, n, values, sx, sy, e, rect, table, poly, tb);
+        if (footprint::cpuHasLanes()) {
+            const footprint::GaussianSlab* closed = table.closedForm();
+            if (!closed)
+                return splatSectionsLanes(sheets, n, values, sx, sy, e, rect, table, poly, tb);
+            // Flat when the boundaries' depths vary over the footprint by < 1e-6 kernel units.
+            const float drift =
+                e.depthScale * (std::abs(e.tx) * e.halfWidth + std::abs(e.ty) * e.halfHeight);
+            if (drift <= 1e-6f && n < kMaxFlat)
+                return splatSectionsClosedLanes<NCh, true>(sheets, n, values, sx, sy, e, rect,
+                                                           table.footprint(), *closed, poly, tb);
+            return splatSectionsClosedLanes<NCh, false>(sheets, n, values, sx, sy, e, rect,
+                                                        table.footprint(), *closed, poly, tb);
+        }
 #endif
     return splatSectionsScalar(sheets, n, values, sx, sy, e, rect, table, poly, tb);
 }
