@@ -18,6 +18,8 @@
 #define FOOTPRINT_HAVE_LANES 1
 #include <immintrin.h>
 
+#include <array>
+
 #if defined(__clang__)
 #define FOOTPRINT_LANES_BEGIN \
     _Pragma("clang attribute push(__attribute__((target(\"avx2,fma\"))), apply_to = function)")
@@ -46,6 +48,9 @@ inline bool cpuHasLanes() {
 
 FOOTPRINT_LANES_BEGIN
 
+static_assert(sizeof(std::array<std::array<float, 8>, 8>) == 64 * sizeof(float),
+              "the lanes read a polynomial's coefficient rows as one array");
+
 class FootprintLanes {
   public:
     /// `poly` (optional) must approximate `table`; it is used instead of the table.
@@ -54,12 +59,9 @@ class FootprintLanes {
           data_(table.values_.data()),
           inv_(_mm256_set1_ps(table.invStep_)),
           last_(_mm256_set1_ps(float(table.resolution()))),
+          coef_(poly ? poly->coefficients()[0].data() : nullptr),
           seg_(_mm256_set1_ps(poly ? poly->segmentScale() : 0.0f)),
-          lastSeg_(_mm256_set1_ps(float(FootprintPoly::kSegments - 1))) {
-        if (poly)
-            for (int k = 0; k < FootprintPoly::kMaxCoefficients; ++k)
-                coef_[k] = _mm256_loadu_ps(poly->coefficients()[k].data());
-    }
+          lastSeg_(_mm256_set1_ps(float(FootprintPoly::kSegments - 1))) {}
     /// fp(r2) for r2 >= 0; lanes at or beyond R^2 must be masked by the caller.
     __m256 operator()(__m256 r2) const {
         if (poly_) {
@@ -68,7 +70,12 @@ class FootprintLanes {
             const __m256i seg = _mm256_cvttps_epi32(sf);
             const __m256 u =
                 _mm256_fmsub_ps(_mm256_set1_ps(2.0f), _mm256_sub_ps(s, sf), _mm256_set1_ps(1.0f));
-            auto a = [&](int k) { return _mm256_permutevar8x32_ps(coef_[7 - k], seg); };  // u^k
+            // u^k's coefficients of the 8 segments (read in place: the splatters make one
+            // of these per splat, so the constructor copies nothing)
+            auto a = [&](int k) {
+                return _mm256_permutevar8x32_ps(
+                    _mm256_loadu_ps(coef_ + FootprintPoly::kSegments * (7 - k)), seg);
+            };
             const __m256 u2 = _mm256_mul_ps(u, u), u4 = _mm256_mul_ps(u2, u2);
             const __m256 q0 = _mm256_fmadd_ps(a(1), u, a(0)), q1 = _mm256_fmadd_ps(a(3), u, a(2));
             const __m256 q2 = _mm256_fmadd_ps(a(5), u, a(4)), q3 = _mm256_fmadd_ps(a(7), u, a(6));
@@ -85,8 +92,9 @@ class FootprintLanes {
   private:
     const FootprintPoly* poly_;
     const float* data_;
-    __m256 inv_, last_, seg_, lastSeg_;
-    __m256 coef_[FootprintPoly::kMaxCoefficients] = {};
+    __m256 inv_, last_;
+    const float* coef_;  // FootprintPoly::coefficients(), kMaxCoefficients rows of kSegments
+    __m256 seg_, lastSeg_;
 };
 
 class FractionLanes {
@@ -159,10 +167,8 @@ class GaussianSlabLanes {
           c3_(_mm256_set1_ps(g.c3_ * g.norm_)),
           xMax_(_mm256_set1_ps(g.xMax_)),
           seg_(_mm256_set1_ps(g.segScale_)),
-          lastSeg_(_mm256_set1_ps(float(GaussianSlab::kSegments - 1))) {
-        for (int d = 0; d < GaussianSlab::kCoefficients; ++d)
-            coef_[d] = _mm256_loadu_ps(g.c_[std::size_t(d)].data());
-    }
+          lastSeg_(_mm256_set1_ps(float(GaussianSlab::kSegments - 1))),
+          coef_(g.c_[0].data()) {}
     /// The radial part, N times GaussianSlab::Radial's a and b, with the chord's square
     /// l2 = L^2 and pl = N P(r^2, L), which the caller gives as half the footprint fp(r^2)
     /// (from its table or polynomial: the sections then sum to exactly that footprint).
@@ -199,9 +205,10 @@ class GaussianSlabLanes {
         const __m256i seg = _mm256_cvttps_epi32(tf);
         const __m256 u =
             _mm256_fmsub_ps(_mm256_set1_ps(2.0f), _mm256_sub_ps(t, tf), _mm256_set1_ps(1.0f));
-        __m256 p = _mm256_permutevar8x32_ps(coef_[0], seg);
+        constexpr int S = GaussianSlab::kSegments;
+        __m256 p = _mm256_permutevar8x32_ps(_mm256_loadu_ps(coef_), seg);
         for (int d = 1; d < GaussianSlab::kCoefficients; ++d)
-            p = _mm256_fmadd_ps(p, u, _mm256_permutevar8x32_ps(coef_[d], seg));
+            p = _mm256_fmadd_ps(p, u, _mm256_permutevar8x32_ps(_mm256_loadu_ps(coef_ + S * d), seg));
         return _mm256_or_ps(p, sign);
     }
     /// N e_R k / 3, the cubic term's coefficient.
@@ -228,7 +235,7 @@ class GaussianSlabLanes {
 
   private:
     __m256 r2Max_, k_, eR_, eRk_, alpha_, s_, c3_, xMax_, seg_, lastSeg_;
-    __m256 coef_[GaussianSlab::kCoefficients] = {};
+    const float* coef_;  // GaussianSlab's erf coefficients, kCoefficients rows of kSegments
 };
 
 FOOTPRINT_LANES_END
