@@ -2,7 +2,7 @@
 #include "splat/sequence.h"
 
 #include <tbb/info.h>
-#include <tbb/parallel_pipeline.h>
+#include <tbb/parallel_for.h>
 
 #include <atomic>
 #include <cmath>
@@ -162,36 +162,17 @@ void renderSequence(const Scene& scene, const std::vector<RendererKind>& rendere
         if (std::int64_t(c.width) * c.height <= 256 * 256)
             batch = std::size_t(std::max(threads, 1));
     }
-    if (batch == 1) {
-        for (std::size_t v : views) {
-            SequenceFrame f = renderView(v, 0);
-            if (cancelled) throw Cancelled();
-            sink(std::move(f));
-        }
-        return;
+    for (std::size_t n0 = 0; n0 < views.size(); n0 += batch) {
+        const std::size_t n1 = std::min(views.size(), n0 + batch);
+        std::vector<SequenceFrame> frames(n1 - n0);
+        if (batch == 1)
+            frames[0] = renderView(views[n0], 0);
+        else
+            tbb::parallel_for(n0, n1,
+                              [&](std::size_t n) { frames[n - n0] = renderView(views[n], 1); });
+        if (cancelled) throw Cancelled();
+        for (SequenceFrame& f : frames) sink(std::move(f));
     }
-    // `batch` views at a time, each on one thread, handed to the sink in view order as they
-    // finish: no barrier between batches, and the sink's work (popping's measures) runs while
-    // the next views render. One token more than the views in flight, so a view finished
-    // ahead of its predecessor does not leave a thread idle.
-    std::size_t next = 0;
-    tbb::parallel_pipeline(
-        batch + 1,
-        tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                            [&](tbb::flow_control& fc) -> std::size_t {
-                                                if (next >= views.size() || cancelled) {
-                                                    fc.stop();
-                                                    return 0;
-                                                }
-                                                return views[next++];
-                                            }) &
-            tbb::make_filter<std::size_t, SequenceFrame>(
-                tbb::filter_mode::parallel, [&](std::size_t v) { return renderView(v, 1); }) &
-            tbb::make_filter<SequenceFrame, void>(tbb::filter_mode::serial_in_order,
-                                                  [&](SequenceFrame f) {
-                                                      if (!cancelled) sink(std::move(f));
-                                                  }));
-    if (cancelled) throw Cancelled();
 }
 
 }  // namespace splat
