@@ -65,9 +65,8 @@ TEST_CASE("gaussian slab: sections equal the exact integral to 1e-6 of the footp
             const double exact = footprint::gaussianCumulativeClosedForm(k, r, z1) -
                                  footprint::gaussianCumulativeClosedForm(k, r, z0);
             const double peak = footprint::gaussianFootprintClosedForm(k, 0.0);
-            worst = std::max(worst,
-                             std::abs(fp * g.fraction(float(r2), float(z0), float(z1)) - exact) /
-                                 peak);
+            worst = std::max(
+                worst, std::abs(fp * g.fraction(float(r2), float(z0), float(z1)) - exact) / peak);
             // A partition of the chord into 7 slabs sums to the whole footprint.
             double sum = 0;
             for (int j = 0; j < 7; ++j)
@@ -110,9 +109,9 @@ double laneError(const GaussianSlab& g, const Kernel& k) {
             e[l] = g.erf(zi[l] * g.erfScale());
             q[l] = float(N) * g.cubic() * zi[l] * zi[l] * zi[l];
         }
-        _mm256_store_ps(inner, footprint::GaussianSlabLanes::inside(
-                                   radial, _mm256_load_ps(zi), _mm256_load_ps(e),
-                                   _mm256_load_ps(q)));
+        _mm256_store_ps(inner,
+                        footprint::GaussianSlabLanes::inside(radial, _mm256_load_ps(zi),
+                                                             _mm256_load_ps(e), _mm256_load_ps(q)));
         for (int l = 0; l < 8; ++l) {
             const GaussianSlab::Radial s = g.radial(r2[l]);
             worst = std::max(worst, std::abs(out[l] - N * g.at(s, z[l])));

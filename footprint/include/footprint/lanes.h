@@ -30,8 +30,8 @@
 #endif
 
 #include "footprint/footprint_poly.h"
-#include "footprint/gaussian_slab.h"
 #include "footprint/footprint_table.h"
+#include "footprint/gaussian_slab.h"
 #include "footprint/slab_table.h"
 
 namespace footprint {
@@ -189,7 +189,8 @@ class GaussianSlabLanes {
     __m256 operator()(const Radial& r, __m256 z) const {
         const __m256 l = _mm256_sqrt_ps(r.l2);
         const __m256 zc = _mm256_min_ps(_mm256_max_ps(z, _mm256_sub_ps(_mm256_setzero_ps(), l)), l);
-        return inside(r, zc, erf(_mm256_mul_ps(zc, s_)), _mm256_mul_ps(c3_, _mm256_mul_ps(zc, _mm256_mul_ps(zc, zc))));
+        return inside(r, zc, erf(_mm256_mul_ps(zc, s_)),
+                      _mm256_mul_ps(c3_, _mm256_mul_ps(zc, _mm256_mul_ps(zc, zc))));
     }
     /// N P at a depth z inside the chord whose erf(z / (sigma sqrt 2)) is e and whose cubic
     /// term N e_R k z^3 / 3 is q: a e - b z + q.
@@ -208,7 +209,8 @@ class GaussianSlabLanes {
         constexpr int S = GaussianSlab::kSegments;
         __m256 p = _mm256_permutevar8x32_ps(_mm256_loadu_ps(coef_), seg);
         for (int d = 1; d < GaussianSlab::kCoefficients; ++d)
-            p = _mm256_fmadd_ps(p, u, _mm256_permutevar8x32_ps(_mm256_loadu_ps(coef_ + S * d), seg));
+            p = _mm256_fmadd_ps(p, u,
+                                _mm256_permutevar8x32_ps(_mm256_loadu_ps(coef_ + S * d), seg));
         return _mm256_or_ps(p, sign);
     }
     /// N e_R k / 3, the cubic term's coefficient.
@@ -228,8 +230,8 @@ class GaussianSlabLanes {
         p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(0.5f));
         p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.0f));
         p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.0f));
-        const __m256i e = _mm256_slli_epi32(
-            _mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
+        const __m256i e =
+            _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
         return _mm256_mul_ps(p, _mm256_castsi256_ps(e));
     }
 

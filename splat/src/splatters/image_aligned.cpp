@@ -224,8 +224,8 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
             const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
                                                 _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
             // Outside the kernel (and beyond the rectangle) the chord and fp are 0: so is N P.
-            footprint::GaussianSlabLanes::Radial radial = section.radial(
-                r2, _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vHalf)));
+            footprint::GaussianSlabLanes::Radial radial =
+                section.radial(r2, _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vHalf)));
             radial.l2 = _mm256_and_ps(inside, radial.l2);
             const __m256 plus = radial.pl, minus = _mm256_sub_ps(vZero, radial.pl);
             const __m256 vPre = ascending ? minus : plus, vSuf = ascending ? plus : minus;
@@ -277,8 +277,7 @@ int splatSectionsScalar(SheetBuffer<NCh>* const* sheets, int n, const float (&va
         visited += sheets[j]->splat(values, sx, sy, e, rect, [&](float r2, float dx, float dy) {
             const float tc = tx * dx + ty * dy;
             if (closed)
-                return fp.lookup(r2) * closed->fraction(r2, ds * (t0 - tc), ds * (t1 - tc)) *
-                       scale;
+                return fp.lookup(r2) * closed->fraction(r2, ds * (t0 - tc), ds * (t1 - tc)) * scale;
             return table.section(r2, ds * (t0 - tc), ds * (t1 - tc)) * scale;
         });
     }
