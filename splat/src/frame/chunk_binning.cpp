@@ -82,6 +82,7 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
     auto runStart = [&](std::size_t r) { return r < runCount ? std::size_t(runs[r]) : n; };
     out.sx.resize(n);
     out.sy.resize(n);
+    if (fields.value) out.value.resize(n);
     out.rect.resize(n);
     out.visible.resize(n);
     out.entry.resize(n);
@@ -112,7 +113,11 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
         };
         for (std::size_t run = std::min(runCount, c * runsPerPart); run < re; ++run) {
             const std::size_t a = runs[run], b = runs[run + 1];
-            if (run + kAhead < re) projector.prefetch(order[runs[run + kAhead]]);
+            if (run + kAhead < re) {
+                const std::uint32_t ahead = order[runs[run + kAhead]];
+                projector.prefetch(ahead);
+                if (fields.value) __builtin_prefetch(&fields.value[ahead]);
+            }
             const bool oneSheet =
                 ortho && b - a <= 0xFFFF && (!fields.slice || fields.slice[order[a]] == fields.slice[order[b - 1]]);
             // Orthographic: positions are affine along a volume row; a run along another
@@ -122,8 +127,13 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
                 const SplatProjector::Row last = projector.row(order[b - 1]);
                 return last.x0 == row.x0 && last.y0 == row.y0;
             }();
+            // The sweep reads a splat's palette entry by chunk position, not by id at random.
+            auto copyValue = [&](std::size_t q) {
+                if (fields.value) out.value[q] = fields.value[order[q]];
+            };
             auto project = [&](std::size_t q) {
                 if (!alongRow && b - a >= 2) row = projector.row(order[q]);
+                copyValue(q);
                 return projector.project(row, order[q], out.sx[q], out.sy[q]);
             };
             // A run in one sheet is tested by its exact box below; another is first tested
@@ -170,7 +180,8 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
             for (std::size_t q = a; q < b; ++q) {
                 const PixelRect r =
                     ortho ? project(q)
-                          : projector.project(order[q], out.sx[q], out.sy[q], &out.each[q]);
+                          : (copyValue(q),
+                             projector.project(order[q], out.sx[q], out.sy[q], &out.each[q]));
                 out.entry[q] = 1;
                 h += !list(q, r);
             }

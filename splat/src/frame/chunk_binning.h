@@ -126,7 +126,8 @@ struct ChunkBins {
     std::vector<std::uint32_t> begin;                  ///< grid.count() + 1 offsets into records
     std::vector<RunRecord> records;                    ///< per tile, in visiting order
     std::vector<footprint::EllipticalFootprint> each;  ///< perspective: per chunk position
-    std::vector<float> sx, sy;                         ///< scratch: per chunk position
+    std::vector<float> sx, sy;                         ///< per chunk position
+    std::vector<std::uint16_t> value;                  ///< per chunk position (fields.value)
     std::vector<PixelRect> rect;                       ///< scratch: boxes of the entries
     std::vector<std::uint32_t> visible;                ///< scratch: tiles where visible
     std::vector<std::uint32_t> entry;                  ///< scratch: splats per entry

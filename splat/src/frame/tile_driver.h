@@ -177,7 +177,7 @@ struct ChunkRecords {
         for (std::uint32_t q = r.local, e = r.local + r.count; q < e; ++q) {
             const std::uint32_t id = order[q];
             f(SplatRecord{id, q, bins.sx[q], bins.sy[q], r.slice,
-                          fields.value ? fields.value[id] : std::uint16_t(0)});
+                          fields.value ? bins.value[q] : std::uint16_t(0)});
         }
     }
     const footprint::EllipticalFootprint& ellipse(const SplatRecord& r) const {
