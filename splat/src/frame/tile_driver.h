@@ -11,7 +11,8 @@
 //
 // A Cutter says which sheet a splat starts in (key, in visiting order), how many sheets it
 // spans, and how its kernel is cut into them, each from the splat's record in the tile's
-// list (the Source's: SplatRecord or SheetRecord); that is all that differs between the
+// list (the Source's: SheetRecord, or a SplatRecord per splat of a chunk's RunRecord, which
+// lists a run of splats in one sheet as one entry); that is all that differs between the
 // axis-aligned (one sheet: the whole footprint) and the image-aligned splatter (every slab
 // it crosses: slab sections).
 #include <tbb/enumerable_thread_specific.h>
