@@ -9,6 +9,7 @@
 #include <random>
 
 #include "footprint/lanes.h"
+#include "frame/chunk_binning.h"
 #include "frame/compositing.h"
 #include "frame/tile_binning.h"
 #include "model/scene_impl.h"
@@ -67,6 +68,109 @@ TEST_CASE("binning: every tile lists exactly the splats whose rectangle touches 
             REQUIRE(rec.depth == p.depth[rec.id]);
         }
         REQUIRE(got == expected);
+    }
+}
+
+TEST_CASE("chunk binning: runs in one sheet list every splat whose box touches a tile, in order",
+          "[stages]") {
+    // Splats of a 20^3 grid (a random third left out) in runs along rows (i, as the cells) and
+    // along columns (j, as the slabs across i), from several directions. Expanding a tile's
+    // entries and keeping the splats whose footprint box touches the tile (as the sweep does)
+    // must give exactly the splats per-splat binning lists there, in visiting order, with the
+    // screen positions of their own volume row.
+    const Volume v = makeSynthetic("phantom", 20);
+    const int n = 20;
+    SplatList splats;
+    splats.origin = v.origin;
+    splats.spacing = v.spacing;
+    std::mt19937 rng(3);
+    std::vector<int> at(std::size_t(n * n * n), -1);
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i)
+                if (rng() % 3 != 0) {
+                    at[std::size_t((k * n + j) * n + i)] = int(splats.i.size());
+                    splats.i.push_back(std::uint16_t(i));
+                    splats.j.push_back(std::uint16_t(j));
+                    splats.k.push_back(std::uint16_t(k));
+                }
+    // Runs along i (cells of 8) and along j (8 rows, one slice i at a time).
+    std::vector<std::uint32_t> rowIds, rowRuns{0}, colIds, colRuns{0};
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i0 = 0; i0 < n; i0 += 8) {
+                for (int i = i0; i < std::min(n, i0 + 8); ++i)
+                    if (at[std::size_t((k * n + j) * n + i)] >= 0)
+                        rowIds.push_back(std::uint32_t(at[std::size_t((k * n + j) * n + i)]));
+                if (rowIds.size() != rowRuns.back()) rowRuns.push_back(std::uint32_t(rowIds.size()));
+            }
+    for (int k = 0; k < n; ++k)
+        for (int j0 = 0; j0 < n; j0 += 8)
+            for (int i = 0; i < n; ++i) {
+                for (int j = j0; j < std::min(n, j0 + 8); ++j)
+                    if (at[std::size_t((k * n + j) * n + i)] >= 0)
+                        colIds.push_back(std::uint32_t(at[std::size_t((k * n + j) * n + i)]));
+                if (colIds.size() != colRuns.back()) colRuns.push_back(std::uint32_t(colIds.size()));
+            }
+    const TileGrid grid(48, 40, 16);
+    const std::vector<TileAccumulator> noTiles;
+    const Occlusion occlusion(grid, noTiles, false);
+    for (double az : {20.0, 70.0, 135.0}) {
+        CameraParams params;
+        params.width = 48;
+        params.height = 40;
+        params.azimuthDeg = az;
+        params.elevationDeg = 15.0;
+        const Camera camera(params, v);
+        const SplatProjector projector(splats, camera, v.spacing, 2.0);
+        // slice = j: the row runs are in one sheet each; slice = i: they cross sheets (one
+        // entry per splat) and the column runs are in one sheet each.
+        for (int pass = 0; pass < 3; ++pass) {
+            const bool columns = pass == 2;
+            const std::vector<std::uint32_t>& ids = columns ? colIds : rowIds;
+            const std::vector<std::uint32_t>& runs = columns ? colRuns : rowRuns;
+            const SplatRecordFields fields{pass == 0 ? splats.j.data() : splats.i.data(), nullptr};
+            ChunkBins bins;
+            const VisitOrder order{&ids, ids.size(), false};
+            REQUIRE(binChunk(projector, order, runs, grid, occlusion, fields, bins) == 0);
+            std::size_t pairs = 0, records = 0;
+            for (int t = 0; t < grid.count(); ++t) {
+                const int ox = (t % grid.tilesX) * 16, oy = (t / grid.tilesX) * 16;
+                auto touches = [&](const PixelRect& r) {
+                    return !r.empty() && r.x0 <= ox + 15 && r.x1 >= ox && r.y0 <= oy + 15 &&
+                           r.y1 >= oy;
+                };
+                std::vector<std::uint32_t> expected, got;
+                for (std::size_t q = 0; q < ids.size(); ++q) {
+                    float sx, sy;
+                    const std::uint32_t id = ids[q];
+                    if (touches(projector.project(projector.row(id), id, sx, sy)))
+                        expected.push_back(id);
+                }
+                for (std::uint32_t e = bins.begin[t]; e < bins.begin[t + 1]; ++e, ++records) {
+                    const RunRecord& rec = bins.records[e];
+                    for (std::uint32_t q = rec.local; q < rec.local + rec.count; ++q) {
+                        const std::uint32_t id = ids[q];
+                        REQUIRE(rec.slice == fields.slice[id]);
+                        float sx, sy;
+                        projector.project(projector.row(id), id, sx, sy);
+                        REQUIRE(bins.sx[q] == sx);
+                        REQUIRE(bins.sy[q] == sy);
+                        if (touches(footprintRect(sx, sy, projector.shared(), grid.width,
+                                                  grid.height)))
+                            got.push_back(id);
+                    }
+                }
+                REQUIRE(got == expected);
+                pairs += expected.size();
+            }
+            INFO("azimuth " << az << " pass " << pass << ": " << records << " entries for "
+                            << pairs << " splat-tile pairs");
+            if (pass == 1)
+                CHECK(records == pairs);  // runs across sheets: an entry per splat and tile
+            else
+                CHECK(records * 2 < pairs);  // runs in one sheet: one per run and tile
+        }
     }
 }
 

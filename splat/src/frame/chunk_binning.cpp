@@ -26,6 +26,19 @@ void forTilesOf(const PixelRect& r, const TileGrid& g, F&& f) {
     for (int ty = ty0; ty <= ty1; ++ty)
         for (int tx = tx0; tx <= tx1; ++tx) f(tx, ty, k++);
 }
+/// The pixel box holding the footprint boxes (footprintRect) of every centre in
+/// [x0, x1] x [y0, y1]: float rounding is monotone, so each of theirs lies inside.
+PixelRect footprintRectOfCentres(float x0, float x1, float y0, float y1,
+                                 const footprint::EllipticalFootprint& e, int width, int height) {
+    const float fx0 = std::ceil(x0 - e.halfWidth - 0.5f), fx1 = std::floor(x1 + e.halfWidth - 0.5f);
+    const float fy0 = std::ceil(y0 - e.halfHeight - 0.5f),
+                fy1 = std::floor(y1 + e.halfHeight - 0.5f);
+    if (!(fx1 >= 0.0f) || !(fy1 >= 0.0f) || !(fx0 <= float(width - 1)) ||
+        !(fy0 <= float(height - 1)) || fx0 > fx1 || fy0 > fy1)
+        return {1, 1, 0, 0};
+    return {int(std::max(fx0, 0.0f)), int(std::max(fy0, 0.0f)),
+            int(std::min(fx1, float(width - 1))), int(std::min(fy1, float(height - 1)))};
+}
 }  // namespace
 
 Occlusion::Occlusion(const TileGrid& grid, const std::vector<TileAccumulator>& tiles, bool cull)
@@ -65,35 +78,73 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
     const std::size_t n = runs.empty() ? 0 : runs.back(), tileCount = std::size_t(grid.count());
     const std::size_t runCount = runs.empty() ? 0 : runs.size() - 1;
     const std::size_t runsPerPart = (runCount + kParts - 1) / kParts;
-    // Part c: runs [c runsPerPart, (c + 1) runsPerPart), positions partStart(c) ..
-    auto partStart = [&](std::size_t c) { return runs[std::min(runCount, c * runsPerPart)]; };
+    // Position of run r's first splat (n from runCount on).
+    auto runStart = [&](std::size_t r) { return r < runCount ? std::size_t(runs[r]) : n; };
     out.sx.resize(n);
     out.sy.resize(n);
+    if (fields.value) out.value.resize(n);
     out.rect.resize(n);
     out.visible.resize(n);
+    out.entry.resize(n);
     if (projector.perspective()) out.each.resize(n);
     out.counts.assign(kParts * tileCount, 0);
     std::vector<std::size_t> hidden(kParts, 0);
     const bool ortho = !projector.perspective(), runBoxes = cull && ortho;
-    // Pass 1: project, and count the tiles where each splat is visible. A run (splats of one
-    // row, between its first and last) whose box is hidden everywhere is skipped whole.
+    const footprint::EllipticalFootprint& shared = projector.shared();
+    // Pass 1: project, and count the tiles where each entry (a run in one sheet, or a splat;
+    // at the entry's first position q: entry[q] splats, box rect[q], tiles visible[q]) is
+    // visible. A run whose box is hidden everywhere is skipped whole.
     tbb::parallel_for(std::size_t(0), kParts, [&](std::size_t c) {
         std::uint32_t* cnt = &out.counts[c * tileCount];
         const std::size_t re = std::min(runCount, (c + 1) * runsPerPart);
         std::size_t h = 0;
+        // Lists the entry at q (box r) in the tiles where it is visible.
+        auto list = [&](std::size_t q, const PixelRect& r) {
+            std::uint32_t bits = 0;
+            if (!r.empty())
+                forTilesOf(r, grid, [&](int tx, int ty, int k) {
+                    const bool v = k >= kMaskTiles || occlusion.visible(r, tx, ty);
+                    cnt[ty * grid.tilesX + tx] += v;
+                    bits |= std::uint32_t(v) << std::min(k, kMaskTiles);
+                });
+            out.rect[q] = r;
+            out.visible[q] = bits;
+            return bits != 0 || r.empty();
+        };
         for (std::size_t run = std::min(runCount, c * runsPerPart); run < re; ++run) {
             const std::size_t a = runs[run], b = runs[run + 1];
-            if (run + kAhead < re) projector.prefetch(order[runs[run + kAhead]]);
-            // Orthographic: the run's positions are affine along its row.
-            const SplatProjector::Row row =
-                ortho ? projector.row(order[a]) : SplatProjector::Row{0, 0, 0, 0};
-            if (runBoxes && b - a >= 2) {
-                float xa, ya, xb, yb;
-                projector.project(row, order[a], xa, ya);
-                projector.project(row, order[b - 1], xb, yb);
+            if (run + kAhead < re) {
+                const std::uint32_t ahead = order[runs[run + kAhead]];
+                projector.prefetch(ahead);
+                if (fields.value) __builtin_prefetch(&fields.value[ahead]);
+            }
+            const bool oneSheet =
+                ortho && b - a <= 0xFFFF && (!fields.slice || fields.slice[order[a]] == fields.slice[order[b - 1]]);
+            // Orthographic: positions are affine along a volume row; a run along another
+            // line (a column) takes each splat's own row.
+            SplatProjector::Row row = ortho ? projector.row(order[a]) : SplatProjector::Row{};
+            const bool alongRow = ortho && b - a >= 2 && [&] {
+                const SplatProjector::Row last = projector.row(order[b - 1]);
+                return last.x0 == row.x0 && last.y0 == row.y0;
+            }();
+            // The sweep reads a splat's palette entry by chunk position, not by id at random.
+            auto copyValue = [&](std::size_t q) {
+                if (fields.value) out.value[q] = fields.value[order[q]];
+            };
+            auto project = [&](std::size_t q) {
+                if (!alongRow && b - a >= 2) row = projector.row(order[q]);
+                copyValue(q);
+                return projector.project(row, order[q], out.sx[q], out.sy[q]);
+            };
+            // A run in one sheet is tested by its exact box below; another is first tested
+            // by the box of its ends, before its inner splats are projected.
+            if (runBoxes && b - a >= 2 && !oneSheet) {
+                project(a);
+                project(b - 1);
+                const float xa = out.sx[a], ya = out.sy[a], xb = out.sx[b - 1], yb = out.sy[b - 1];
                 // Every centre of the run lies between the two ends: one box (widened by a
                 // pixel against rounding) holds all their footprint boxes.
-                footprint::EllipticalFootprint e = projector.shared();
+                footprint::EllipticalFootprint e = shared;
                 e.halfWidth += 0.5f * std::abs(xa - xb) + 1.0f;
                 e.halfHeight += 0.5f * std::abs(ya - yb) + 1.0f;
                 const PixelRect box =
@@ -104,25 +155,35 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
                         any |= k >= kMaskTiles || occlusion.visible(box, tx, ty);
                     });
                 if (!any) {
-                    for (std::size_t q = a; q < b; ++q) out.visible[q] = 0;
+                    out.entry[a] = std::uint32_t(b - a);
+                    out.visible[a] = 0;
                     h += b - a;
                     continue;
                 }
             }
+            if (oneSheet) {
+                // One entry: the box of the footprints of every centre of the run.
+                float x0 = 1e30f, x1 = -1e30f, y0 = 1e30f, y1 = -1e30f;
+                for (std::size_t q = a; q < b; ++q) {
+                    project(q);
+                    x0 = std::min(x0, out.sx[q]);
+                    x1 = std::max(x1, out.sx[q]);
+                    y0 = std::min(y0, out.sy[q]);
+                    y1 = std::max(y1, out.sy[q]);
+                }
+                out.entry[a] = std::uint32_t(b - a);
+                if (!list(a, footprintRectOfCentres(x0, x1, y0, y1, shared, grid.width,
+                                                    grid.height)))
+                    h += b - a;
+                continue;
+            }
             for (std::size_t q = a; q < b; ++q) {
                 const PixelRect r =
-                    ortho ? projector.project(row, order[q], out.sx[q], out.sy[q])
-                          : projector.project(order[q], out.sx[q], out.sy[q], &out.each[q]);
-                out.rect[q] = r;
-                std::uint32_t bits = 0;
-                if (!r.empty())
-                    forTilesOf(r, grid, [&](int tx, int ty, int k) {
-                        const bool v = k >= kMaskTiles || occlusion.visible(r, tx, ty);
-                        cnt[ty * grid.tilesX + tx] += v;
-                        bits |= std::uint32_t(v) << std::min(k, kMaskTiles);
-                    });
-                out.visible[q] = bits;
-                h += bits == 0 && !r.empty();
+                    ortho ? project(q)
+                          : (copyValue(q),
+                             projector.project(order[q], out.sx[q], out.sy[q], &out.each[q]));
+                out.entry[q] = 1;
+                h += !list(q, r);
             }
         }
         hidden[c] = h;
@@ -140,22 +201,17 @@ std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
     }
     out.begin[tileCount] = std::uint32_t(total);
     out.records.resize(total);
-    // Pass 2: the records.
+    // Pass 2: the records, entry by entry over the same runs as pass 1.
     tbb::parallel_for(std::size_t(0), kParts, [&](std::size_t c) {
         std::uint32_t* next = &out.counts[c * tileCount];
-        const std::size_t e = partStart(c + 1);
-        for (std::size_t q = partStart(c); q < e; ++q) {
-            if (q + kAheadPositions < e) {
-                const std::uint32_t ahead = order[q + kAheadPositions];
-                if (fields.slice) __builtin_prefetch(&fields.slice[ahead]);
-                if (fields.value) __builtin_prefetch(&fields.value[ahead]);
-            }
+        const std::size_t e = runStart((c + 1) * runsPerPart);
+        for (std::size_t q = runStart(c * runsPerPart); q < e; q += out.entry[q]) {
+            if (q + kAheadPositions < e && fields.slice)
+                __builtin_prefetch(&fields.slice[order[q + kAheadPositions]]);
             const std::uint32_t bits = out.visible[q];
             if (bits == 0) continue;
-            const std::uint32_t id = order[q];
-            const SplatRecord rec{id, std::uint32_t(q), out.sx[q], out.sy[q],
-                                  fields.slice ? fields.slice[id] : std::uint16_t(0),
-                                  fields.value ? fields.value[id] : std::uint16_t(0)};
+            const RunRecord rec{std::uint32_t(q), std::uint16_t(out.entry[q]),
+                                fields.slice ? fields.slice[order[q]] : std::uint16_t(0)};
             forTilesOf(out.rect[q], grid, [&](int tx, int ty, int k) {
                 if (bits >> std::min(k, kMaskTiles) & 1)
                     out.records[next[ty * grid.tilesX + tx]++] = rec;

@@ -70,15 +70,25 @@ class BrickTest {
     const Occlusion& occlusion_;
 };
 
-/// One entry of a tile's list: the splat, its position in the chunk, its screen centre, its
-/// slice along the sheet axis and its palette entry (written by binning, so that the tile
-/// sweep and its sort by sheet stream through the records instead of reading the per-splat
-/// arrays by id; 20 bytes).
+/// One splat as the tile sweep reads it: its index, its position in the chunk, its screen
+/// centre, its slice along the sheet axis and its palette entry (made by ChunkRecords from a
+/// RunRecord and the chunk's arrays).
 struct SplatRecord {
     std::uint32_t id, local;
     float sx, sy;
     std::uint16_t slice;  ///< SplatRecordFields::slice[id] (0 without)
     std::uint16_t value;  ///< SplatRecordFields::value[id] (0 without)
+};
+
+/// One entry of a tile's list: a run of `count` splats at consecutive chunk positions from
+/// `local`, all in one sheet (their `slice`), of which at least the run's box touches the
+/// tile where it was not yet opaque (8 bytes; a splat that does not reach the tile or is
+/// hidden there is left out by the sweep's own per-splat tests). Binning and sorting by sheet
+/// handle a run of up to a cell's splats as one entry, not each splat.
+struct RunRecord {
+    std::uint32_t local;
+    std::uint16_t count;
+    std::uint16_t slice;
 };
 
 /// The per-splat arrays binChunk copies into each record (either may be null).
@@ -100,8 +110,8 @@ struct VisitOrder {
 
 /// What a streaming splatter hands the chunked tile stage (tile_driver.h): `count` chunks
 /// of whole sheets in visiting order; gather(c, ids, runs) lists chunk c's splats in any
-/// order (binning sorts each tile's records by sheet, stably), cut into runs along volume
-/// rows (binChunk), and may leave out the splats of bricks `visible` says are hidden
+/// order (binning sorts each tile's records by sheet, stably), cut into runs along lines of
+/// voxels (binChunk), and may leave out the splats of bricks `visible` says are hidden
 /// (returning how many it left out). Its cutter spans one sheet per splat (a ring of one),
 /// so no sheet is pending between chunks.
 struct SheetChunks {
@@ -114,21 +124,28 @@ struct SheetChunks {
 /// One chunk's splats binned to tiles (arrays reused from chunk to chunk and frame to frame).
 struct ChunkBins {
     std::vector<std::uint32_t> begin;                  ///< grid.count() + 1 offsets into records
-    std::vector<SplatRecord> records;                  ///< per tile, in visiting order
+    std::vector<RunRecord> records;                    ///< per tile, in visiting order
     std::vector<footprint::EllipticalFootprint> each;  ///< perspective: per chunk position
-    std::vector<float> sx, sy;                         ///< scratch: per chunk position
-    std::vector<PixelRect> rect;                       ///< scratch: footprint boxes
+    std::vector<float> sx, sy;                         ///< per chunk position
+    std::vector<std::uint16_t> value;                  ///< per chunk position (fields.value)
+    std::vector<PixelRect> rect;                       ///< scratch: boxes of the entries
     std::vector<std::uint32_t> visible;                ///< scratch: tiles where visible
+    std::vector<std::uint32_t> entry;                  ///< scratch: splats per entry
     std::vector<std::uint32_t> counts;                 ///< scratch: per part and tile
     std::vector<std::uint32_t> ids;                    ///< scratch: the chunk's splats
     std::vector<std::uint32_t> runs;                   ///< scratch: their runs
 };
 
 /// Projects the splats order[0, runs.back()) and bins the visible ones into `out`. `runs`
-/// cuts them into runs (run r: positions [runs[r], runs[r + 1])) of splats on one segment
-/// of a volume row, first and last at its ends: with culling, a run whose box is hidden in
-/// every tile it touches is skipped without projecting its inner splats, and a splat is
-/// left out of every tile that `occlusion` says is opaque over its footprint box there.
+/// cuts them into runs (run r: positions [runs[r], runs[r + 1])) of splats on one line of
+/// voxels (a segment of a volume row or column), first and last at its ends. In an
+/// orthographic view a run whose splats share a sheet (the slices of its ends are equal: the
+/// slice index is monotone along a line) is one entry, binned by the box of its centres'
+/// footprints; every other splat is an entry of its own, binned by its footprint box. With
+/// culling, a run whose box is hidden in every tile it touches is skipped without projecting
+/// its inner splats, and an entry is left out of every tile that `occlusion` says is opaque
+/// over its box there (the sweep tests each splat again: as opacity only grows, it draws
+/// exactly the splats that per-splat binning would have listed, in the same order).
 /// Returns the splats left out of every tile they touch.
 std::size_t binChunk(const SplatProjector& projector, const VisitOrder& order,
                      const std::vector<std::uint32_t>& runs, const TileGrid& grid,

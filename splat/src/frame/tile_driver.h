@@ -11,7 +11,8 @@
 //
 // A Cutter says which sheet a splat starts in (key, in visiting order), how many sheets it
 // spans, and how its kernel is cut into them, each from the splat's record in the tile's
-// list (the Source's: SplatRecord or SheetRecord); that is all that differs between the
+// list (the Source's: SheetRecord, or a SplatRecord per splat of a chunk's RunRecord, which
+// lists a run of splats in one sheet as one entry); that is all that differs between the
 // axis-aligned (one sheet: the whole footprint) and the image-aligned splatter (every slab
 // it crosses: slab sections).
 #include <tbb/enumerable_thread_specific.h>
@@ -147,6 +148,10 @@ struct BinnedSplats {
     std::uint32_t begin() const { return in.bins.begin[t]; }
     std::uint32_t end() const { return in.bins.begin[t + 1]; }
     const SheetRecord& record(std::uint32_t q) const { return in.bins.records[q]; }
+    template <class F>
+    void forEachSplat(const SheetRecord& r, F&& f) const {
+        f(r);
+    }
     const footprint::EllipticalFootprint& ellipse(const SheetRecord& r) const {
         return in.proj.ellipse(r.id);
     }
@@ -156,15 +161,26 @@ struct BinnedSplats {
     }
 };
 
-/// A tile's records of one chunk (chunk_binning.h).
+/// A tile's records of one chunk (chunk_binning.h): runs of splats in one sheet.
 struct ChunkRecords {
     const ChunkBins& bins;
     const SplatProjector& projector;
     const TileGrid& grid;
+    const VisitOrder& order;
+    const SplatRecordFields& fields;
     int t;
     std::uint32_t begin() const { return bins.begin[t]; }
     std::uint32_t end() const { return bins.begin[t + 1]; }
-    const SplatRecord& record(std::uint32_t q) const { return bins.records[q]; }
+    const RunRecord& record(std::uint32_t q) const { return bins.records[q]; }
+    /// Calls f(SplatRecord) for each splat of the run, in visiting order.
+    template <class F>
+    void forEachSplat(const RunRecord& r, F&& f) const {
+        for (std::uint32_t q = r.local, e = r.local + r.count; q < e; ++q) {
+            const std::uint32_t id = order[q];
+            f(SplatRecord{id, q, bins.sx[q], bins.sy[q], r.slice,
+                          fields.value ? bins.value[q] : std::uint16_t(0)});
+        }
+    }
     const footprint::EllipticalFootprint& ellipse(const SplatRecord& r) const {
         return projector.perspective() ? bins.each[r.local] : projector.shared();
     }
@@ -191,21 +207,22 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
     bool pending = false;
     while (next < end || pending) {
         if (!pending) step = std::max(step, cutter.key(src.record(next)));  // skip empty sheets
-        for (; next < end && cutter.key(src.record(next)) == step; ++next) {
-            const auto& rec = src.record(next);
-            const PixelRect r = clipToTile(src.rect(rec), grid, ox, oy);
-            if (acc.rectOpaque(r.x0 - ox, r.y0 - oy, r.x1 - ox, r.y1 - oy)) {
-                ++cnt.culled;
-                continue;
-            }
-            const std::uint32_t n = cutter.span(rec);
-            for (std::uint32_t j = 0; j < n; ++j) target[j] = sheets[(step + j) % ring];
-            float v[NCh];
-            recordValues<Policy>(in, rec, v);
-            cnt.footprintPixels += cutter.cut(target, rec, v, src.ellipse(rec), r);
-            pendingEnd = std::max(pendingEnd, step + n - 1);
-            pending = true;
-        }
+        for (; next < end && cutter.key(src.record(next)) == step; ++next)
+            src.forEachSplat(src.record(next), [&](const auto& rec) {
+                const PixelRect r = clipToTile(src.rect(rec), grid, ox, oy);
+                if (r.empty()) return;  // a splat of a run that misses this tile
+                if (acc.rectOpaque(r.x0 - ox, r.y0 - oy, r.x1 - ox, r.y1 - oy)) {
+                    ++cnt.culled;
+                    return;
+                }
+                const std::uint32_t n = cutter.span(rec);
+                for (std::uint32_t j = 0; j < n; ++j) target[j] = sheets[(step + j) % ring];
+                float v[NCh];
+                recordValues<Policy>(in, rec, v);
+                cnt.footprintPixels += cutter.cut(target, rec, v, src.ellipse(rec), r);
+                pendingEnd = std::max(pendingEnd, step + n - 1);
+                pending = true;
+            });
         SheetBuffer<NCh>& sheet = *sheets[step % ring];
         if (sheet.dirty()) {
             acc.setSheet(step);
@@ -311,13 +328,12 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
 
 /// Sorts records [first, last) stably by the cutter's sheet key (a counting sort: a chunk
 /// spans few sheets).
-template <class Cutter>
-void sortBySheet(const Cutter& cutter, SplatRecord* first, SplatRecord* last,
-                 std::vector<SplatRecord>& scratch) {
+template <class Cutter, class Record>
+void sortBySheet(const Cutter& cutter, Record* first, Record* last, std::vector<Record>& scratch) {
     if (last - first < 2) return;
     std::uint32_t lo = cutter.key(*first), hi = lo;
     bool sorted = true;
-    for (SplatRecord* r = first + 1; r != last; ++r) {
+    for (Record* r = first + 1; r != last; ++r) {
         const std::uint32_t k = cutter.key(*r);
         sorted &= k >= cutter.key(*(r - 1));
         lo = std::min(lo, k);
@@ -325,10 +341,10 @@ void sortBySheet(const Cutter& cutter, SplatRecord* first, SplatRecord* last,
     }
     if (sorted) return;
     std::vector<std::uint32_t> start(std::size_t(hi - lo) + 2, 0);
-    for (SplatRecord* r = first; r != last; ++r) ++start[cutter.key(*r) - lo + 1];
+    for (Record* r = first; r != last; ++r) ++start[cutter.key(*r) - lo + 1];
     for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
     scratch.resize(std::size_t(last - first));
-    for (SplatRecord* r = first; r != last; ++r) scratch[start[cutter.key(*r) - lo]++] = *r;
+    for (Record* r = first; r != last; ++r) scratch[start[cutter.key(*r) - lo]++] = *r;
     std::copy(scratch.begin(), scratch.end(), first);
 }
 
@@ -361,7 +377,7 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
     tbb::enumerable_thread_specific<std::unique_ptr<SheetBuffer<NCh>>> scratch;
     double binMs = 0, tilesMs = 0;
     std::size_t hidden = 0;
-    tbb::enumerable_thread_specific<std::vector<SplatRecord>> sortScratch;
+    tbb::enumerable_thread_specific<std::vector<RunRecord>> sortScratch;
     const SplatList& splats = in.scene.splats;
     const SplatRecordFields fields{cutter.sliceIndex(),
                                    splats.paletted() ? splats.emissionIndex.data() : nullptr};
@@ -370,8 +386,8 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
         const auto t0 = Clock::now();
         const Occlusion occlusion(g, tiles, cull);
         hidden += sc.gather(c, bins.ids, bins.runs, BrickTest(projector, occlusion));
-        hidden += binChunk(projector, VisitOrder{&bins.ids, bins.ids.size(), false}, bins.runs, g,
-                           occlusion, fields, bins);
+        const VisitOrder order{&bins.ids, bins.ids.size(), false};
+        hidden += binChunk(projector, order, bins.runs, g, occlusion, fields, bins);
         const auto t1 = Clock::now();
         tbb::parallel_for(0, g.count(), 1, [&](int t) {
             if (bins.begin[t] == bins.begin[t + 1] || progress.stopped()) return;
@@ -385,7 +401,8 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
             sheet->moveTo(ox, oy, acc.width(), acc.height());
             SheetBuffer<NCh>* ring[1] = {sheet.get()};
             const std::vector<float> tileScale = tilePathScale(pathScale, g, t);
-            sweepTile(in, policy, cutter, ChunkRecords{bins, projector, g, t}, g, t, acc, ring, 1,
+            sweepTile(in, policy, cutter, ChunkRecords{bins, projector, g, order, fields, t}, g, t,
+                      acc, ring, 1,
                       tileScale.empty() ? nullptr : tileScale.data(), counters[std::size_t(t)]);
         });
         binMs += ms(t0, t1);

@@ -25,22 +25,56 @@ SheetAxis sheetAxis(const glm::dvec3& view, const glm::dvec3& spacing) {
 
 namespace {
 
-/// Adds values * fp(r^2) * e.scale, the whole footprint, to the pixels of `rect`: eight
-/// pixels at a time where AVX2 is available (fp from the polynomial when given).
 #if defined(FOOTPRINT_HAVE_LANES)
 FOOTPRINT_LANES_BEGIN
-template <int NCh>
+/// fp(r^2) for eight r^2 >= 0 from a footprint polynomial of degree <= 5 (lanes at or beyond
+/// R^2 masked by the caller): footprint::FootprintLanes' evaluation without its terms of
+/// degree 6 and 7, which are exact zeros there, so every value is the same to the bit and
+/// a lookup costs two permutes and two fused multiply-adds less (the default Gaussian's
+/// polynomial has degree 5).
+class Degree5Lanes {
+  public:
+    explicit Degree5Lanes(const footprint::FootprintPoly& poly)
+        : seg_(_mm256_set1_ps(poly.segmentScale())),
+          lastSeg_(_mm256_set1_ps(float(footprint::FootprintPoly::kSegments - 1))) {
+        for (int k = 0; k < 6; ++k)
+            coef_[k] = _mm256_loadu_ps(
+                poly.coefficients()[footprint::FootprintPoly::kMaxCoefficients - 1 - k].data());
+    }
+    static bool fits(const footprint::FootprintPoly& poly) {
+        return footprint::FootprintPoly::kMaxCoefficients == 8 && poly.degree() <= 5;
+    }
+    __m256 operator()(__m256 r2) const {
+        const __m256 s = _mm256_mul_ps(r2, seg_);
+        const __m256 sf = _mm256_min_ps(_mm256_floor_ps(s), lastSeg_);
+        const __m256i seg = _mm256_cvttps_epi32(sf);
+        const __m256 u =
+            _mm256_fmsub_ps(_mm256_set1_ps(2.0f), _mm256_sub_ps(s, sf), _mm256_set1_ps(1.0f));
+        auto a = [&](int k) { return _mm256_permutevar8x32_ps(coef_[k], seg); };  // of u^k
+        const __m256 u2 = _mm256_mul_ps(u, u), u4 = _mm256_mul_ps(u2, u2);
+        const __m256 q0 = _mm256_fmadd_ps(a(1), u, a(0)), q1 = _mm256_fmadd_ps(a(3), u, a(2));
+        const __m256 q2 = _mm256_fmadd_ps(a(5), u, a(4));
+        return _mm256_fmadd_ps(q2, u4, _mm256_fmadd_ps(q1, u2, q0));
+    }
+
+  private:
+    __m256 seg_, lastSeg_;
+    __m256 coef_[6];  ///< coefficient of u^k of every segment
+};
+
+/// Adds values * fp(r^2) * e.scale, the whole footprint, to the pixels of `rect`: eight
+/// pixels at a time where AVX2 is available (fp from `footprintOf`: FootprintLanes or
+/// Degree5Lanes).
+template <int NCh, class Footprint>
 int splatFootprintLanes(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx, float sy,
                         const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                        const footprint::FootprintTable& table,
-                        const footprint::FootprintPoly* poly) {
+                        const footprint::FootprintTable& table, const Footprint& footprintOf) {
     const int ox = sheet.originX(), oy = sheet.originY();
     const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
     sheet.markDirty(x0, x1, y0, y1);
     const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
     const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
     const __m256 vMax = _mm256_set1_ps(table.r2Max()), zero = _mm256_setzero_ps();
-    const footprint::FootprintLanes footprintOf(table, poly);
     __m256 vv[NCh];
     for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
     // Row pointers from plain locals: the stores could alias the sheet's members, which the
@@ -72,6 +106,18 @@ int splatFootprintLanes(SheetBuffer<NCh>& sheet, const float (&values)[NCh], flo
     }
     return (x1 - x0 + 1) * (y1 - y0 + 1);
 }
+
+/// splatFootprintLanes with the footprint polynomial (Degree5Lanes where it fits) or table.
+template <int NCh>
+int splatFootprintVector(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx, float sy,
+                         const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                         const footprint::FootprintTable& table,
+                         const footprint::FootprintPoly* poly) {
+    if (poly && Degree5Lanes::fits(*poly))
+        return splatFootprintLanes(sheet, values, sx, sy, e, rect, table, Degree5Lanes(*poly));
+    return splatFootprintLanes(sheet, values, sx, sy, e, rect, table,
+                               footprint::FootprintLanes(table, poly));
+}
 FOOTPRINT_LANES_END
 #endif
 
@@ -92,7 +138,7 @@ int splatFootprint(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx
 #if defined(FOOTPRINT_HAVE_LANES)
     if constexpr (NCh != kLabelChannels)  // labels select by max: the scalar loop
         if (footprint::cpuHasLanes())
-            return splatFootprintLanes(sheet, values, sx, sy, e, rect, table, poly);
+            return splatFootprintVector(sheet, values, sx, sy, e, rect, table, poly);
 #endif
     return splatFootprintScalar(sheet, values, sx, sy, e, rect, table, poly);
 }
@@ -110,7 +156,8 @@ struct WholeFootprints {
     const footprint::FootprintTable& table;
     const footprint::FootprintPoly* poly;
 
-    std::uint32_t key(const SplatRecord& s) const {
+    template <class Record>  // SplatRecord or RunRecord
+    std::uint32_t key(const Record& s) const {
         return ascending ? s.slice : slices - 1 - s.slice;  // s.slice = index[s.id]
     }
     /// What binning copies into each record's `slice`.
@@ -191,7 +238,8 @@ class AxisAligned final : public Splatter {
             };
             // The cells are listed in parts (in parallel, then joined in order): part p holds
             // slice q0 + p / bricksV (m = 0: all of them) and the v-brick p % bricksV. One
-            // run per non-empty cell: its splats lie on one row between its first and last.
+            // run per non-empty cell (m = 0: per slice of kWidth cells): its splats lie on
+            // one line of voxels between its first and last, in one sheet.
             const std::size_t ny = std::size_t(d.y);
             const std::size_t nParts = m == 0 ? bricksV : (q1 - q0) * bricksV;
             if (parts.size() < nParts) parts.resize(nParts);
@@ -216,9 +264,29 @@ class AxisAligned final : public Splatter {
                         for (std::size_t ci = 0; ci < cx; ++ci)
                             if (shown(ci * kWidth, k)) add((k * ny + slice) * cx + ci);
                 } else {  // u = j, v = k; the slab is cell column `slab`
+                    // A cell's splats lie in different slices here: the cells of kWidth rows
+                    // j are listed slice by slice instead, each slice's splats one run along
+                    // j (per slice the same order as row by row: k, then j).
+                    const std::vector<std::uint16_t>& si = sc.splats.i;
+                    std::uint32_t at[kWidth], stop[kWidth];
                     for (std::size_t k = v0; k < v1; ++k)
-                        for (std::size_t j = 0; j < ny; ++j)
-                            if (shown(j, k)) add((k * ny + j) * cx + slab);
+                        for (std::size_t j0 = 0; j0 < ny; j0 += kWidth) {
+                            if (!shown(j0, k)) continue;
+                            const std::size_t rows = std::min<std::size_t>(kWidth, ny - j0);
+                            for (std::size_t r = 0; r < rows; ++r) {
+                                const std::size_t cell = (k * ny + j0 + r) * cx + slab;
+                                at[r] = cells[cell];
+                                stop[r] = cells[cell + 1];
+                            }
+                            for (std::size_t i = q0; i < q1; ++i) {
+                                const std::size_t before = part.ids.size();
+                                for (std::size_t r = 0; r < rows; ++r)
+                                    while (at[r] < stop[r] && si[at[r]] == i)
+                                        part.ids.push_back(at[r]++);
+                                if (part.ids.size() != before)
+                                    part.runs.push_back(std::uint32_t(part.ids.size()));
+                            }
+                        }
                 }
             });
             std::size_t total = 0, runCount = 0;
