@@ -299,8 +299,7 @@ void addPartStats(const RenderStats& part, RenderStats& frame) {
 }
 
 /// The splatters' frame of the lists `parts` (levelOfDetail): one list is one frame; more
-/// (X-ray, a sum over splats) are a frame per list, summed, every list low-passed by the
-/// pixel filter.
+/// (X-ray, a sum over splats) are a frame per list, summed.
 Image splatParts(const std::vector<std::shared_ptr<const Scene::Impl>>& parts,
                  const Camera& camera, const RenderSettings& s, RenderStats& stats,
                  Image* depth) {
@@ -312,16 +311,19 @@ Image splatParts(const std::vector<std::shared_ptr<const Scene::Impl>>& parts,
         stats.lodLevel = std::max(stats.lodLevel, part.level);
         stats.lodSplats += part.splats.size();
     };
+    // `--lod brick` below a pixel per voxel: level 0 through the pixel filter too (as EWA),
+    // like the merged levels, whatever --ewa says (the levels' footprints then carry the same
+    // total variance), also where every brick kept level 0.
+    RenderSettings filtered = s;
+    if (s.quality.lodBrick && lodAutoApplies(s.mode) &&
+        voxelPixels(camera, *parts.front()->volume) < Quality::kEwaAutoPixels)
+        filtered.quality.ewa = Ewa::On;
     if (parts.size() == 1) {
         count(*parts.front());
-        return splatFrame(*parts.front(), camera, s, stats, depth);
+        return splatFrame(*parts.front(), camera, filtered, stats, depth);
     }
     if (s.mode != RenderMode::Xray)
         throw Error("internal: levels of detail are mixed in a frame only in X-ray");
-    // Level 0 through the pixel filter too (as EWA), like the merged levels: every level's
-    // footprints then carry the same total variance, so the bricks meet without seams.
-    RenderSettings filtered = s;
-    filtered.quality.ewa = Ewa::On;
     Image image;
     for (const auto& part : parts) {
         count(*part);

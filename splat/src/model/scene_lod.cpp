@@ -47,6 +47,16 @@ std::vector<std::shared_ptr<const Scene::Impl>> Scene::Impl::lodParts(
     int coarsest = 0;
     for (std::size_t b = 0; b < levels.size(); ++b)
         if (detail.occupied[b]) coarsest = std::max(coarsest, int(levels[b]));
+    // Merging under a tenth of level 0 is not worth a copy of the rest (memory: the part of
+    // level 0 would be nearly a second level-0 list): the frame is level 0.
+    std::size_t kept = 0;
+    for (std::size_t q = 0; q < splats.size(); ++q)
+        kept += levels[detail.brick(splats.i[q], splats.j[q], splats.k[q])] == 0;
+    if (coarsest == 0 || kept > splats.size() - splats.size() / 10) {
+        lodLevels_ = levels;
+        lodParts_ = {std::shared_ptr<const Impl>(std::shared_ptr<const Impl>(), this)};
+        return lodParts_;
+    }
     std::vector<std::shared_ptr<const Impl>> parts;
     const Impl* lvl = this;
     for (int L = 0; lvl && L <= coarsest; ++L, lvl = L <= coarsest ? lvl->coarser() : nullptr) {
