@@ -12,7 +12,8 @@
 // built once per configuration; the time is that of render() alone). The splatters use the
 // default front-to-back early termination (1/256) unless --early-termination says otherwise.
 // --lod L adds the axis-aligned and slab-1 image-aligned splatters at level of detail L
-// (Quality::lod) and their level; --lod auto the same with Quality::lodAuto (README "Level of
+// (Quality::lod) and their level; --lod auto the same with Quality::lodAuto, --lod brick with
+// Quality::lodBrick (README "Level of
 // detail"); with --ewa also both with EWA on; a list (--lod 1,auto) adds each in turn. --axis-only leaves out the image-aligned rows. --supersample N renders the reference with N x N rays per
 // pixel (at N times the size) and box-filters it: the pixel's area average rather than its
 // centre's value.
@@ -54,6 +55,15 @@ struct Config {
     Ewa ewa = Ewa::Auto;
     bool lodAuto = false;
 };
+
+/// ": a + b + ... per level" where a frame mixed levels (--lod brick), else "".
+std::string perLevel(const std::vector<std::size_t>& n) {
+    if (std::count_if(n.begin(), n.end(), [](std::size_t c) { return c > 0; }) < 2) return "";
+    std::string s = ": ";
+    for (std::size_t l = 0; l < n.size(); ++l)
+        s += (l ? " + " : "") + std::to_string(n[l]);
+    return s + " per level";
+}
 
 std::vector<double> parseList(const std::string& s) {
     std::vector<double> out;
@@ -171,9 +181,10 @@ int main(int argc, char** argv) {
         }
         std::size_t at = ewa ? 2 : 1;  // after "axis" (and "axis, EWA")
         for (const std::string& l : lods) {
+            // "brick": per-brick levels (Quality::lodBrick), marked by lod -1 here.
             const bool lodAuto = l == "auto";
-            const double lod = lodAuto ? 0 : std::stod(l);
-            if (!lodAuto && !(lod > 0)) continue;
+            const double lod = lodAuto ? 0 : (l == "brick" ? -1.0 : std::stod(l));
+            if (!lodAuto && !(lod > 0) && lod != -1.0) continue;
             std::vector<Config> add = {
                 {"axis, lod " + l, RendererKind::Axis, 1.0, lod, Ewa::Off, lodAuto}};
             if (ewa)
@@ -267,6 +278,8 @@ int main(int argc, char** argv) {
                 s.quality.slab = c.slab;
                 s.quality.lod = c.lod;
                 s.quality.lodAuto = c.lodAuto;
+                s.quality.lodBrick = c.lod == -1.0;
+                if (s.quality.lodBrick) s.quality.lod = 0;
                 s.quality.ewa = c.ewa;
                 s.camera.azimuthDeg = az;
                 const Renderer renderer(volume, s);
@@ -281,7 +294,8 @@ int main(int argc, char** argv) {
                 const std::string label =
                     c.label + (c.ewa == Ewa::Auto && st.ewaSigma > 0 ? ", EWA" : "") +
                     (st.lodLevel ? " (level " + std::to_string(st.lodLevel) + ", " +
-                                       std::to_string(st.lodSplats) + " splats)"
+                                       std::to_string(st.lodSplats) + " splats" +
+                                       perLevel(st.lodLevelSplats) + ")"
                                  : "");
                 if (withFiltered) {
                     const ImageMetrics f = compareImages(im, filtered);

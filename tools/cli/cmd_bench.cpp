@@ -107,6 +107,7 @@ void registerBench(CLI::App& app) {
                                    {"culled", stats.culledSplats},
                                    {"lod_level", stats.lodLevel},
                                    {"lod_splats", stats.lodSplats},
+                                   {"lod_level_splats", stats.lodLevelSplats},
                                    {"project_ms", stats.projectMs},
                                    {"bin_ms", stats.binMs},
                                    {"tiles_ms", stats.tilesMs}});

@@ -122,13 +122,28 @@ void registerRender(CLI::App& app) {
             warn(std::to_string(stats.exactPixels) + " of " +
                  std::to_string(std::size_t(image.width) * std::size_t(image.height)) +
                  " pixels handed to the exact path: " + stats.exactReason);
-        if (stats.lodLevel > 0)
+        // A frame of `--lod auto` may mix levels, one per brick: the splats of each.
+        std::string perLevel;
+        int levelsUsed = 0;
+        for (std::size_t l = 0; l < stats.lodLevelSplats.size(); ++l)
+            if (stats.lodLevelSplats[l] > 0) {
+                perLevel += (perLevel.empty() ? "" : ", ") + std::string("level ") +
+                            std::to_string(l) + " " + std::to_string(stats.lodLevelSplats[l]);
+                ++levelsUsed;
+            }
+        if (stats.lodLevel > 0 && levelsUsed > 1)
+            std::printf("level of detail %d: %zu splats, a level per brick (%s) (--lod %s)\n",
+                        stats.lodLevel, stats.lodSplats, perLevel.c_str(),
+                        settings.quality.lodAuto    ? "auto"
+                        : settings.quality.lodBrick ? "brick"
+                                                    : std::to_string(settings.quality.lod).c_str());
+        else if (stats.lodLevel > 0)
             std::printf("level of detail %d: %zu splats of %dx%dx%d voxels each (--lod %s)\n",
                         stats.lodLevel, stats.lodSplats, 1 << stats.lodLevel, 1 << stats.lodLevel,
                         1 << stats.lodLevel,
-                        settings.quality.lodAuto
-                            ? "auto"
-                            : std::to_string(settings.quality.lod).c_str());
+                        settings.quality.lodAuto    ? "auto"
+                        : settings.quality.lodBrick ? "brick"
+                                                    : std::to_string(settings.quality.lod).c_str());
         finishRun(*cmd);
     });
 }

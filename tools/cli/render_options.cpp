@@ -70,7 +70,9 @@ void addRenderOptions(CLI::App& cmd, RenderArgs& a, bool imageOutput) {
     addOption(cmd, "--lod", a.lod,
               "splatters: level of detail, pixels per voxel below which 2x2x2 voxels are "
               "merged into one splat of twice the size, repeatedly (0..64; 0 = off), or auto: "
-              "the coarsest level whose merged voxels stay within the pixel filter (xray)",
+              "the coarsest level whose merged voxels stay within the pixel filter (xray), or brick: "
+              "that level per brick of 16^3 voxels where its dropped detail and seams stay "
+              "small (xray)",
               q);
     addOption(cmd, "--pixel-filter", a.pixelFilter,
               "Gaussian pixel filter sigma in pixels (0..4): the reference supersamples and "
@@ -200,9 +202,12 @@ RenderSettings parseSettings(const RenderArgs& a) {
     if (a.lod == "auto") {
         s.quality.lodAuto = true;
         s.quality.lod = 0;
+    } else if (a.lod == "brick") {
+        s.quality.lodBrick = true;
+        s.quality.lod = 0;
     } else {
         const std::vector<double> l = parseNumbers(a.lod, "--lod");
-        if (l.size() != 1) throw Error("--lod needs one number of pixels per voxel, or auto");
+        if (l.size() != 1) throw Error("--lod needs one number of pixels per voxel, or auto, or brick");
         const double lod = l[0];
         requireIn(lod, 0, 64, "--lod (pixels per voxel; 0 = off; or auto)");
         s.quality.lod = lod;

@@ -131,6 +131,12 @@ struct Quality {
     /// pixel filter, less the pyramid's box), still sum to a constant on their grid; a
     /// pixel or more per voxel keeps level 0 (bit-identical to lod 0).
     bool lodAuto = false;
+    /// Level of detail per brick and view (`--lod brick`, issue 27, model/brick_lod.h): in the
+    /// modes of lodAuto, a level per brick of 16^3 voxels, the coarsest the projected voxel size
+    /// at the brick allows (lodAutoLevel) whose dropped detail and whose seams with finer
+    /// neighbours stay within a tolerance of the field, each level splatted as lodAuto splats
+    /// it; the frame sums a frame per level (X-ray). Ignored when lodAuto is set.
+    bool lodBrick = false;
     /// Pixel filter, a Gaussian of this standard deviation in pixels truncated at 4 sigma
     /// (README "Aliasing and EWA"). Reference ray caster: 0 samples each pixel at its centre;
     /// > 0 supersamples s x s rays per pixel (s = 2, 4, 8, 16) and filters, doubling s until
@@ -210,8 +216,12 @@ struct RenderStats {
     /// Level of detail the splatters used (Quality::lod): 0 the full-resolution list, L the
     /// list of 2^L x 2^L x 2^L voxels merged per splat, holding lodSplats splats (= splats at
     /// level 0; 0 for frames of the reference ray caster).
+    /// With `--lod auto` a frame mixes levels, a level per brick (Quality::lodAuto): lodLevel
+    /// is then the coarsest level splatted, lodSplats the splats splatted over all levels and
+    /// lodLevelSplats[L] those of level L (empty for frames of the reference ray caster).
     int lodLevel = 0;
     std::size_t lodSplats = 0;
+    std::vector<std::size_t> lodLevelSplats;
     /// Reference with a pixel filter (Quality::pixelFilter): rays per pixel along each axis
     /// of the last pass, and the RMS change of the filtered image from the pass before,
     /// relative to its largest value.

@@ -234,7 +234,8 @@ void applyKnob(RenderSettings& s, const std::string& n, const std::string& v) {
         q.polynomialTolerance = parseNumber(n, v);
     else if (n == "lod") {
         q.lodAuto = v == "auto";
-        q.lod = q.lodAuto ? 0 : parseNumber(n, v);
+        q.lodBrick = v == "brick";
+        q.lod = q.lodAuto || q.lodBrick ? 0 : parseNumber(n, v);
     }
     else if (n == "ewa")
         q.ewa = parseEwa(v);
@@ -549,6 +550,7 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
         frame.quality.tileSize = s.quality.tileSize;
         frame.quality.lod = s.quality.lod;
         frame.quality.lodAuto = s.quality.lodAuto;
+        frame.quality.lodBrick = s.quality.lodBrick;
         frame.quality.ewa = s.quality.ewa;
         frame.quality.pixelFilter = s.quality.pixelFilter;
         frame.quality.pixelFilterTolerance = s.quality.pixelFilterTolerance;

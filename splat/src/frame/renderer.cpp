@@ -9,13 +9,16 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <chrono>
+#include <memory>
 
 #include "frame/compositing.h"
 #include "frame/frame.h"
 #include "frame/projection.h"
 #include "frame/stopwatch.h"
 #include "frame/tile_binning.h"
+#include "model/brick_lod.h"
 #include "model/level_of_detail.h"
 #include "reference/pixel_filter.h"
 #include "reference/reference_frame.h"
@@ -225,25 +228,46 @@ bool needsExactPath(const Scene::Impl& scene, const Camera& camera) {
         [](bool a, bool b) { return a || b; });
 }
 
-/// The level of detail the splatters use for this view (Quality::lod): coarser while a voxel
-/// of the level covers fewer than `lod` pixels.
-/// Auto (Quality::lodAuto): lodAutoLevel of the level-0 voxel's size, in the modes where it
-/// was measured free (lodAutoApplies).
-const Scene::Impl& levelOfDetail(const Scene::Impl& scene, const Camera& camera,
-                                 const Quality& q, RenderMode mode) {
+/// The lists the splatters render for this view, finest first (one unless `--lod brick`
+/// mixes levels). Quality::lod: the level of detail coarser while a voxel of the level covers
+/// fewer than `lod` pixels. Auto (Quality::lodAuto): lodAutoLevel of the level-0 voxel's size,
+/// in the modes where it was measured free (lodAutoApplies). Brick (Quality::lodBrick): in
+/// the same modes a level per brick of the level-0 grid (model/brick_lod.h), one list per
+/// level in use. Each list is the scene itself, a level of its pyramid, or a part of one.
+std::vector<std::shared_ptr<const Scene::Impl>> levelOfDetail(const Scene::Impl& scene,
+                                                              const Camera& camera,
+                                                              const Quality& q, RenderMode mode) {
+    // Levels are owned by the pyramid: no owner here.
+    auto one = [](const Scene::Impl& l) {
+        return std::vector<std::shared_ptr<const Scene::Impl>>{
+            std::shared_ptr<const Scene::Impl>(std::shared_ptr<const Scene::Impl>(), &l)};
+    };
+    const double sigma = q.pixelFilter > 0 ? q.pixelFilter : Quality::kEwaDefaultSigma;
     const Scene::Impl* level = &scene;
     if (q.lodAuto) {
-        if (!lodAutoApplies(mode)) return scene;
-        const int target = lodAutoLevel(
-            voxelPixels(camera, *scene.volume),
-            q.pixelFilter > 0 ? q.pixelFilter : Quality::kEwaDefaultSigma,
-            scene.kernel.variance(), 16);
+        if (!lodAutoApplies(mode)) return one(scene);
+        const int target =
+            lodAutoLevel(voxelPixels(camera, *scene.volume), sigma, scene.kernel.variance(), 16);
         while (level->level < target) {
             const Scene::Impl* next = level->coarser();
             if (!next) break;
             level = next;
         }
-        return *level;
+        return one(*level);
+    }
+    if (q.lodBrick) {
+        if (!lodAutoApplies(mode)) return one(scene);
+        auto levels = [&](const BrickDetail* detail) {
+            return brickLevels(camera, scene.splats.origin, scene.splats.spacing,
+                               scene.volume->dims, sigma, scene.kernel.variance(),
+                               kLodBrickMaxLevel, detail);
+        };
+        // The geometric rule alone first: where it keeps every brick at level 0 (a voxel
+        // covering more than ~0.47 pixels) the pyramid is not even made.
+        const std::vector<std::uint8_t> geometric = levels(nullptr);
+        if (std::all_of(geometric.begin(), geometric.end(), [](std::uint8_t l) { return l == 0; }))
+            return one(scene);
+        return scene.lodParts(levels(&scene.brickDetail()));
     }
     const double lod = q.lod;
     if (lod > 0)
@@ -252,7 +276,68 @@ const Scene::Impl& levelOfDetail(const Scene::Impl& scene, const Camera& camera,
             if (!next) break;
             level = next;
         }
-    return *level;
+    return one(*level);
+}
+
+/// Adds the counters of a frame of one part of a mixed-level frame to the frame's.
+void addPartStats(const RenderStats& part, RenderStats& frame) {
+    frame.footprintPixels += part.footprintPixels;
+    frame.sheets += part.sheets;
+    frame.culledSplats += part.culledSplats;
+    frame.slabs += part.slabs;
+    frame.pathScalePixels += part.pathScalePixels;
+    frame.shadeMs += part.shadeMs;
+    frame.projectMs += part.projectMs;
+    frame.orderMs += part.orderMs;
+    frame.binMs += part.binMs;
+    frame.tilesMs += part.tilesMs;
+    if (frame.sheetAxis < 0) {
+        frame.sheetAxis = part.sheetAxis;
+        frame.sheetSign = part.sheetSign;
+    }
+    if (!(frame.ewaSigma > 0)) frame.ewaSigma = part.ewaSigma;
+}
+
+/// The splatters' frame of the lists `parts` (levelOfDetail): one list is one frame; more
+/// (X-ray, a sum over splats) are a frame per list, summed.
+Image splatParts(const std::vector<std::shared_ptr<const Scene::Impl>>& parts,
+                 const Camera& camera, const RenderSettings& s, RenderStats& stats,
+                 Image* depth) {
+    stats.lodLevelSplats.clear();
+    auto count = [&](const Scene::Impl& part) {
+        const std::size_t L = std::size_t(part.level);
+        if (stats.lodLevelSplats.size() <= L) stats.lodLevelSplats.resize(L + 1, 0);
+        stats.lodLevelSplats[L] += part.splats.size();
+        stats.lodLevel = std::max(stats.lodLevel, part.level);
+        stats.lodSplats += part.splats.size();
+    };
+    // `--lod brick` below a pixel per voxel: level 0 through the pixel filter too (as EWA),
+    // like the merged levels, whatever --ewa says (the levels' footprints then carry the same
+    // total variance), also where every brick kept level 0.
+    RenderSettings filtered = s;
+    if (s.quality.lodBrick && lodAutoApplies(s.mode) &&
+        voxelPixels(camera, *parts.front()->volume) < Quality::kEwaAutoPixels)
+        filtered.quality.ewa = Ewa::On;
+    if (parts.size() == 1) {
+        count(*parts.front());
+        return splatFrame(*parts.front(), camera, filtered, stats, depth);
+    }
+    if (s.mode != RenderMode::Xray)
+        throw Error("internal: levels of detail are mixed in a frame only in X-ray");
+    Image image;
+    for (const auto& part : parts) {
+        count(*part);
+        RenderStats ps;
+        const Image im = splatFrame(*part, camera, filtered, ps, nullptr);
+        addPartStats(ps, stats);
+        if (image.pixels.empty()) {
+            image = im;
+            continue;
+        }
+        for (std::size_t p = 0; p < image.pixels.size(); ++p)
+            image.pixels[p] += glm::vec4(glm::vec3(im.pixels[p]), 0.0f);
+    }
+    return image;
 }
 
 }  // namespace
@@ -299,14 +384,14 @@ Image renderFrame(const Scene::Impl& scene, const RenderSettings& given, RenderS
         local.perspective = camera.perspective();
         // The camera is the full-resolution scene's: a level's grid is centred differently
         // when a dimension is odd.
-        const Scene::Impl& level = s.renderer == RendererKind::Reference
-                                       ? scene
-                                       : levelOfDetail(scene, camera, s.quality, s.mode);
+        const auto parts = s.renderer == RendererKind::Reference
+                               ? std::vector<std::shared_ptr<const Scene::Impl>>{}
+                               : levelOfDetail(scene, camera, s.quality, s.mode);
         if (s.renderer == RendererKind::Reference) {
             image = s.quality.pixelFilter > 0
                         ? filteredReferenceFrame(scene, camera, s, local, depth)
                         : referenceFrame(scene, camera, s, local, depth);
-        } else if (needsExactPath(level, camera)) {
+        } else if (needsExactPath(*parts.front(), camera)) {
             image = referenceFrame(scene, camera, s, local, depth);
             local.exactPixels = std::size_t(camera.width()) * std::size_t(camera.height());
             local.exactReason =
@@ -314,9 +399,7 @@ Image renderFrame(const Scene::Impl& scene, const RenderSettings& given, RenderS
                 "the perspective near plane, where a splat footprint is invalid): every pixel "
                 "was rendered by the reference ray caster";
         } else {
-            local.lodLevel = level.level;
-            local.lodSplats = level.splats.size();
-            image = splatFrame(level, camera, s, local, depth);
+            image = splatParts(parts, camera, s, local, depth);
         }
     });
     local.milliseconds = msSince(start);

@@ -15,6 +15,7 @@
 #include "frame/projection.h"
 #include "frame/tile_binning.h"
 #include "frame/transfer_table.h"
+#include "model/brick_lod.h"
 #include "splat/scene.h"
 
 namespace splat {
@@ -55,6 +56,18 @@ struct Scene::Impl {
     /// The next level (2x the spacing), made on first use and kept; null when this level's
     /// grid is one voxel along every axis. The splatters render a level like any scene.
     const Impl* coarser() const;
+
+    /// `--lod auto` per brick (model/brick_lod.h): a part of a level, `splats` (a subset of
+    /// that level's list), with its grid, settings, kernel and tables.
+    struct Part {};
+    Impl(const Impl& level, SplatList splats, Part);
+    /// The pyramid's per-brick detail (brickDetail over levels 0 .. kLodBrickMaxLevel), made
+    /// on first use; call on level 0.
+    const BrickDetail& brickDetail() const;
+    /// One part per level in use for the bricks' `levels` (brickLevels), finest first: the
+    /// level itself where every brick holding its splats took it, else splatsOfBricks. The
+    /// last frame's parts are kept and reused while the levels are the same. Call on level 0.
+    std::vector<std::shared_ptr<const Impl>> lodParts(const std::vector<std::uint8_t>& levels) const;
 
     float minValue = 0, maxValue = 0;  ///< of the volume (normalized iso levels)
     /// Labels: colour and extinction (a) per label as shown, and the shown label of every
@@ -118,6 +131,10 @@ struct Scene::Impl {
     mutable std::shared_ptr<const ReferenceField> field_;
     mutable std::vector<std::unique_ptr<FrameWorkspace>> pool_;
     mutable std::unique_ptr<Impl> coarser_;
+    mutable std::mutex lodMutex_;
+    mutable std::unique_ptr<BrickDetail> brickDetail_;
+    mutable std::vector<std::uint8_t> lodLevels_;
+    mutable std::vector<std::shared_ptr<const Impl>> lodParts_;
 };
 
 /// A workspace taken from a Scene's pool for the duration of one frame.
