@@ -303,11 +303,30 @@ struct FieldGrid {
         if constexpr (W == 4)
             if (footprint::cpuHasLanes()) {
                 float frac[3];
+                bool inside = true;
                 for (int a = 0; a < 3; ++a) {
                     const double fl = std::floor(p[a]);
-                    if (!(fl >= 1 && fl + 2 < dims[a])) return evalPlain(p, out);
+                    if (!(fl >= -8 && fl < dims[a] + 8)) return evalPlain(p, out);
                     base[a] = int(fl) - 1;
                     frac[a] = float(p[a] - double(base[a]));
+                    inside = inside && fl >= 1 && fl + 2 < dims[a];
+                }
+                // A window leaving the grid (near the faces): its lattice points copied, those
+                // outside the grid 0, and the same vector rows over the copy.
+                if (!inside) {
+                    alignas(32) float local[64 * C] = {};
+                    for (int kz = 0; kz < 4; ++kz)
+                        for (int jy = 0; jy < 4; ++jy)
+                            for (int ix = 0; ix < 4; ++ix) {
+                                const int i = base[0] + ix, j = base[1] + jy, kk = base[2] + kz;
+                                if (i < 0 || j < 0 || kk < 0 || i >= dims.x || j >= dims.y ||
+                                    kk >= dims.z)
+                                    continue;
+                                for (int c = 0; c < C; ++c)
+                                    local[((kz * 4 + jy) * 4 + ix) * C + c] =
+                                        values[index(i, j, kk) + c];
+                            }
+                    return separableLanes<C>(local, 4 * C, 16 * C, frac, k, out);
                 }
                 if (windowEmpty(base, W)) {
                     for (int c = 0; c < C; ++c) out[c] = 0.0;
