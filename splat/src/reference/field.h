@@ -116,59 +116,49 @@ class SeparableGaussian {
 FOOTPRINT_LANES_BEGIN
 // FieldGrid::evalSeparable's rows for W = 4 with AVX2 + FMA (footprint/lanes.h: called only
 // where the CPU has them): `at` points at the window's first voxel, the rows `row` and planes
-// `plane` floats apart. The weights of two rows (jy, jy + 1) are made in one 8-lane vector
-// (h = N gx gy gz - A + B (qx + qy + qz), masked to q < R^2); for C = 4 each lattice point's
-// weight is spread over its four channels (one permute per two points), for C = 1 the two
-// rows' values are one 8-lane load; float within a plane, double across planes.
+// `plane` floats apart; the weights as in rowsSse2, two lattice points (8 channels) per FMA
+// for C = 4, one row per FMA for C = 1; float within a plane, double across planes.
 template <int C>
 void separableRowsLanes(const float* at, std::ptrdiff_t row, std::ptrdiff_t plane,
                         const float q[3][4], const float g[3][4], const SeparableGaussian& k,
                         double out[C]) {
     // Branch-free: all 16 rows, the weights of points at or beyond R masked to 0 (which rows
-    // are inside changes from sample to sample).
-    const __m256 qx = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(q[0]));
-    const __m256 gx = _mm256_broadcast_ps(reinterpret_cast<const __m128*>(g[0]));
-    const __m256 vr2 = _mm256_set1_ps(k.r2()), vb = _mm256_set1_ps(k.b());
-    const __m256 bqx = _mm256_fmsub_ps(vb, qx, _mm256_set1_ps(k.a()));  // B qx - A
-    // Rows (0, 1) and (2, 3): qy and N gy per half.
-    const __m256 qy01 = _mm256_setr_m128(_mm_set1_ps(q[1][0]), _mm_set1_ps(q[1][1]));
-    const __m256 qy23 = _mm256_setr_m128(_mm_set1_ps(q[1][2]), _mm_set1_ps(q[1][3]));
-    const __m256 gy01 =
-        _mm256_mul_ps(_mm256_set1_ps(k.n()),
-                      _mm256_setr_m128(_mm_set1_ps(g[1][0]), _mm_set1_ps(g[1][1])));
-    const __m256 gy23 =
-        _mm256_mul_ps(_mm256_set1_ps(k.n()),
-                      _mm256_setr_m128(_mm_set1_ps(g[1][2]), _mm_set1_ps(g[1][3])));
-    const __m256i i0 = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1);
-    const __m256i i1 = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
-    const __m256i i2 = _mm256_setr_epi32(4, 4, 4, 4, 5, 5, 5, 5);
-    const __m256i i3 = _mm256_setr_epi32(6, 6, 6, 6, 7, 7, 7, 7);
+    // are inside changes from sample to sample); rows summed in independent registers.
+    const __m128 qx = _mm_loadu_ps(q[0]), gx = _mm_loadu_ps(g[0]);
+    const __m128 vr2 = _mm_set1_ps(k.r2()), zero = _mm_setzero_ps();
+    const __m128 bqx = _mm_fmsub_ps(_mm_set1_ps(k.b()), qx, _mm_set1_ps(k.a()));  // B qx - A
+    const __m256i lo01 = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1);
+    const __m256i hi23 = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
     __m256d sum = _mm256_setzero_pd();
     for (int kz = 0; kz < 4; ++kz) {
-        const __m256 qz = _mm256_set1_ps(q[2][kz]), gz = _mm256_set1_ps(g[2][kz]);
-        const float* pl = at + kz * plane;
-        __m256 acc[2];
-        for (int pair = 0; pair < 2; ++pair) {
-            const __m256 qyz = _mm256_add_ps(pair ? qy23 : qy01, qz);
-            const __m256 h = _mm256_fmadd_ps(gx, _mm256_mul_ps(pair ? gy23 : gy01, gz),
-                                             _mm256_fmadd_ps(vb, qyz, bqx));
-            const __m256 w =
-                _mm256_and_ps(h, _mm256_cmp_ps(_mm256_add_ps(qx, qyz), vr2, _CMP_LT_OQ));
-            const float* r0 = pl + (2 * pair) * row;
-            const float* r1 = r0 + row;
+        __m256 acc8[4];
+        __m128 acc4[4];
+        for (int jy = 0; jy < 4; ++jy) {
+            const float qyz = q[1][jy] + q[2][kz];
+            const __m128 qq = _mm_add_ps(qx, _mm_set1_ps(qyz));
+            // h = N gx gy gz - A + B (qx + qyz)
+            const __m128 h = _mm_fmadd_ps(gx, _mm_set1_ps(k.n() * g[1][jy] * g[2][kz]),
+                                          _mm_add_ps(bqx, _mm_set1_ps(k.b() * qyz)));
+            const __m128 w =
+                _mm_and_ps(h, _mm_and_ps(_mm_cmplt_ps(qq, vr2), _mm_cmpgt_ps(h, zero)));
+            const float* r = at + kz * plane + jy * row;
             if constexpr (C == 4) {
-                const __m256 a = _mm256_fmadd_ps(
-                    _mm256_permutevar8x32_ps(w, i1), _mm256_loadu_ps(r0 + 8),
-                    _mm256_mul_ps(_mm256_permutevar8x32_ps(w, i0), _mm256_loadu_ps(r0)));
-                acc[pair] = _mm256_fmadd_ps(
-                    _mm256_permutevar8x32_ps(w, i3), _mm256_loadu_ps(r1 + 8),
-                    _mm256_fmadd_ps(_mm256_permutevar8x32_ps(w, i2), _mm256_loadu_ps(r1), a));
+                const __m256 w8 = _mm256_castps128_ps256(w);
+                acc8[jy] = _mm256_fmadd_ps(
+                    _mm256_permutevar8x32_ps(w8, hi23), _mm256_loadu_ps(r + 8),
+                    _mm256_mul_ps(_mm256_permutevar8x32_ps(w8, lo01), _mm256_loadu_ps(r)));
             } else {
-                acc[pair] = _mm256_mul_ps(w, _mm256_loadu2_m128(r1, r0));
+                acc4[jy] = _mm_mul_ps(w, _mm_loadu_ps(r));
             }
         }
-        const __m256 a = _mm256_add_ps(acc[0], acc[1]);
-        const __m128 p4 = _mm_add_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+        __m128 p4;
+        if constexpr (C == 4) {
+            const __m256 a =
+                _mm256_add_ps(_mm256_add_ps(acc8[0], acc8[1]), _mm256_add_ps(acc8[2], acc8[3]));
+            p4 = _mm_add_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+        } else {
+            p4 = _mm_add_ps(_mm_add_ps(acc4[0], acc4[1]), _mm_add_ps(acc4[2], acc4[3]));
+        }
         sum = _mm256_add_pd(sum, _mm256_cvtps_pd(p4));
     }
     alignas(32) double s[4];
@@ -306,7 +296,8 @@ struct FieldGrid {
     }
 
     // The separable Gaussian path over the W^3 lattice points around p (W = 2 ceil(R));
-    // near the volume's faces, where the window leaves the grid, the plain path.
+    // near the volume's faces, where the window leaves the grid, a zero-padded copy of the
+    // window (W = 4 with AVX2 + FMA) or the plain path.
     template <int W>
     void evalSeparable(const glm::dvec3& p, double out[C]) const {
         const SeparableGaussian& k = *gauss;
