@@ -434,6 +434,59 @@ TEST_CASE("reference: the separable Gaussian path equals the kernel table's to 2
     }
 }
 
+TEST_CASE("reference: four channels: the vector path equals the kernel table's to 2e-6, at the "
+          "faces too",
+          "[reference]") {
+    // Emission layout (rho, e_r, e_g, e_b) of random values, 20% or 97% of the voxels 0 (the
+    // sparse one has windows with no non-zero point: the empty-window flags): points inside,
+    // where the 4^3 window leaves the grid (the zero-padded copy) and beyond the padded bounds.
+    const double zeros = GENERATE(0.2, 0.97);
+    Volume v = makeVolume({10, 9, 11}, {1.0, 1.0, 1.0}, "random");
+    std::uint32_t seed = 777;
+    auto rnd = [&] {
+        seed = seed * 1664525u + 1013904223u;
+        return double(seed >> 8) / double(1u << 24);
+    };
+    for (float& d : v.data) d = rnd() < zeros ? 0.0f : float(0.5 + 0.5 * rnd());
+    SplatList splats = splatsByHand(v);
+    for (std::size_t q = 0; q < splats.size(); ++q) {
+        splats.r[q] = float(rnd());
+        splats.g[q] = float(3.0 * rnd());
+        splats.b[q] = float(0.1 * rnd());
+    }
+    const footprint::Kernel kernel = footprint::Kernel::gaussian(0.65, 2.0);
+    const ReferenceField fast(v, splats, kernel, FieldLayout::Emission);
+    const ReferenceField plain(v, splats, kernel, FieldLayout::Emission, {false, false});
+    REQUIRE(fast.grid4().gauss != nullptr);
+    REQUIRE(plain.grid4().gauss == nullptr);
+    double maxDiff = 0, maxValue = 0;
+    int faces = 0, emptyWindows = 0;
+    for (int n = 0; n < 20000; ++n) {
+        const glm::dvec3 p(-3.0 + 16.0 * rnd(), -3.0 + 15.0 * rnd(), -3.0 + 17.0 * rnd());
+        bool inside = true;
+        for (int a = 0; a < 3; ++a)
+            inside = inside && std::floor(p[a]) >= 1 && std::floor(p[a]) + 2 < v.dims[a];
+        faces += inside ? 0 : 1;
+        double a[4], b[4];
+        fast.grid4().eval(p, a);
+        plain.grid4().eval(p, b);
+        int base[3];
+        for (int k = 0; k < 3; ++k) base[k] = int(std::floor(p[k])) - 1;
+        if (inside && fast.grid4().windowEmpty(base, 4)) ++emptyWindows;
+        for (int c = 0; c < 4; ++c) {
+            maxDiff = std::max(maxDiff, std::abs(a[c] - b[c]));
+            maxValue = std::max(maxValue, std::abs(b[c]));
+        }
+    }
+    INFO(zeros << " zeros: max |vector - table| = " << maxDiff << ", largest value "
+               << maxValue << ", " << faces << " points near or beyond the faces, "
+               << emptyWindows << " in empty windows");
+    REQUIRE(faces > 10000);
+    if (zeros > 0.9) REQUIRE(emptyWindows > 100);
+    REQUIRE(maxValue > 0.5);
+    CHECK(maxDiff <= 2e-6 * 3.0);  // 2e-6 of the largest voxel value
+}
+
 TEST_CASE("reference: fast paths give the plain path's image within the tolerance (CT in HU)",
           "[reference]") {
     // ct-phantom: Hounsfield units, background -1000 (air), ct-hu: the skull opaque, so rays

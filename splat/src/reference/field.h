@@ -19,6 +19,8 @@
 //  - a cell flag per voxel (separable path) says whether the window of lattice points a
 //    sample in that cell reads holds any non-zero value: if not the sample is exactly 0.
 // Views through the volume (slices, MPR, CPR) evaluate the same fields.
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -223,31 +225,43 @@ struct FieldGrid {
     /// support, finer than the bricks).
     std::vector<std::uint8_t> windowFlags;
 
-    // Fills windowFlags for windows of w points per axis from floor(p) - (w / 2 - 1).
+    // Fills windowFlags for windows of w points per axis from floor(p) - (w / 2 - 1) (planes
+    // in parallel: each cell is written once per pass, so any thread count gives the same).
     void buildWindowFlags(int w) {
         const std::size_t n = std::size_t(dims.x) * dims.y * dims.z;
+        const std::size_t planeSize = std::size_t(dims.x) * dims.y;
         std::vector<std::uint8_t> a(n), b(n);
-        for (std::size_t v = 0; v < n; ++v) {
-            bool any = false;
-            for (int c = 0; c < C; ++c) any = any || values[v * C + c] != 0.0f;
-            a[v] = any;
-        }
-        // Separable dilation: cell c sees voxels c - (w / 2 - 1) .. c + w / 2 on each axis.
+        tbb::parallel_for(0, dims.z, [&](int k) {
+            for (std::size_t v = k * planeSize; v < (k + 1) * planeSize; ++v) {
+                bool any = false;
+                for (int c = 0; c < C; ++c) any = any || values[v * C + c] != 0.0f;
+                a[v] = any;
+            }
+        });
+        // Separable dilation: cell c sees voxels c - (w / 2 - 1) .. c + w / 2 on each axis, as
+        // ORs of whole rows (shifted along x, neighbouring rows along y and z).
         const int lo = w / 2 - 1, hi = w / 2;
-        const std::size_t stride[3] = {1, std::size_t(dims.x), std::size_t(dims.x) * dims.y};
+        const std::size_t stride[3] = {1, std::size_t(dims.x), planeSize};
         for (int axis = 0; axis < 3; ++axis) {
-            for (int k = 0; k < dims.z; ++k)
-                for (int j = 0; j < dims.y; ++j)
-                    for (int i = 0; i < dims.x; ++i) {
-                        const int at[3] = {i, j, k};
-                        const std::size_t v = (std::size_t(k) * dims.y + j) * dims.x + i;
-                        std::uint8_t any = 0;
-                        for (int d = std::max(0, at[axis] - lo);
-                             d <= std::min(dims[axis] - 1, at[axis] + hi) && !any; ++d)
-                            any = a[v +
-                                    (std::ptrdiff_t(d) - at[axis]) * std::ptrdiff_t(stride[axis])];
-                        b[v] = any;
+            tbb::parallel_for(0, dims.z, [&](int k) {
+                for (int j = 0; j < dims.y; ++j) {
+                    const std::size_t row = (std::size_t(k) * dims.y + j) * dims.x;
+                    std::uint8_t* out = b.data() + row;
+                    std::fill(out, out + dims.x, std::uint8_t(0));
+                    const int at = axis == 1 ? j : k;
+                    for (int d = -lo; d <= hi; ++d) {
+                        if (axis == 0) {
+                            const std::uint8_t* in = a.data() + row;
+                            for (int i = std::max(0, -d); i < std::min(dims.x, dims.x - d); ++i)
+                                out[i] |= in[i + d];
+                        } else if (at + d >= 0 && at + d < dims[axis]) {
+                            const std::uint8_t* in =
+                                a.data() + row + d * std::ptrdiff_t(stride[axis]);
+                            for (int i = 0; i < dims.x; ++i) out[i] |= in[i];
+                        }
                     }
+                }
+            });
             std::swap(a, b);
         }
         windowFlags = std::move(a);
@@ -282,7 +296,8 @@ struct FieldGrid {
     }
 
     // The separable Gaussian path over the W^3 lattice points around p (W = 2 ceil(R));
-    // near the volume's faces, where the window leaves the grid, the plain path.
+    // near the volume's faces, where the window leaves the grid, a zero-padded copy of the
+    // window (W = 4 with AVX2 + FMA) or the plain path.
     template <int W>
     void evalSeparable(const glm::dvec3& p, double out[C]) const {
         const SeparableGaussian& k = *gauss;
@@ -293,11 +308,30 @@ struct FieldGrid {
         if constexpr (W == 4)
             if (footprint::cpuHasLanes()) {
                 float frac[3];
+                bool inside = true;
                 for (int a = 0; a < 3; ++a) {
                     const double fl = std::floor(p[a]);
-                    if (!(fl >= 1 && fl + 2 < dims[a])) return evalPlain(p, out);
+                    if (!(fl >= -8 && fl < dims[a] + 8)) return evalPlain(p, out);
                     base[a] = int(fl) - 1;
                     frac[a] = float(p[a] - double(base[a]));
+                    inside = inside && fl >= 1 && fl + 2 < dims[a];
+                }
+                // A window leaving the grid (near the faces): its lattice points copied, those
+                // outside the grid 0, and the same vector rows over the copy.
+                if (!inside) {
+                    alignas(32) float local[64 * C] = {};
+                    for (int kz = 0; kz < 4; ++kz)
+                        for (int jy = 0; jy < 4; ++jy)
+                            for (int ix = 0; ix < 4; ++ix) {
+                                const int i = base[0] + ix, j = base[1] + jy, kk = base[2] + kz;
+                                if (i < 0 || j < 0 || kk < 0 || i >= dims.x || j >= dims.y ||
+                                    kk >= dims.z)
+                                    continue;
+                                for (int c = 0; c < C; ++c)
+                                    local[((kz * 4 + jy) * 4 + ix) * C + c] =
+                                        values[index(i, j, kk) + c];
+                            }
+                    return separableLanes<C>(local, 4 * C, 16 * C, frac, k, out);
                 }
                 if (windowEmpty(base, W)) {
                     for (int c = 0; c < C; ++c) out[c] = 0.0;

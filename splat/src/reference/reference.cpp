@@ -107,6 +107,7 @@ struct Panel {
     int level = 1;
     bool joined = false;  // starts where the previous panel ends (shares its end sample)
     double tau = 0, tauPrev = 0;  // optical depth over the panel at level and level - 1
+    double att = 1;               // exp(-tau): the panel's transmittance
     glm::dvec3 e{0.0}, ePrev{0.0};  // emission from its start at level and level - 1
     double eps = 0;               // first-order change of the pixel between the two
 };
@@ -402,6 +403,7 @@ class Caster {
         p.tauPrev = p.tau;
         p.ePrev = p.e;
         panelIntegral(q.data(), 2 * n, 1, h, p.tau, p.e);
+        p.att = std::exp(-p.tau);
     }
 
     // dvr with panel adaptivity (see "Panel adaptivity" above).
@@ -451,7 +453,8 @@ class Caster {
                 p.level = 1;
                 panelIntegral(q.data(), 2, 2, p.h0, p.tauPrev, p.ePrev);
                 panelIntegral(q.data(), 4, 1, h, p.tau, p.e);
-                Tend *= std::exp(-p.tau);
+                p.att = std::exp(-p.tau);
+                Tend *= p.att;
                 ++done;
             }
             // Transmittance in front of each panel, the colour, and each panel's share of the
@@ -461,7 +464,7 @@ class Caster {
             for (std::size_t k = 0; k < done; ++k) {
                 sc.T[k] = T;
                 colour += T * sc.panels[k].e;
-                T *= std::exp(-sc.panels[k].tau);
+                T *= sc.panels[k].att;
             }
             sc.T[done] = T;
             Tend = T;
@@ -503,7 +506,7 @@ class Caster {
                 }
                 if (refined) {
                     Tend = 1.0;
-                    for (std::size_t k = 0; k < done; ++k) Tend *= std::exp(-sc.panels[k].tau);
+                    for (std::size_t k = 0; k < done; ++k) Tend *= sc.panels[k].att;
                     continue;
                 }
             }
