@@ -33,6 +33,42 @@ constexpr double kMaxSlabs = double(1 << 24);
 /// Most slabs one kernel may span (the slab thickness is at least 1e-3 voxels).
 constexpr int kMaxSpan = 8192;
 
+/// The boundaries a row of a kernel's slabs must evaluate: those whose depth over the row
+/// is beyond the kernel on the near side (`front(b)`) or the far side (`back(b)`) take a
+/// constant, and since the depths are monotone in b (ascending front to back, descending back
+/// to front) they are a prefix [0, pre) and a suffix [suf, n]; the row visits slabs
+/// [max(pre - 1, 0), min(suf, n)).
+struct SlabRange {
+    int pre, suf, jBegin, jEnd;
+};
+template <class Front, class Back>
+SlabRange slabRange(int n, bool ascending, Front front, Back back) {
+    int pre = 0, suf = n + 1;
+    if (ascending) {
+        while (pre <= n && front(pre)) ++pre;
+        while (suf > pre && back(suf - 1)) --suf;
+    } else {
+        while (pre <= n && back(pre)) ++pre;
+        while (suf > pre && front(suf - 1)) --suf;
+    }
+    return {pre, suf, std::max(pre - 1, 0), std::min(suf, n)};
+}
+
+/// Row y of the sheets jBegin .. jEnd - 1 and the distance between their channel planes
+/// (the stores may alias the sheets' members: without these the compiler reloads them for
+/// every store).
+template <int NCh>
+void sheetRows(SheetBuffer<NCh>* const* sheets, int jBegin, int jEnd, int y, float** rows,
+               std::ptrdiff_t* planes) {
+    for (int j = jBegin; j < jEnd; ++j) {
+        rows[j] = sheets[j]->row(0, y);
+        if constexpr (NCh > 1)
+            planes[j] = sheets[j]->row(1, y) - rows[j];
+        else
+            planes[j] = 0;
+    }
+}
+
 /// The sections of one kernel in n consecutive slabs at once, slab j between the depths
 /// tb[j] and tb[j + 1] (world units along the ray, relative to the splat centre), each added
 /// to sheets[j]. Sharing r^2, fp(r^2) and the fraction F(r^2, z) at every inner slab
@@ -80,25 +116,10 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
         // z(b) over the row's pixels lies in [zLo(b), zHi(b)].
         auto zero = [&](int b) { return e.depthScale * (tb[b] - tcLo) <= sat.zeroBelow; };
         auto one = [&](int b) { return e.depthScale * (tb[b] - tcHi) >= sat.oneAbove; };
-        int pre = 0, suf = n + 1;
-        if (ascending) {
-            while (pre <= n && zero(pre)) ++pre;
-            while (suf > pre && one(suf - 1)) --suf;
-        } else {
-            while (pre <= n && one(pre)) ++pre;
-            while (suf > pre && zero(suf - 1)) --suf;
-        }
-        const int jBegin = std::max(pre - 1, 0), jEnd = std::min(suf, n);
+        const SlabRange range = slabRange(n, ascending, zero, one);
+        const int pre = range.pre, suf = range.suf, jBegin = range.jBegin, jEnd = range.jEnd;
         if (jBegin >= jEnd) continue;
-        // This row of every slab's sheet (the stores may alias the sheets' members: without
-        // these the compiler reloads them for every store).
-        for (int j = jBegin; j < jEnd; ++j) {
-            rows[j] = sheets[j]->row(0, y);
-            if constexpr (NCh > 1)
-                planes[j] = sheets[j]->row(1, y) - rows[j];
-            else
-                planes[j] = 0;
-        }
+        sheetRows(sheets, jBegin, jEnd, y, rows, planes);
         const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(e.beta * dy);
         const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
@@ -196,23 +217,10 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
         const float tcLo = std::min(tcA, tcB), tcHi = std::max(tcA, tcB);
         auto before = [&](int b) { return e.depthScale * (tb[b] - tcLo) <= -chord; };
         auto behind = [&](int b) { return e.depthScale * (tb[b] - tcHi) >= chord; };
-        int pre = 0, suf = n + 1;
-        if (ascending) {
-            while (pre <= n && before(pre)) ++pre;
-            while (suf > pre && behind(suf - 1)) --suf;
-        } else {
-            while (pre <= n && behind(pre)) ++pre;
-            while (suf > pre && before(suf - 1)) --suf;
-        }
-        const int jBegin = std::max(pre - 1, 0), jEnd = std::min(suf, n);
+        const SlabRange range = slabRange(n, ascending, before, behind);
+        const int pre = range.pre, suf = range.suf, jBegin = range.jBegin, jEnd = range.jEnd;
         if (jBegin >= jEnd) continue;
-        for (int j = jBegin; j < jEnd; ++j) {
-            rows[j] = sheets[j]->row(0, y);
-            if constexpr (NCh > 1)
-                planes[j] = sheets[j]->row(1, y) - rows[j];
-            else
-                planes[j] = 0;
-        }
+        sheetRows(sheets, jBegin, jEnd, y, rows, planes);
         const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(e.beta * dy);
         const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
