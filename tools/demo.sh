@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 bash tools/build.sh
 build/bin/splat info synthetic:phantom:128
 build/bin/splat rotate synthetic:phantom:128 --renderer sheet --tf tools/gallery/phantom-tf.json --size 384x384 \
-    --elevation 20 --frames 36 -o out/phantom --gif out/phantom.gif \
+    --elevation 20 --frames 36 -o out/phantom --overwrite --gif out/phantom.gif \
     --contact-sheet out/phantom_sheet.png
 build/bin/splat popping synthetic:phantom:64 --tf ct-soft --size 128x128 --from 40 --to 50 --step 0.5 \
     --report out/popping
