@@ -717,12 +717,14 @@ TEST_CASE("lod auto: --lod auto on the command line, in scene files and as a stu
     INFO(again.err);
     REQUIRE(again.status == 0);
     CHECK(readTextFile(out) == first);
-    for (const char* bad : {"automatic", "1,2", ""}) {
+    for (const char* bad : {"automatic", "bricks", "1,2", ""}) {
         const RunResult b = runSplat({"render", "synthetic:phantom:16", "--size", "16x16", "--lod",
                                       bad, "-o", (dir / "bad.png").string()});
         INFO(bad << ": " << b.err);
         CHECK(b.status == 2);
         CHECK(b.errLines().size() == 1);
+        // The line names the words --lod takes, not only numbers.
+        CHECK(b.err.find("auto or brick") != std::string::npos);
         CHECK(!std::filesystem::exists(dir / "bad.png"));
     }
     const std::filesystem::path report = dir / "study";

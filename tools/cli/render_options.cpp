@@ -206,10 +206,18 @@ RenderSettings parseSettings(const RenderArgs& a) {
         s.quality.lodBrick = true;
         s.quality.lod = 0;
     } else {
-        const std::vector<double> l = parseNumbers(a.lod, "--lod");
-        if (l.size() != 1) throw Error("--lod needs one number of pixels per voxel, or auto, or brick");
+        // One message for every value that is not a number: it names the words too.
+        const std::string what = "--lod '" + a.lod +
+                                 "' must be one number of pixels per voxel (0 = off), auto or brick";
+        std::vector<double> l;
+        try {
+            l = parseNumbers(a.lod, "--lod");
+        } catch (const Error&) {
+            throw Error(what);
+        }
+        if (l.size() != 1) throw Error(what);
         const double lod = l[0];
-        requireIn(lod, 0, 64, "--lod (pixels per voxel; 0 = off; or auto)");
+        requireIn(lod, 0, 64, "--lod (pixels per voxel; 0 = off; or auto or brick)");
         s.quality.lod = lod;
     }
     requireIn(a.pixelFilter, 0, 4, "--pixel-filter (sigma in pixels; 0 = point sampling)");
