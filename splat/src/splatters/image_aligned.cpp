@@ -75,6 +75,26 @@ void sheetRows(SheetBuffer<NCh>* const* sheets, int jBegin, int jEnd, int y, flo
 /// boundary between the slabs halves the work of splatting slab by slab.
 #if defined(FOOTPRINT_HAVE_LANES)
 FOOTPRINT_LANES_BEGIN
+/// Adds one 8-pixel group of a kernel's sections to the rows of slabs jBegin .. jEnd - 1: slab
+/// j gets values * scale * |at(j + 1) - at(j)|, at(b) the kernel's cumulative part (fraction
+/// or N P) at boundary b (the boundaries run back to front when compositing is).
+template <int NCh, class At>
+[[gnu::always_inline]] inline void addSections(float* const* rows, const std::ptrdiff_t* planes,
+                                               int x, int jBegin, int jEnd, __m256 scale,
+                                               const __m256 (&vv)[NCh], At at) {
+    const __m256 signBit = _mm256_set1_ps(-0.0f);
+    __m256 below = at(jBegin);
+    for (int j = jBegin; j < jEnd; ++j) {
+        const __m256 above = at(j + 1);
+        const __m256 w = _mm256_mul_ps(scale, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
+        below = above;
+        float* p = rows[j] + x;
+        for (int c = 0; c < NCh; ++c, p += planes[j]) {
+            _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
+        }
+    }
+}
+
 template <int NCh>
 int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
                        float sy, const footprint::EllipticalFootprint& e, const PixelRect& rect,
@@ -86,7 +106,6 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
     for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
     const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), vZero = _mm256_setzero_ps();
     const __m256 vOne = _mm256_set1_ps(1.0f);
-    const __m256 signBit = _mm256_set1_ps(-0.0f);
     const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
     const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
     const footprint::FootprintLanes footprintOf(fpTable, poly);
@@ -141,18 +160,7 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
                 return fraction(radial,
                                 _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
             };
-            __m256 below = fractionAt(jBegin);
-            for (int j = jBegin; j < jEnd; ++j) {
-                const __m256 above = fractionAt(j + 1);
-                // |F(above) - F(below)|: the boundaries run back to front when compositing is.
-                const __m256 w =
-                    _mm256_mul_ps(weight, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
-                below = above;
-                float* p = rows[j] + x;
-                for (int c = 0; c < NCh; ++c, p += planes[j]) {
-                    _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
-                }
-            }
+            addSections(rows, planes, x, jBegin, jEnd, weight, vv, fractionAt);
         }
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
@@ -179,7 +187,7 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
     const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
     for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
     const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), vZero = _mm256_setzero_ps();
-    const __m256 signBit = _mm256_set1_ps(-0.0f), vHalf = _mm256_set1_ps(0.5f);
+    const __m256 vHalf = _mm256_set1_ps(0.5f);
     const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
     const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
     const footprint::FootprintLanes footprintOf(fpTable, poly);
@@ -253,17 +261,7 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
                                    _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
                 }
             };
-            __m256 below = pAt(jBegin);
-            for (int j = jBegin; j < jEnd; ++j) {
-                const __m256 above = pAt(j + 1);
-                const __m256 w =
-                    _mm256_mul_ps(vScale, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
-                below = above;
-                float* p = rows[j] + x;
-                for (int c = 0; c < NCh; ++c, p += planes[j]) {
-                    _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
-                }
-            }
+            addSections(rows, planes, x, jBegin, jEnd, vScale, vv, pAt);
         }
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
