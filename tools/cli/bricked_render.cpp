@@ -189,4 +189,15 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
             static_cast<unsigned long long>(all[r].bytesExchanged));
 }
 
+void printRankStats(const std::vector<BrickStats>& ranks, std::size_t frames, const char* scene) {
+    for (std::size_t r = 0; r < ranks.size(); ++r)
+        std::printf(
+            "rank %zu: %d of %d bricks, largest %zu samples (%.1f MiB), load %.1f ms, scene %.1f "
+            "ms%s; render %.1f ms, composite %.1f ms, exchanged %llu bytes over %zu frames\n",
+            r, ranks[r].rendered, ranks[r].bricks, ranks[r].samplesLoaded,
+            ranks[r].samplesLoaded * 4.0 / 1048576.0, ranks[r].loadMs, ranks[r].sceneMs, scene,
+            ranks[r].renderMs, ranks[r].compositeMs,
+            static_cast<unsigned long long>(ranks[r].bytesExchanged), frames);
+}
+
 }  // namespace splat::cli

@@ -73,4 +73,9 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
                          BrickComposite composite = BrickComposite::Exact,
                          const std::string& compositor = "direct");
 
+/// One line per rank of a bricked sequence (rotate, popping): bricks, samples loaded, load
+/// and scene time (`scene` names how the scene time counts, e.g. " once"), render, composite
+/// and bytes exchanged over `frames` frames.
+void printRankStats(const std::vector<BrickStats>& ranks, std::size_t frames, const char* scene);
+
 }  // namespace splat::cli

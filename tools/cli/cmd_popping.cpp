@@ -208,16 +208,7 @@ void registerPopping(CLI::App& app) {
         writePoppingReport(result, a->report, commandLine());
         removeJournal(journal);
         printSummary(result);
-        if (!a->quiet)
-            for (std::size_t r = 0; r < ranks.size(); ++r)
-                std::printf(
-                    "rank %zu: %d of %d bricks, largest %zu samples (%.1f MiB), load %.1f ms, "
-                    "scene %.1f ms; render %.1f ms, composite %.1f ms, exchanged %llu bytes over "
-                    "%zu frames\n",
-                    r, ranks[r].rendered, ranks[r].bricks, ranks[r].samplesLoaded,
-                    ranks[r].samplesLoaded * 4.0 / 1048576.0, ranks[r].loadMs, ranks[r].sceneMs,
-                    ranks[r].renderMs, ranks[r].compositeMs,
-                    static_cast<unsigned long long>(ranks[r].bytesExchanged), requests->frames());
+        if (!a->quiet) printRankStats(ranks, requests->frames(), "");
         std::printf("wrote %s/report.html, metrics.csv, summary.json (%.1f s)\n", a->report.c_str(),
                     result.totalMs / 1000.0);
         finishRun(*cmd);

@@ -294,14 +294,7 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
     const std::vector<BrickStats> all = group.gather(frames.stats());
     if (!leader || a.quiet) return;
     progress.finish();
-    for (std::size_t r = 0; r < all.size(); ++r)
-        std::printf(
-            "rank %zu: %d of %d bricks, largest %zu samples (%.1f MiB), load %.1f ms, scene "
-            "%.1f ms once; render %.1f ms, composite %.1f ms, exchanged %llu bytes over %zu "
-            "frames\n",
-            r, all[r].rendered, all[r].bricks, all[r].samplesLoaded,
-            all[r].samplesLoaded * 4.0 / 1048576.0, all[r].loadMs, all[r].sceneMs, all[r].renderMs,
-            all[r].compositeMs, static_cast<unsigned long long>(all[r].bytesExchanged), pending);
+    printRankStats(all, pending, " once");
 }
 }  // namespace
 
