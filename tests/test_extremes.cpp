@@ -1,6 +1,6 @@
 // The renderers at the extremes of their parameters (issue 12; ctest -L extremes). Every case
 // asserts finite output and a stated bound against the reference ray caster or a closed
-// form; none merely checks that nothing crashed. Closed forms (splat/DESIGN.md, "The model"):
+// form; none merely checks that nothing crashed. Closed forms (docs/design.md "The model"):
 //   xray:                 I = sum_i d_i fp(r_i) / |S^-1 w|
 //   dvr, constant colour: I = k (1 - exp(-tau)),  tau = sum_i rho_i fp(r_i) / |S^-1 w|
 // (fp is the kernel's exact line integral, r_i the ray's distance from voxel i in index

@@ -400,7 +400,7 @@ TEST_CASE("lod: dvr at level 1 against the reference (the measured cost of the k
     // phantom:64 at 64^2 (the geometry of phantom:512 at 512^2: a voxel covers 0.58 pixels),
     // the timing transfer function. Level 1 widens every kernel to 2.3 pixels: opaque
     // silhouettes grow and thin shells blur, so its error is far above the full splatter's
-    // (README "Level of detail" has the figures at full size).
+    // (docs/speed-vs-accuracy.md "Level of detail" has the figures at full size).
     const Volume v = makeSynthetic("phantom", 64);
     const RenderSettings s = timingView(64, 30, 15);
     const Scene scene(v, s);

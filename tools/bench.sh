@@ -11,7 +11,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # The Performance figures are measured with -march=native (SPLAT_NATIVE=ON; the default build
-# is portable and 4.6-6.6% slower on ch2 512^2, README "Building").
+# is portable and 4.6-6.6% slower on ch2 512^2, docs/building.md).
 cmake -S . -B build -DSPLAT_NATIVE=ON > /dev/null
 cmake --build build -j2 --target splat_cli bench_frames bench_fill bench_accuracy > /dev/null
 # As root, splat and VTK run at real-time priority (SCHED_FIFO, inherited by every child; the

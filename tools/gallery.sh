@@ -70,5 +70,5 @@ $S cpr $CH2 --curve $tmp/curve.json -o $G/tech_cpr.png
 $S render synthetic:ct-phantom:128 --azimuth 120 --elevation 15 --size 320x320 --clip-plane 63.5,0,0,1,0,0 --shade -o $G/ct_hu_clipped.png
 $S render synthetic:ct-phantom:128 --classify post --azimuth 120 --elevation 15 --size 320x320 --clip-plane 63.5,0,0,1,0,0 -o $G/ct_hu_post.png
 $S render synthetic:ct-phantom:128 --mode mip --azimuth 90 --size 320x320 -o $G/ct_hu_mip.png
-# Aliasing with and without EWA (README "Aliasing and EWA").
+# Aliasing with and without EWA (docs/accuracy.md "Aliasing and EWA").
 bash tools/gallery_ewa.sh

@@ -8,7 +8,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cmake --install build --prefix "$tmp/prefix" > "$tmp/install.log"
 # IceT (SPLAT_ICET) is private to splat::mpi, which is not installed: the installed package
-# config, splat.pc and libraries never name IceT or ParaView (README "Building").
+# config, splat.pc and libraries never name IceT or ParaView (docs/building.md).
 if grep -rliE "icet|paraview" "$tmp/prefix/lib"*/cmake "$tmp/prefix/lib"*/pkgconfig; then
     echo "test_install: the installed package names IceT or ParaView (files above)"; exit 1
 fi

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Sort-last bricks under MPI (issue 26, README "Beyond one machine"): peak memory per rank,
+"""Sort-last bricks under MPI (issue 26, docs/parallel.md): peak memory per rank,
 strong and weak scaling with the work per rank and the bytes exchanged, a frame-time model
 for 64-1024 ranks, and the plot (SVG) of the README.
 

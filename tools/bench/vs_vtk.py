@@ -13,7 +13,7 @@ VTK against itself at 1/8-voxel steps (VTK's images are the 8-bit frame buffer, 
 errors include 8-bit rounding). "splat vs VTK" checks that the two see the same picture.
 The fill limit is tools/bench/bench_fill.cpp: a minimal AVX2 footprint-accumulate kernel.
 
-Beside the comparison (issue 27, README "Performance"): splat's error against the
+Beside the comparison (issue 27, docs/performance.md): splat's error against the
 pixel-filtered reference where voxels are smaller than pixels (FILTERED; the filtered frames
 are cached in BUILD/bench-cache between runs), an aliasing table of EWA and level of detail
 against it (ALIASING), the reference ray caster's time per ch2 256^2 frame, the accuracy check
@@ -515,11 +515,11 @@ LOD_ROWS = [("ch2", 256), ("phantom:256", 256), ("phantom:512", 512)]
 LOD_AUTO_ROWS = [("ch2", 256), ("ch2", 512), ("ch2", 1024), ("phantom:512", 512),
                  ("ch2 0.5 mm", 512)]
 
-# The pixel-filtered reference: Gaussian pixel filter of FILTER_SIGMA pixels (README "Aliasing
-# and EWA"), for the (volume, size) rows where voxels are smaller than pixels, frames listed
-# (of the 12-frame rotation; 1 = azimuth 30, 4 = azimuth 120). ch2 256^2: 0.76 pixels per
-# voxel, 15 s per filtered frame (4 x 4 rays per pixel); phantom:512 512^2: 0.58, 46 s per
-# frame (8 x 8), under chrt on the 2-core machine.
+# The pixel-filtered reference: Gaussian pixel filter of FILTER_SIGMA pixels (docs/accuracy.md
+# "Aliasing and EWA"), for the (volume, size) rows where voxels are smaller than pixels, frames
+# listed (of the 12-frame rotation; 1 = azimuth 30, 4 = azimuth 120). ch2 256^2: 0.76 pixels per
+# voxel, 15 s per filtered frame (4 x 4 rays per pixel); phantom:512 512^2: 0.58, 46 s per frame (8
+# x 8), under chrt on the 2-core machine.
 FILTER_SIGMA = 0.5
 FILTERED = {("ch2", 256): [1, 4], ("phantom:256", 256): [1, 4], ("phantom:512", 512): [1, 4]}
 
@@ -805,7 +805,7 @@ def markdown(result):
                f"{', '.join(map(str, result['error_frames']))} "
                f"of the {result['frames']}-frame rotation (images up to {result['error_max_size']}²). "
                f"*Filtered ref.*: against the pixel-filtered reference (`--renderer reference "
-               f"--pixel-filter {FILTER_SIGMA:g}`, README \"Aliasing and EWA\"), the judge where "
+               f"--pixel-filter {FILTER_SIGMA:g}`, docs/accuracy.md \"Aliasing and EWA\"), the judge where "
                "voxels are smaller than pixels, computed for " +
                ("; ".join(f"{v} {s}² frame{'s' if len(f) > 1 else ''} {', '.join(map(str, f))}"
                           for v, s, f in fr) if fr else "no row in this run") +

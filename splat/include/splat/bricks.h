@@ -1,5 +1,5 @@
 #pragma once
-// Sort-last bricked rendering (issue 26, splat/DESIGN.md "Beyond one machine"), the parts
+// Sort-last bricked rendering (issue 26, docs/parallel.md), the parts
 // that do not need MPI: the volume is cut into K bricks by a k-d tree (uneven splits for odd
 // dimensions and K not a power of 2), each brick loaded with ghost layers as wide as the
 // kernel's support; a brick is rendered by the unchanged renderers with the whole volume's

@@ -1,5 +1,5 @@
 #pragma once
-// Popping-artifact analysis (splat/DESIGN.md, "Artifact analysis"). A sweep of views
+// Popping-artifact analysis (docs/design.md "Artifact analysis"). A sweep of views
 // theta_0 < theta_1 < ... is rendered by each renderer X from one Scene, and per interval
 // [theta_n, theta_n+1]:
 //   temporal change  T_X(n) = RMS(I_X(theta_n+1) - I_X(theta_n))
@@ -30,7 +30,7 @@
 namespace splat {
 
 /// The views of a sweep: the base camera turned about one angle. End points follow the one
-/// convention of splat/DESIGN.md ("Sequences"): `to` is inclusive, the last view.
+/// convention of docs/decisions.md "Sequences": `to` is inclusive, the last view.
 struct Sweep {
     enum class Angle { Azimuth, Elevation };
     Angle angle = Angle::Azimuth;

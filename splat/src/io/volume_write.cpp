@@ -101,7 +101,7 @@ void saveNifti(const std::string& path, const Volume& v) {
 
 void saveNrrd(const std::string& path, const Volume& v) {
     checkWritable(v, path);
-    // World (RAS) axes and origin: direction applied (splat/DESIGN.md "World frame").
+    // World (RAS) axes and origin: direction applied (docs/design.md "World frame").
     auto vec = [](const glm::dvec3& a) {
         std::ostringstream o;
         o << '(' << fmt(a.x) << ',' << fmt(a.y) << ',' << fmt(a.z) << ')';
