@@ -1,4 +1,4 @@
-// Sort-last bricks without MPI (splat/bricks.h, issue 26): the k-d split, ghost layers,
+// Sort-last bricks without MPI (splat/bricks.h): the k-d split, ghost layers,
 // visibility order, brick loading, and bricked frames against one-process frames.
 #include <catch2/catch.hpp>
 #include <cmath>

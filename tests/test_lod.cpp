@@ -1,4 +1,4 @@
-// Level of detail (issue 11, Quality::lod, splat/src/model/level_of_detail.h): the 2x level
+// Level of detail (Quality::lod, splat/src/model/level_of_detail.h): the 2x level
 // of a scene against brute-force cell averages, closed forms of X-ray and dvr through a
 // constant box with bounds derived from the footprint's lattice ripple, the box-filtered
 // volume it stands for, when a level is used, and the command line.
@@ -27,7 +27,7 @@ using splat::test::testTmpDir;
 
 namespace {
 
-/// The transfer function of the README's timing runs (issue 11).
+/// The transfer function of the timing runs in docs/speed-vs-accuracy.md "Level of detail".
 TransferFunction timingTransfer() {
     TransferFunction tf;
     tf.normalized = true;
@@ -453,7 +453,7 @@ TEST_CASE("lod: --lod on the command line and in scene files", "[lod][cli]") {
     CHECK(ref.errLines()[0].find("--lod applies to the splatters") != std::string::npos);
 }
 
-// ---- --lod auto (issue 27): the level chosen from the error it adds, and the merged kernel
+// ---- --lod auto: the level chosen from the error it adds, and the merged kernel
 // narrowed so that kernel, pyramid box and pixel filter together are what the pixel-filtered
 // reference sees (model/level_of_detail.h, lodFootprint).
 

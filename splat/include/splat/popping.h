@@ -188,7 +188,8 @@ std::vector<double> predictSheetSwitches(const CameraPath& path, const Volume& v
 
 /// Writes `dir`/report.html (self-contained: inline SVG plots, embedded images and
 /// animation), metrics.csv (one row per renderer and interval) and summary.json (schema in
-/// the README), each atomically. `commandLine` is shown in the report (how to reproduce it).
+/// docs/popping.md "Popping reports: summary.json"), each atomically. `commandLine` is shown
+/// in the report (how to reproduce it).
 void writePoppingReport(const PoppingResult& result, const std::string& dir,
                         const std::string& commandLine);
 

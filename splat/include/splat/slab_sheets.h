@@ -1,5 +1,5 @@
 #pragma once
-// Exact sort-last bricks for the image-aligned splatter (issue 26, docs/parallel.md). A slab's
+// Exact sort-last bricks for the image-aligned splatter (docs/parallel.md). A slab's
 // optical depth and emission (or its density integral) are sums over kernels of their sections in
 // the slab (docs/design.md "Sheets"), so summing every slab's sheets over the bricks, each brick
 // contributing the sections of the kernels of the samples it owns (every kernel once: no ghost

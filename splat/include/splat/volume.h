@@ -45,7 +45,7 @@ struct Volume {
     /// an ignored field (sheared axes made a rotation, 4D file's first volume, DICOM gantry
     /// tilt, NaNs replaced, ...). Every command prints it (docs/input-files.md lists the cases).
     std::string note;
-    /// Background value b (issue 21, docs/design.md "Reconstructed fields"): what the data
+    /// Background value b (docs/design.md "Reconstructed fields"): what the data
     /// hold where nothing is (air at -1000 HU in CT, 0 in MR magnitude and signed fields).
     /// The reconstructed field is f(x) = b + sum_i (d_i - b) h(x - x_i): it tends to b
     /// outside the volume and across clipped regions, and "empty" means "equal to b".

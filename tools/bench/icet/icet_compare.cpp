@@ -1,4 +1,4 @@
-// Sort-last compositing, splat's direct-send against IceT (issue 26, docs/parallel.md "Memory,
+// Sort-last compositing, splat's direct-send against IceT (docs/parallel.md "Memory,
 // scaling and a model"). Under `mpirun -np P` every rank holds one partial RGBA float image of W x
 // H with premultiplied colour and all ranks share one visibility order. The partial images are
 // either synthetic (a soft disc, different per rank, transparent outside it, as a brick's

@@ -1,5 +1,5 @@
 #pragma once
-// Sort-last bricked rendering over MPI (issue 26): the BrickGroup of splat/bricks.h on the
+// Sort-last bricked rendering over MPI: the BrickGroup of splat/bricks.h on the
 // ranks of the job, with two compositors of the partial images (docs/parallel.md,
 // "Direct-send beside IceT"):
 //
