@@ -16,8 +16,8 @@ Usage: check_doc_refs.py [--list] [--allow FILE] SOURCE_ROOT
    what the code does and why.
 
 Files listed in the allow file (default: allowed_paths.txt beside this script; one path
-relative to SOURCE_ROOT per line, `#` comments) may still hold old-style and work-item
-references: they are counted, listed with --list, and do not fail the check. Exit status 0
+relative to SOURCE_ROOT per line, a folder when it ends in '/', `#` comments) may still hold
+old-style and work-item references: they are counted, listed with --list, and do not fail the check. Exit status 0
 when nothing else is found, 1 otherwise, 2 on a usage error.
 """
 import os
@@ -110,9 +110,19 @@ class Checker:
         self.tolerated = []
         self.cache = {}
 
+    def allowed_entry(self, rel):
+        """The allow-file entry covering `rel`: the path itself, or a folder ending in '/'."""
+        for entry in self.allowed:
+            if rel == entry or (entry.endswith("/") and rel.startswith(entry)):
+                return entry
+        return None
+
     def report(self, rel, line, message, allowable=False):
         entry = (rel, line, message)
-        (self.tolerated if allowable and rel in self.allowed else self.problems).append(entry)
+        if allowable and self.allowed_entry(rel):
+            self.tolerated.append(entry)
+        else:
+            self.problems.append(entry)
 
     def doc(self, rel):
         if rel not in self.cache:
@@ -216,7 +226,7 @@ def main(argv):
     if listing:
         for rel, line, message in checker.tolerated:
             print(f"{rel}:{line}: (allowed) {message}")
-    stale = sorted(checker.allowed - {rel for rel, _, _ in checker.tolerated})
+    stale = sorted(checker.allowed - {checker.allowed_entry(rel) for rel, _, _ in checker.tolerated})
     for rel in stale:
         print(f"check_doc_refs: note: {rel} is allowed but holds nothing to allow; "
               f"remove it from {os.path.basename(allow)}", file=sys.stderr)
