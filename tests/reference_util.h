@@ -72,7 +72,7 @@ inline SplatList splatsByHand(const Volume& v, float rhoPerUnit = 1.0f,
 }
 
 /// Perpendicular distance (index units) of `ray` from voxel `p`, and |S^-1 dir|: the line
-/// integral of that voxel's kernel along the ray is fp(r) / |v| (splat/DESIGN.md, footprints).
+/// integral of that voxel's kernel along the ray is fp(r) / |v| (docs/design.md "Footprints").
 struct KernelLine {
     double r = 0, vLen = 1;
 };

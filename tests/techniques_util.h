@@ -1,5 +1,5 @@
 #pragma once
-// Helpers of the [techniques] tests (issue 13).
+// Helpers of the [techniques] tests.
 #include <cmath>
 #include <glm/glm.hpp>
 #include <vector>

@@ -1,4 +1,4 @@
-// The background value b (issue 21, splat/DESIGN.md "Reconstructed fields"): the field is
+// The background value b (docs/design.md "Reconstructed fields"): the field is
 // f(x) = b + sum_i (d_i - b) h(x - x_i), so it tends to b outside the volume. Checked on a
 // CT-like volume in Hounsfield units (air -1000, soft tissue 40, bone 700), on all-negative
 // data, and by shift invariance: the same volume shifted by c, with b, the transfer function

@@ -1,4 +1,4 @@
-// The number of bricks from a memory budget per process (splat/brick_budget.h, issue 26):
+// The number of bricks from a memory budget per process (splat/brick_budget.h):
 // the estimate's closed form, and the choice — the fewest bricks, a multiple of the ranks,
 // that keep the busiest process within the budget.
 #include <catch2/catch.hpp>

@@ -1,4 +1,4 @@
-// Bricks read alone from files (issue 26, README "Beyond one machine"): every brick of a
+// Bricks read alone from files (docs/parallel.md): every brick of a
 // NIfTI, NRRD, MetaImage or .raw file, raw-stored or compressed, equals the crop of the whole
 // loaded volume bit for bit — several sample types, both byte orders, odd dimensions, file
 // axes flipped and permuted against the world — and the background value read from the

@@ -1,4 +1,4 @@
-// The axis-aligned splatter's bricks on an anisotropic grid (issue 26's open case): a
+// The axis-aligned splatter's bricks on an anisotropic grid: a
 // 24 x 20 x 18 Gaussian blob at spacing 1, 1.5, 2 in 2 and 5 bricks equals one process within
 // 1e-5 of the peak, dvr, x-ray and mip, from five views.
 #include <catch2/catch.hpp>
@@ -46,7 +46,7 @@ float maxAbs(const Image& a, const Image& b) {
 
 TEST_CASE("bricks: the axis splatter's seams on an anisotropic grid are within 1e-5 of the peak",
           "[bricks]") {
-    // The open case of issue 26: 1.5e-4 with 5 bricks before. The cause was the clipping's
+    // With 5 bricks this once differed by 1.5e-4. The cause was the clipping's
     // margin in classification (the kernel's own reach, R): an oblique ray's sheet pixel sees
     // kernels up to sqrt 3 (R + 1/2) from the kept region (model/clip_region.h, clipReach),
     // so the bricks' halves of a sheet pixel missed kernels just beyond the face; ghost

@@ -1,7 +1,6 @@
-// Bricked sequences without MPI (splat/bricks.h BrickedFrames, issue 26): the bricks'
+// Bricked sequences without MPI (splat/bricks.h BrickedFrames): the bricks'
 // Scenes built once and rendered view after view equal one-process frames, and
-// `splat rotate --bricks K` writes the frames `splat rotate` writes (README "Beyond one
-// machine").
+// `splat rotate --bricks K` writes the frames `splat rotate` writes (docs/parallel.md).
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>

@@ -1,4 +1,4 @@
-// Sort-last bricks without MPI (splat/bricks.h, issue 26): the k-d split, ghost layers,
+// Sort-last bricks without MPI (splat/bricks.h): the k-d split, ghost layers,
 // visibility order, brick loading, and bricked frames against one-process frames.
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -182,7 +182,7 @@ TEST_CASE(
     // The axis-aligned splatter cuts each sheet pixel's path at the brick face: the two
     // pieces composite to the uncut one. The image-aligned splatter's slabs straddle the
     // faces and, composited fast (partial images), are cut as if their density were uniform
-    // across them: README "Beyond one machine" gives the seam measured here (the exact
+    // across them: docs/parallel.md gives the seam measured here (the exact
     // composite: test_bricks_exact.cpp).
     for (RenderMode mode : {RenderMode::Dvr, RenderMode::Mip, RenderMode::Xray})
         for (RendererKind r : {RendererKind::Axis, RendererKind::Sheet}) {

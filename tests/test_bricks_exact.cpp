@@ -1,4 +1,4 @@
-// Exact bricks of the image-aligned splatter (splat/slab_sheets.h, issue 26): every slab's
+// Exact bricks of the image-aligned splatter (splat/slab_sheets.h): every slab's
 // sheets summed over the bricks before compositing give the one-process frame to float
 // rounding, for odd sizes and K not a power of 2; the fast path (partial images) does not.
 #include <catch2/catch.hpp>

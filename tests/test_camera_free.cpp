@@ -1,4 +1,4 @@
-// The free camera (issue 24, finding 6): eye, look-at point and up vector beside the orbit.
+// The free camera: eye, look-at point and up vector beside the orbit.
 #include <catch2/catch.hpp>
 #include <cmath>
 

@@ -1,4 +1,4 @@
-// The command line's contract with scripts (README "Command line"): exit status 0 success,
+// The command line's contract with scripts (docs/command-line.md): exit status 0 success,
 // 1 the work failed, 2 usage error, for every subcommand; usage text on a bare `splat`;
 // grouped --help; --version; one warning line per ignored flag with the image unchanged;
 // compare --fail-above; Volume::note warnings from every command that loads a volume; the

@@ -1,5 +1,5 @@
-// Scene files (README "Scene files"): --write-scene writes the scene that reproduces an
-// image byte for byte; relative paths are relative to the scene's folder; typed values and
+// Scene files (docs/command-line.md "Scene files"): --write-scene writes the scene that reproduces
+// an image byte for byte; relative paths are relative to the scene's folder; typed values and
 // the old string forms; every malformed case names its key and the file (exit status 2);
 // the metadata of written images; normalized and absolute iso levels.
 #include <OpenImageIO/imageio.h>

@@ -1,4 +1,4 @@
-// Issue 27: the pixel-filtered reference (reference/pixel_filter.h) and EWA resampling in the
+// The pixel-filtered reference (reference/pixel_filter.h) and EWA resampling in the
 // splatters (footprint/ellipse.h, ewaFootprint), against closed forms: a Gaussian blob's
 // X-ray is a Gaussian, and Gaussians convolve to a Gaussian.
 #include <catch2/catch.hpp>

@@ -1,6 +1,6 @@
-// The renderers at the extremes of their parameters (issue 12; ctest -L extremes). Every case
+// The renderers at the extremes of their parameters (ctest -L extremes). Every case
 // asserts finite output and a stated bound against the reference ray caster or a closed
-// form; none merely checks that nothing crashed. Closed forms (splat/DESIGN.md, "The model"):
+// form; none merely checks that nothing crashed. Closed forms (docs/design.md "The model"):
 //   xray:                 I = sum_i d_i fp(r_i) / |S^-1 w|
 //   dvr, constant colour: I = k (1 - exp(-tau)),  tau = sum_i rho_i fp(r_i) / |S^-1 w|
 // (fp is the kernel's exact line integral, r_i the ray's distance from voxel i in index
@@ -422,8 +422,9 @@ TEST_CASE("extremes: a perspective eye inside the volume, and one a voxel from a
                     CHECK(st.exactPixels == std::size_t(33 * 33));
                     CHECK(e.maxAbs <= 1e-6 * peak);
                 } else {
-                    // The local-affine footprint's error (README table: below 1% of the
-                    // peak up to 120 degrees; measured 2e-3 for the dvr core at 169.9).
+                    // The local-affine footprint's error (docs/speed-vs-accuracy.md "Perspective
+                    // error": below 1% of the peak up to 120 degrees; measured 2e-3 for the
+                    // dvr core at 169.9).
                     CHECK(e.maxAbs < 0.02 * peak);
                 }
             }
@@ -462,7 +463,7 @@ double plateFieldPeak(const footprint::Kernel& h, int slices) {
 
 }  // namespace
 
-// Issue 21, "MIP of thin volumes": a sheet's MIP value is the mean of f over the ray's path
+// The MIP of thin volumes: a sheet's MIP value is the mean of f over the ray's path
 // through the sheet. The axis-aligned splatter integrates each kernel whole into its own
 // slice's sheet, so across a plate only N slices thick it attributes to one sheet the mass
 // that the field spreads over N + 2R slices: its MIP of the plate is the plate's value

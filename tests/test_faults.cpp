@@ -1,4 +1,4 @@
-// The library's writers under faults (issue 23): writeImage, writeTextAtomic and the study
+// The library's writers under faults: writeImage, writeTextAtomic and the study
 // report throw splat::Error naming the file and the OS error, and leave the previous file
 // untouched and no temporary behind. The failing write is made by RLIMIT_FSIZE with SIGXFSZ
 // ignored (write(2) then fails with EFBIG part way through the file); the command-line

@@ -1,4 +1,4 @@
-// Progress and cancel inside one frame (issue 24, finding 4): every renderer reports a total
+// Progress and cancel inside one frame: every renderer reports a total
 // known up front, counts up to it in order, and stops within a tile, chunk or row of a cancel.
 #include <catch2/catch.hpp>
 #include <atomic>

@@ -1,4 +1,4 @@
-// DICOM series read right (issue 14): order along the slice normal whatever the
+// DICOM series read right: order along the slice normal whatever the
 // InstanceNumbers and file names, spacing from PixelSpacing and the positions, values in
 // Hounsfield units, one series per volume, upright like NIfTI. The series are written here
 // with GDCM's writer.

@@ -1,4 +1,4 @@
-// Absurd geometry and parameters (issue 14): spacings 1e-30,1,1 and 1e-6,1,1e6 and a NaN
+// Absurd geometry and parameters: spacings 1e-30,1,1 and 1e-6,1,1e6 and a NaN
 // or Inf origin crashed the image-aligned splatter (unchecked float -> uint32 slab index);
 // a reference step of 1e-9 voxels silently became the coarsest step. Each now stops with
 // one splat::Error before any frame work, for every renderer.

@@ -1,7 +1,7 @@
-// Hostile files (issue 14): every fault found by hand becomes a reproducer written here.
+// Hostile files: every fault found by hand becomes a reproducer written here.
 // Each must give one line naming the file and the problem (nothing allocated beyond what
 // the file can hold, no over-read), or load with a stated warning in Volume::note, or load
-// correctly. README "Input files and bad input" is the policy these tests pin down.
+// correctly. docs/input-files.md is the policy these tests pin down.
 #include <nifti/nifti1.h>
 #include <nifti/nifti2.h>
 #include <sys/stat.h>

@@ -1,4 +1,4 @@
-// The library boundary (issue 24): lifetimes the compiler enforces, settings and in-memory
+// The library boundary: lifetimes the compiler enforces, settings and in-memory
 // volumes validated where they enter, and one rule for what a frame may change.
 #include <catch2/catch.hpp>
 #include <cmath>

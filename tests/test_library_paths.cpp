@@ -1,4 +1,4 @@
-// Issue 24, findings 4, 6 and 8 beyond one frame: progress totals known up front for
+// The library beyond one frame: progress totals known up front for
 // sequences, popping and studies, cancel reaching the frame in flight; the popping analyzer
 // over any camera path; one end-point convention; honest exact-path fallbacks.
 #include <catch2/catch.hpp>

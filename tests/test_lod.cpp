@@ -1,4 +1,4 @@
-// Level of detail (issue 11, Quality::lod, splat/src/model/level_of_detail.h): the 2x level
+// Level of detail (Quality::lod, splat/src/model/level_of_detail.h): the 2x level
 // of a scene against brute-force cell averages, closed forms of X-ray and dvr through a
 // constant box with bounds derived from the footprint's lattice ripple, the box-filtered
 // volume it stands for, when a level is used, and the command line.
@@ -27,7 +27,7 @@ using splat::test::testTmpDir;
 
 namespace {
 
-/// The transfer function of the README's timing runs (issue 11).
+/// The transfer function of the timing runs in docs/speed-vs-accuracy.md "Level of detail".
 TransferFunction timingTransfer() {
     TransferFunction tf;
     tf.normalized = true;
@@ -400,7 +400,7 @@ TEST_CASE("lod: dvr at level 1 against the reference (the measured cost of the k
     // phantom:64 at 64^2 (the geometry of phantom:512 at 512^2: a voxel covers 0.58 pixels),
     // the timing transfer function. Level 1 widens every kernel to 2.3 pixels: opaque
     // silhouettes grow and thin shells blur, so its error is far above the full splatter's
-    // (README "Level of detail" has the figures at full size).
+    // (docs/speed-vs-accuracy.md "Level of detail" has the figures at full size).
     const Volume v = makeSynthetic("phantom", 64);
     const RenderSettings s = timingView(64, 30, 15);
     const Scene scene(v, s);
@@ -453,7 +453,7 @@ TEST_CASE("lod: --lod on the command line and in scene files", "[lod][cli]") {
     CHECK(ref.errLines()[0].find("--lod applies to the splatters") != std::string::npos);
 }
 
-// ---- --lod auto (issue 27): the level chosen from the error it adds, and the merged kernel
+// ---- --lod auto: the level chosen from the error it adds, and the merged kernel
 // narrowed so that kernel, pyramid box and pixel filter together are what the pixel-filtered
 // reference sees (model/level_of_detail.h, lodFootprint).
 

@@ -1,4 +1,4 @@
-// The `splat` program under mpirun (issue 26, README "Beyond one machine"): frame-parallel
+// The `splat` program under mpirun (docs/parallel.md): frame-parallel
 // sequences equal the one-process run bit for bit, bricked frames equal it within 1e-5 of
 // the peak, a failing rank ends the job with one error. Hidden tag [.mpi]: registered with
 // ctest only when splat is built with MPI (tests/CMakeLists.txt).

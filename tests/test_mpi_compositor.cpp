@@ -1,9 +1,9 @@
-// The compositors of bricks under mpirun (splat/mpi/brick_group.h, README "Beyond one
-// machine"): the sparse direct-send gives the one-process bricked frame bit for bit (the same
-// blends in the same order; only the transparent pixels are left out of its messages), IceT
-// (when splat is built with it) the same frame within float rounding, for every renderer
-// that composites partial images, an empty brick included. Hidden tag [.mpi]: run by
-// mpi.ranks. The usage errors of --compositor need no mpirun.
+// The compositors of bricks under mpirun (splat/mpi/brick_group.h, docs/parallel.md): the sparse
+// direct-send gives the one-process bricked frame bit for bit (the same blends in the same order;
+// only the transparent pixels are left out of its messages), IceT (when splat is built with it) the
+// same frame within float rounding, for every renderer that composites partial images, an empty
+// brick included. Hidden tag [.mpi]: run by mpi.ranks. The usage errors of --compositor need no
+// mpirun.
 #include <catch2/catch.hpp>
 #include <cstring>
 #include <fstream>

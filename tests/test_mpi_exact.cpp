@@ -1,4 +1,4 @@
-// Exact bricks of the image-aligned splatter under mpirun (splat/slab_sheets.h, issue 26):
+// Exact bricks of the image-aligned splatter under mpirun (splat/slab_sheets.h):
 // every slab's sheets are summed across ranks (onto ranges of screen tiles, a sparse direct
 // exchange) before compositing, so the frame equals one process's within 1e-5 of the peak; the
 // fast composite stays within its documented bound. Hidden tag [.mpi]: run by mpi.ranks.

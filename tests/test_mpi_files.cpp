@@ -1,5 +1,5 @@
 // Bricks read from files under mpirun, and the number of bricks chosen from --rank-memory
-// (issue 26, README "Beyond one machine"): a NRRD whose file axes are permuted and flipped
+// (docs/parallel.md): a NRRD whose file axes are permuted and flipped
 // against the world, raw-stored and gzip-compressed, with a CT background (-1000), renders on
 // 2 and 3 ranks as on one process (within 1e-5 of the peak) without --background-value.
 // Hidden tag [.mpi], run by the ctest test mpi.ranks when splat is built with MPI.

@@ -1,4 +1,4 @@
-// Bricked popping under mpirun (issue 26, README "Beyond one machine"): `mpirun -np P splat
+// Bricked popping under mpirun (docs/parallel.md): `mpirun -np P splat
 // popping --bricks K` (rank 0 runs the analysis and asks the ranks for every frame, each rank
 // renders its bricks, the group composites) finds what the one-process popping finds: the
 // same events (angles, refined angle and width, sheet axes, prediction, classification) and

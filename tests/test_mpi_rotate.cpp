@@ -1,4 +1,4 @@
-// Bricked sequences under mpirun (issue 26, README "Beyond one machine"): `mpirun -np 2
+// Bricked sequences under mpirun (docs/parallel.md): `mpirun -np 2
 // splat rotate --bricks 3` (an uneven split, K not a multiple of the ranks) writes the frames
 // of the one-process `splat rotate` within 1e-5 of the peak, exact sheets included; a brick
 // that cannot be read ends the job with one error on rank 0 and no frame.

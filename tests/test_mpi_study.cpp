@@ -1,4 +1,4 @@
-// `splat study` under mpirun (issue 26, README "Beyond one machine"): the references are
+// `splat study` under mpirun (docs/parallel.md): the references are
 // rendered across the ranks before anything is timed, the timed frames on rank 0 alone; every
 // output but the wall times and memory figures equals the one-process run's. Hidden tag
 // [.mpi]: run by mpi.ranks.

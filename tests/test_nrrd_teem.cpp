@@ -1,4 +1,4 @@
-// NRRD as teem writes it (issue 22): teem (Debian teem-apps, the format's reference
+// NRRD as teem writes it: teem (Debian teem-apps, the format's reference
 // implementation) writes one volume in every type, in all five encodings of the format
 // (raw, gzip, bzip2, ascii, hex) and both byte orders; splat reads each voxel for voxel,
 // and the world frame of every named space. Needs teem-unu (tools/setup.sh).

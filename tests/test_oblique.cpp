@@ -1,6 +1,6 @@
-// Oblique volumes in their true orientation (issue 22): Volume::direction rotates the
+// Oblique volumes in their true orientation: Volume::direction rotates the
 // volume's frame into the world, and the Camera turns its world parameters into the volume's
-// frame (splat/DESIGN.md "World frame"), so an oblique volume is a change of basis of the
+// frame (docs/design.md "World frame"), so an oblique volume is a change of basis of the
 // view, never a resampling.
 #include <catch2/catch.hpp>
 #include <cmath>

@@ -1,4 +1,4 @@
-// The reference ray caster against closed forms of the model (splat/DESIGN.md, "The model").
+// The reference ray caster against closed forms of the model (docs/design.md "The model").
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>

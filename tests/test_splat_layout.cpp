@@ -1,4 +1,4 @@
-// The compact splat list of issue 11: positions computed from the index, emission by value.
+// The compact splat list: positions computed from the index, emission by value.
 #include <catch2/catch.hpp>
 
 #include "splat/classify.h"

@@ -267,7 +267,7 @@ TEST_CASE("empty volume, a 1x1x1 volume and a 1x1 image render", "[splatter]") {
 }
 
 TEST_CASE("impossible settings are refused with a clear message", "[splatter]") {
-    // (iso is rendered by the splatters since issue 13: tests/test_techniques_iso.cpp)
+    // (iso is rendered by the splatters: tests/test_techniques_iso.cpp)
     const Volume v = makeSynthetic("sphere", 16);
     RenderSettings s = baseSettings(RendererKind::Axis, RenderMode::Dvr);
     s.renderer = RendererKind::Sheet;
@@ -331,7 +331,7 @@ TEST_CASE("splatters against the reference ray caster", "[splatter][accuracy]") 
     };
     // Bounds: RMSE over the image, dvr colour in [0, 1]; measured values are ~2-3x lower.
     const Case cases[] = {{"blob", 32, "gray-ramp", 0.01, 0.01, true},
-                          // The antialiased ball (issue 13; the binary one had one colour,
+                          // The antialiased ball (the binary one had one colour,
                           // so every sheet order was exact to 1e-5).
                           {"sphere", 32, "gray-ramp", 5e-4, 3e-4, true},
                           {"phantom", 64, "ct-soft", 0.02, 0.02, true}};

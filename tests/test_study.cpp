@@ -1,4 +1,4 @@
-// Speed-accuracy studies, convergence orders and "model only what the scene needs" (issue 12).
+// Speed-accuracy studies, convergence orders and "model only what the scene needs".
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>

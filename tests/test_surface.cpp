@@ -1,4 +1,4 @@
-// Surface export (issue 21): the mesh of f = level lies on the level set of the reconstructed
+// Surface export: the mesh of f = level lies on the level set of the reconstructed
 // field, is closed and outward-oriented for a closed object, has a sphere's volume and area,
 // needs no box faces on CT data in HU, and survives a round trip through each file format.
 #include <catch2/catch.hpp>

@@ -62,7 +62,7 @@ TEST_CASE("phantom: brain ~1.0 at the centre, skull 2.0, head upright", "[volume
 }
 
 TEST_CASE("sphere voxel sum is the smooth ball's volume 4/3 pi (r^3 + 3 r w^2 / 7)", "[volume]") {
-    // The antialiased ball (issue 13): the edge profile's second moment is w^2 / 7.
+    // The antialiased ball: the edge profile's second moment is w^2 / 7.
     for (int n : {32, 64}) {
         Volume v = makeSynthetic("sphere", n);
         double count = 0;

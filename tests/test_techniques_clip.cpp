@@ -1,4 +1,4 @@
-// Clipping cuts the reconstructed field, not the voxels (issue 13): the cut face shows the cut
+// Clipping cuts the reconstructed field, not the voxels: the cut face shows the cut
 // data where the plane is, in every renderer; a kept region holding everything changes no pixel.
 #include <catch2/catch.hpp>
 #include <cmath>

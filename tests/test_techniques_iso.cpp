@@ -1,4 +1,4 @@
-// Isosurfaces through the splatters' sheets against the reference's root finding (issue 13).
+// Isosurfaces through the splatters' sheets against the reference's root finding.
 #include <catch2/catch.hpp>
 #include <cmath>
 

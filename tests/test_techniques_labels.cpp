@@ -1,4 +1,4 @@
-// Segmentation labels: nearest-label classification, never interpolated (issue 13).
+// Segmentation labels: nearest-label classification, never interpolated.
 #include <catch2/catch.hpp>
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // Shading (one Blinn-Phong model, pre and post, every renderer), edge enhancement and the
-// gradient method (issue 13).
+// gradient method.
 #include <catch2/catch.hpp>
 #include <cmath>
 

@@ -1,4 +1,4 @@
-// Slices, MPR and CPR through the reconstructed field; clipping (issue 13).
+// Slices, MPR and CPR through the reconstructed field; clipping.
 #include <catch2/catch.hpp>
 #include <cmath>
 

@@ -1,5 +1,5 @@
-// Transfer-function files (issue 13: ParaView's colour-map presets, presets carrying their
-// mode; issue 14: refused typos and absurd numbers). Files are written by the tests.
+// Transfer-function files (ParaView's colour-map presets, presets carrying their mode,
+// refused typos and absurd numbers). Files are written by the tests.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>

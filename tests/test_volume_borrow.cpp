@@ -1,4 +1,4 @@
-// Borrowed and typed volumes (issue 24, finding 5): a Volume over caller-owned samples of
+// Borrowed and typed volumes: a Volume over caller-owned samples of
 // type u8/i16/u16/f32, read as raw * scale + offset, renders exactly as its owned float copy
 // in every renderer and mode, without a float copy; the keepAlive is held; validation holds.
 #include <catch2/catch.hpp>

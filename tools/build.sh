@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the dependencies and builds splat (Release) into ./build; the log goes to
 # build/build.log (never the repository root). ccache is used when it is installed.
-# SPLAT_WITH_ICET=1: with splat::mpi's IceT compositor (README "Building").
+# SPLAT_WITH_ICET=1: with splat::mpi's IceT compositor (docs/building.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh

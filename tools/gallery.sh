@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Renders the README's pictures into tools/gallery/ with the project's own renderer.
+# Renders the pictures of README.md and splat/docs/ into tools/gallery/ with the project's own
+# renderer.
 # Usage: bash tools/gallery.sh   (after tools/build.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -39,7 +40,7 @@ $S rotate synthetic:phantom:96 --tf tools/gallery/phantom-tf.json --renderer she
 $S popping $CH2 --tf mri-head --size 128x128 --from 40 --to 50 --step 0.5 --report $tmp/popping -q
 python3 tools/popping_figures.py $tmp/popping $G/popping_ch2
 
-# ---- Techniques (issue 13): shading, edges, isosurfaces, labels, clipping, views ----------
+# ---- Techniques: shading, edges, isosurfaces, labels, clipping, views ----------
 T=/usr/share/mricron/templates
 # Post-classified ch2, unshaded and shaded (Blinn-Phong, light from the upper left).
 $S render $CH2 --tf mri-head --classify post --renderer sheet --azimuth 180 --elevation 10 --size 320x320 -o $G/tech_head_post.png
@@ -65,10 +66,10 @@ $S slices $CH2 --axis z --every 12 --scale-bar 50 -o $tmp/slices && cp $tmp/slic
 $S mpr $CH2 --plane 0,0,10,0.3,0.2,1 --size 256x256 --pixel-size 0.8 --scale-bar 50 -o $G/tech_mpr_oblique.png
 printf '{"points": [[-60, -20, 10], [-30, 40, 20], [30, 40, 20], [60, -20, 10]], "lateral": [0, 0, 1], "width": 160}\n' > $tmp/curve.json
 $S cpr $CH2 --curve $tmp/curve.json -o $G/tech_cpr.png
-# CT in Hounsfield units (issue 21): the Shepp-Logan head in HU (air -1000, b = -1000), the
+# CT in Hounsfield units: the Shepp-Logan head in HU (air -1000, b = -1000), the
 # CT look chosen from the data (no --tf: ct-hu), cut open at x = 63.5; post-classified; MIP.
 $S render synthetic:ct-phantom:128 --azimuth 120 --elevation 15 --size 320x320 --clip-plane 63.5,0,0,1,0,0 --shade -o $G/ct_hu_clipped.png
 $S render synthetic:ct-phantom:128 --classify post --azimuth 120 --elevation 15 --size 320x320 --clip-plane 63.5,0,0,1,0,0 -o $G/ct_hu_post.png
 $S render synthetic:ct-phantom:128 --mode mip --azimuth 90 --size 320x320 -o $G/ct_hu_mip.png
-# Aliasing with and without EWA (README "Aliasing and EWA").
+# Aliasing with and without EWA (docs/accuracy.md "Aliasing and EWA").
 bash tools/gallery_ewa.sh

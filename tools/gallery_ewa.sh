@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The pictures of README "Aliasing and EWA": an X-ray of synthetic:phantom:128 at
+# The pictures of docs/accuracy.md "Aliasing and EWA": an X-ray of synthetic:phantom:128 at
 # 128x128 (a voxel covers 0.58 pixels), axis-aligned splatter without and with EWA, the
 # pixel-filtered reference (Gaussian, sigma 0.5 pixels), and |splatter - filtered reference|.
 # Usage: bash tools/gallery_ewa.sh   (after tools/build.sh; tools/gallery.sh runs it too)

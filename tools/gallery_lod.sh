@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The pictures of README "Level of detail": an X-ray of synthetic:phantom:128 at 64x64 (a
-# voxel covers 0.29 pixels): the axis-aligned splatter at full resolution, at --lod 1 (which
-# takes level 2 here, the doubled kernel), at --lod auto (level 1, the merged footprint
+# The pictures of docs/speed-vs-accuracy.md "Level of detail": an X-ray of synthetic:phantom:128 at
+# 64x64 (a voxel covers 0.29 pixels): the axis-aligned splatter at full resolution, at --lod 1
+# (which takes level 2 here, the doubled kernel), at --lod auto (level 1, the merged footprint
 # narrowed to k^2 - B_1 + sigma^2), the pixel-filtered reference (sigma 0.5 pixels), and
 # |splatter - filtered reference| (heat maps scaled to 2).
 # Usage: bash tools/gallery_lod.sh   (after tools/build.sh)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""README figures from a popping report: the error-jump plot (J against angle) as a
+"""The figures of docs/popping.md from a popping report: the error-jump plot (J against angle) as a
 standalone SVG, and the first event's frames before and after (axis | sheet | reference)
 with the |after - before| heat maps, tiled into one PNG strip with oiiotool.
 Usage: python3 tools/popping_figures.py REPORT_DIR OUT_PREFIX"""

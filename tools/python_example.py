@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# splat from Python (README "Python"): load a volume, render it with the three renderers,
+# splat from Python (docs/python.md): load a volume, render it with the three renderers,
 # compare them, find popping on a sweep and plot the error series. ctest runs it (python.example).
 import sys
 from pathlib import Path

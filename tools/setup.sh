@@ -7,10 +7,10 @@ packages=(build-essential cmake pkg-config libglm-dev libopenimageio-dev openima
           clang-14 libclang-rt-14-dev mricron-data chromium
           xvfb xauth  # xvfb, xauth: tools/bench/vs_vtk.py runs VTK without a display
           python3 python3-nibabel python3-pydicom teem-apps libbz2-dev  # tests: faults, third-party files and oracles
-          libopenmpi-dev openmpi-bin  # splat::mpi (README "Beyond one machine")
-          pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib)  # the Python module (README "Python")
+          libopenmpi-dev openmpi-bin  # splat::mpi (docs/parallel.md)
+          pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib)  # the Python module (docs/python.md)
 # SPLAT_WITH_ICET=1 also installs ParaView's IceT for splat::mpi's optional IceT compositor
-# (README "Building"; Debian ships IceT only inside ParaView: paraview-dev, ~100 MB to
+# (docs/building.md; Debian ships IceT only inside ParaView: paraview-dev, ~100 MB to
 # download, ~700 MB on disk). CI asks for it (.ci/run); a newcomer's setup does not.
 if [ "${SPLAT_WITH_ICET:-0}" = 1 ]; then packages+=(paraview-dev); fi
 missing=()

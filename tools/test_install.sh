@@ -8,7 +8,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cmake --install build --prefix "$tmp/prefix" > "$tmp/install.log"
 # IceT (SPLAT_ICET) is private to splat::mpi, which is not installed: the installed package
-# config, splat.pc and libraries never name IceT or ParaView (README "Building").
+# config, splat.pc and libraries never name IceT or ParaView (docs/building.md).
 if grep -rliE "icet|paraview" "$tmp/prefix/lib"*/cmake "$tmp/prefix/lib"*/pkgconfig; then
     echo "test_install: the installed package names IceT or ParaView (files above)"; exit 1
 fi
@@ -52,7 +52,7 @@ for mode in plain static; do
         tail -20 "$tmp/pc_$mode.log"; exit 1; }
     "$tmp/pc_consumer_$mode" "$tmp"
 done
-# The default build is portable (issue 24, finding 7): SPLAT_NATIVE is off and no target
+# The default build is portable: SPLAT_NATIVE is off and no target
 # compiles with -march=native unless asked for.
 cmake -S . -B "$tmp/defaults" > "$tmp/defaults.log" 2>&1 || { cat "$tmp/defaults.log"; exit 1; }
 grep -q "^SPLAT_NATIVE:BOOL=OFF" "$tmp/defaults/CMakeCache.txt" ||

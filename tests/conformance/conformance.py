@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Conformance of splat's loaders against nibabel and pydicom (issue 22).
+"""Conformance of splat's loaders against nibabel and pydicom.
 
 Runs `splat info` over every NIfTI / ANALYZE / DICOM file of the two third-party corpora
 Debian ships (python3-nibabel's nibabel/tests/data and nibabel/nicom/tests/data,

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""One world frame for every format (issue 22): no left-right mirror between them.
+"""One world frame for every format: no left-right mirror between them.
 
 One asymmetric volume (an L-shaped bar, a ramp and one brightest marker voxel) with a known
 RAS geometry is written

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Fault injection for splat's writers and --resume (issue 23; README "Reliability").
+"""Fault injection for splat's writers and --resume (docs/reliability.md).
 
 Usage: fault_injection.py SPLAT_EXE WORK_DIR [SEED]
 

@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
              "space directions: (0.5,0,0) (0,-1,0) (0,0,2)\nspace origin: (1,2,3)\n"
              "byte skip: 0\n\n" +
              be);
-    // The other encodings (issue 22): bzip2, hex; a time space and a left-handed one.
+    // The other encodings: bzip2, hex; a time space and a left-handed one.
     {
         const std::string raw = ramp<std::int16_t>(24);
         const std::string skipped = "sk" + raw;  // byte skip 2 counts decompressed bytes

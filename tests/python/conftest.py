@@ -1,4 +1,4 @@
-# The Python module's tests (README "Python"), run by ctest as python.pytest with
+# The Python module's tests (docs/python.md), run by ctest as python.pytest with
 # PYTHONPATH=build/python and SPLAT_EXE (the CLI they compare with).
 import os
 import subprocess

@@ -13,21 +13,20 @@
 // default front-to-back early termination (1/256) unless --early-termination says otherwise.
 // --lod L adds the axis-aligned and slab-1 image-aligned splatters at level of detail L
 // (Quality::lod) and their level; --lod auto the same with Quality::lodAuto, --lod brick with
-// Quality::lodBrick (README "Level of
-// detail"); with --ewa also both with EWA on; a list (--lod 1,auto) adds each in turn. --axis-only leaves out the image-aligned rows. --supersample N renders the reference with N x N rays per
-// pixel (at N times the size) and box-filters it: the pixel's area average rather than its
-// centre's value.
+// Quality::lodBrick (docs/speed-vs-accuracy.md "Level of detail"); with --ewa also both with EWA
+// on; a list (--lod 1,auto) adds each in turn. --axis-only leaves out the image-aligned rows.
+// --supersample N renders the reference with N x N rays per pixel (at N times the size) and
+// box-filters it: the pixel's area average rather than its centre's value.
 //
 // Where a voxel covers fewer than one pixel (or with --pixel-filter SIGMA, or --truth
 // filtered), it also renders the pixel-filtered reference (Quality::pixelFilter: s x s rays
-// per pixel through a Gaussian of SIGMA pixels, default 0.5, converged; README "Aliasing and
-// EWA") and gives every row two sets of columns: RMSE against the point-sampled reference
-// (one ray at each pixel centre, the columns above) and RMSE, PSNR and max abs against the
-// filtered one. --truth point leaves the filtered reference out (it costs s^2 reference
-// frames and more). The splatters' rows use the default EWA setting (Quality::ewa auto: on
-// in xray below a pixel per voxel; the label says ", EWA" where it was on); --ewa adds the
-// axis-aligned and slab-1 image-aligned splatters with EWA off and with EWA on (low-pass
-// SIGMA, or 0.5 pixels).
+// per pixel through a Gaussian of SIGMA pixels, default 0.5, converged; docs/accuracy.md "Aliasing
+// and EWA") and gives every row two sets of columns: RMSE against the point-sampled reference (one
+// ray at each pixel centre, the columns above) and RMSE, PSNR and max abs against the filtered one.
+// --truth point leaves the filtered reference out (it costs s^2 reference frames and more). The
+// splatters' rows use the default EWA setting (Quality::ewa auto: on in xray below a pixel per
+// voxel; the label says ", EWA" where it was on); --ewa adds the axis-aligned and slab-1
+// image-aligned splatters with EWA off and with EWA on (low-pass SIGMA, or 0.5 pixels).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

@@ -1,4 +1,4 @@
-// Memory per sample type and per mode (issue 24, finding 5): builds an N^3 Gaussian blob
+// Memory per sample type and per mode: builds an N^3 Gaussian blob
 // stored as TYPE (float32 owned, or borrowed float32/uint8/int16/uint16, the
 // caller's buffer allocated here), renders one frame of MODE with RENDERER, and prints the
 // peak resident set size. Run it under `/usr/bin/time -v` for the kernel's figure.

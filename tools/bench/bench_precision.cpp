@@ -1,11 +1,11 @@
-// Float against double accumulation (README, "Speed vs accuracy" → "Float and double").
+// Float against double accumulation (docs/speed-vs-accuracy.md "Float and double").
 //
 // The splatters accumulate footprints and composite sheets in float. This program measures
 // what that costs on a large frame: the X-ray of synthetic:phantom:N (N = 512 by default)
 // at S×S pixels (2048² by default), seen along the volume's y axis (azimuth 0, elevation 0,
 // orthographic), where the exact image is a closed form,
 //
-//     I(pixel) = Σ_i d_i fp(r_i) / |S⁻¹ω|        (DESIGN, "Footprints"; |S⁻¹ω| = 1 here),
+//     I(pixel) = Σ_i d_i fp(r_i) / |S⁻¹ω|        (docs/design.md "Footprints"; |S⁻¹ω| = 1 here),
 //
 // summed here in double over every voxel whose kernel the pixel's ray crosses (the voxel
 // columns within the kernel radius of the ray). Two sums are formed per sampled pixel: with

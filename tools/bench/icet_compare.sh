@@ -1,10 +1,9 @@
 #!/usr/bin/env bash
-# splat's direct-send compositing beside IceT's (README "Beyond one machine" -> "Memory,
-# scaling and a model"): builds tools/bench/icet/icet_compare and runs it under
-# `mpirun --oversubscribe -np P` for P = 2, 3, 4, 8 at 256^2, 512^2 and 1024^2, then prints
-# a markdown table (median time of the slowest rank, bytes sent per rank, max abs against a
-# one-process composite). Exits 77 when IceT is not installed (Debian: paraview-dev).
-# Usage: bash tools/bench/icet_compare.sh [REPS] [RANKS] [SIZES] [IMAGES]
+# splat's direct-send compositing beside IceT's (docs/parallel.md "Memory, scaling and a model"):
+# builds tools/bench/icet/icet_compare and runs it under `mpirun --oversubscribe -np P` for P = 2,
+# 3, 4, 8 at 256^2, 512^2 and 1024^2, then prints a markdown table (median time of the slowest rank,
+# bytes sent per rank, max abs against a one-process composite). Exits 77 when IceT is not installed
+# (Debian: paraview-dev). Usage: bash tools/bench/icet_compare.sh [REPS] [RANKS] [SIZES] [IMAGES]
 #   (defaults 15, "2 3 4 8", "256 512 1024", 0.7; after tools/build.sh). IMAGES is either a
 #   number, the diameter of each rank's synthetic disc over the image side (0.7 leaves 62%
 #   of every partial image transparent, 3 covers it all: no transparent pixel for IceT's

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The README's table of compositors (README "Beyond one machine", "Direct-send beside IceT")
+"""The table of compositors in docs/parallel.md "Direct-send beside IceT"
 from tools/bench/icet_compare.sh's JSON lines, run with ICET_COMPARE_BASE set to an
 icet_compare built before the sparse direct-send: per P and image size, the busiest rank's
 bytes sent and the median composite time of the old (dense) direct-send, the sparse one, IceT

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Sort-last bricks under MPI (issue 26, README "Beyond one machine"): peak memory per rank,
+"""Sort-last bricks under MPI (docs/parallel.md): peak memory per rank,
 strong and weak scaling with the work per rank and the bytes exchanged, a frame-time model
-for 64-1024 ranks, and the plot (SVG) of the README.
+for 64-1024 ranks, and the plot (SVG) of docs/parallel.md.
 
     /usr/bin/python3 tools/bench/mpi_scaling.py [--splat build/bin/splat] [--out DIR]
         [--memory-volume synthetic:phantom:800] [--skip-memory]

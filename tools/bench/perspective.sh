@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The splatters' perspective error against the field of view (README, "Speed vs accuracy"):
+# The splatters' perspective error against the field of view (docs/speed-vs-accuracy.md):
 # X-ray of synthetic:phantom:64 at 128x128, azimuth 30, elevation 15, eye at the fitted
 # distance (the bounding sphere fills the field of view); RMSE and max error relative to the
 # reference's peak. Usage: bash tools/bench/perspective.sh [VOLUME] [MODE]

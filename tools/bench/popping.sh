@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The popping analyzer's cost (README, "Popping analysis"): a 21-angle azimuth sweep
+# The popping analyzer's cost (docs/popping.md): a 21-angle azimuth sweep
 # (40..50 degrees in 0.5 degree steps) of ch2 with mri-head at 256x256, once with all three
 # renderers and once without the reference, refinement off (the sweep alone) and on.
 # Usage: bash tools/bench/popping.sh [THREADS]   (after tools/build.sh; takes a few minutes)

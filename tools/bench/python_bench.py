@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# The Python module's targets (issue 25, README "Python"), measured in one run:
+# What the Python module costs (docs/python.md "What Python costs"), measured in one run:
 #  1. Python overhead per frame: wall time of Scene.render minus the library's own frame time
 #     (RenderStats::milliseconds, the whole frame in C++), ch2 at 512x512, median of N frames;
 #     and the one-shot splat.render's wall time against a C++ Scene + frame of the same

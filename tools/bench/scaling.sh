@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Scaling of the splatters (README, "Speed vs accuracy"): time and peak memory against the
+# Scaling of the splatters (docs/speed-vs-accuracy.md): time and peak memory against the
 # number of visible voxels (synthetic:phantom:N, N = 64..512, 512x512 image) and against the
 # image size (256^2 .. 2048^2, phantom:128), each with the fitted exponent (least-squares
 # slope on log-log axes), and the speed-up from 1 thread to all.

@@ -1,5 +1,5 @@
 // An outside program linked against the installed splat package, as research code would use
-// it (issue 24). It renders the X-ray of a 16^3 constant cube (value 1, spacing 1 mm, in a
+// it. It renders the X-ray of a 16^3 constant cube (value 1, spacing 1 mm, in a
 // 20^3 volume of 0) whose samples live in a caller-owned uint16 array, borrowed without a
 // copy (Volume::borrow, scale 1/1000) and, after a round trip through a NIfTI file, loaded
 // with loadVolume. Through the centre the line integral of the reconstructed field is the

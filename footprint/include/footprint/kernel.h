@@ -2,10 +2,10 @@
 // Radially symmetric reconstruction kernels h(u), u the distance in voxels (index space),
 // truncated at radius R and normalised so that the integral of h over R^3 is 1.
 //
-// A volume's reconstructed field is f(x) = sum_i d_i h(|S^-1 (x - x_i)|) (splat/DESIGN.md, "The
-// model"); a constant volume reconstructs to the constant up to the kernel's
-// partition-of-unity ripple, max_p |sum_i h(p - p_i) - 1|, which partitionOfUnityRipple()
-// measures and the tests bound for the defaults.
+// A volume's reconstructed field is f(x) = sum_i d_i h(|S^-1 (x - x_i)|) (docs/design.md "The
+// model"); a constant volume reconstructs to the constant up to the kernel's partition-of-unity
+// ripple, max_p |sum_i h(p - p_i) - 1|, which partitionOfUnityRipple() measures and the tests bound
+// for the defaults.
 //
 // Gaussian (default).  With q = u^2 and e_R = exp(-R^2 / (2 sigma^2)),
 //

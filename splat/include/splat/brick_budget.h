@@ -1,6 +1,6 @@
 #pragma once
-// How many bricks a frame needs so that each process stays within a memory budget (issue 26,
-// README "Beyond one machine"): a pure function of the volume's size, the image and the
+// How many bricks a frame needs so that each process stays within a memory budget
+// (docs/parallel.md): a pure function of the volume's size, the image and the
 // ranks, so that it is tested with numbers and every rank computes the same choice.
 //
 // A process rendering bricks holds, at its peak: the largest of its bricks (ghost layers

@@ -1,5 +1,5 @@
 #pragma once
-// Sort-last bricked rendering (issue 26, splat/DESIGN.md "Beyond one machine"), the parts
+// Sort-last bricked rendering (docs/parallel.md), the parts
 // that do not need MPI: the volume is cut into K bricks by a k-d tree (uneven splits for odd
 // dimensions and K not a power of 2), each brick loaded with ghost layers as wide as the
 // kernel's support; a brick is rendered by the unchanged renderers with the whole volume's
@@ -189,7 +189,8 @@ enum class BrickComposite {
     /// the one-process frame to float rounding; exchanges the sheets, not images.
     Exact,
     /// Partial images composited over each other: each brick's slabs are cut at its faces as
-    /// if uniform across a slab, a seam of up to a few percent of the peak (README).
+    /// if uniform across a slab, a seam of up to a few percent of the peak
+    /// (docs/parallel.md "Sort-last bricks").
     Fast,
 };
 

@@ -1,5 +1,5 @@
 #pragma once
-// The camera of splat/DESIGN.md ("Camera convention"): world z is up; azimuth a, elevation e give
+// The camera of docs/design.md "Camera convention": world z is up; azimuth a, elevation e give
 // the view direction (-sin a cos e, cos a cos e, -sin e), image right (cos a, sin a, 0) and
 // image up = right x view. The view is centred on the volume centre; pixel (0, 0) is the
 // top-left corner and pixel centres sit at half-integers.

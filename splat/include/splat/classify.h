@@ -19,7 +19,7 @@ struct SplatList {
     /// The volume's grid: a splat's world position is origin + spacing (i, j, k), computed
     /// when needed (world()) rather than stored beside the index position.
     glm::dvec3 origin{0.0}, spacing{1.0};
-    /// The volume's background value b (splat/DESIGN.md "Reconstructed fields"): density
+    /// The volume's background value b (docs/design.md "Reconstructed fields"): density
     /// holds d_i - b, so that sum (d_i - b) h is the field minus b and a voxel equal to b
     /// needs no splat; whoever reads the field adds b back (x-ray integrates f - b).
     float background = 0.0f;

@@ -1,10 +1,10 @@
 #pragma once
-// Where the frames of a sequence are rendered (issue 26, splat/DESIGN.md "Beyond one
-// machine"). renderSequence renders them in this process unless a FrameFarm is installed:
-// then it hands the farm the list of views, and the farm renders them wherever it likes (the
-// MPI module splat/mpi: on other processes that hold the same Scene) and gives them back in
-// view order. The core never calls MPI; the farm is the seam. Pixels do not depend on the
-// process or the thread count that rendered them, so a farm changes no output.
+// Where the frames of a sequence are rendered (docs/parallel.md). renderSequence renders
+// them in this process unless a FrameFarm is installed: then it hands the farm the list of views,
+// and the farm renders them wherever it likes (the MPI module splat/mpi: on other processes that
+// hold the same Scene) and gives them back in view order. The core never calls MPI; the farm is the
+// seam. Pixels do not depend on the process or the thread count that rendered them, so a farm
+// changes no output.
 #include <cstddef>
 #include <functional>
 #include <memory>

@@ -1,5 +1,5 @@
 #pragma once
-// Popping-artifact analysis (splat/DESIGN.md, "Artifact analysis"). A sweep of views
+// Popping-artifact analysis (docs/design.md "Artifact analysis"). A sweep of views
 // theta_0 < theta_1 < ... is rendered by each renderer X from one Scene, and per interval
 // [theta_n, theta_n+1]:
 //   temporal change  T_X(n) = RMS(I_X(theta_n+1) - I_X(theta_n))
@@ -30,7 +30,7 @@
 namespace splat {
 
 /// The views of a sweep: the base camera turned about one angle. End points follow the one
-/// convention of splat/DESIGN.md ("Sequences"): `to` is inclusive, the last view.
+/// convention of docs/decisions.md "Sequences": `to` is inclusive, the last view.
 struct Sweep {
     enum class Angle { Azimuth, Elevation };
     Angle angle = Angle::Azimuth;
@@ -188,7 +188,8 @@ std::vector<double> predictSheetSwitches(const CameraPath& path, const Volume& v
 
 /// Writes `dir`/report.html (self-contained: inline SVG plots, embedded images and
 /// animation), metrics.csv (one row per renderer and interval) and summary.json (schema in
-/// the README), each atomically. `commandLine` is shown in the report (how to reproduce it).
+/// docs/popping.md "Popping reports: summary.json"), each atomically. `commandLine` is shown
+/// in the report (how to reproduce it).
 void writePoppingReport(const PoppingResult& result, const std::string& dir,
                         const std::string& commandLine);
 

@@ -23,7 +23,7 @@ struct CameraPath {
 
     enum class Angle { Azimuth, Elevation };
     /// `frames` views turning `angle` evenly from `from` to `to`, both inclusive (the one
-    /// end-point convention of splat/DESIGN.md "Sequences": the last view is `to`; one frame
+    /// end-point convention of docs/decisions.md "Sequences": the last view is `to`; one frame
     /// is `from`). A loop that does not repeat its first view ends one step short of a full
     /// turn: to = from + 360 (frames - 1) / frames (the `splat rotate` default).
     static CameraPath turn(const CameraParams& base, Angle angle, double from, double to,

@@ -1,14 +1,13 @@
 #pragma once
-// Exact sort-last bricks for the image-aligned splatter (issue 26, README "Beyond one
-// machine"). A slab's optical depth and emission (or its density integral) are sums over
-// kernels of their sections in the slab (splat/DESIGN.md "Sheets"), so summing every slab's
-// sheets over the bricks, each brick contributing the sections of the kernels of the samples
-// it owns (every kernel once: no ghost kernel, no clip plane), and compositing only the sums
-// gives the one-process frame to float rounding. The core stays free of MPI: BrickSheets
-// gives one brick's sheets of a group of slabs as plain float blocks, the caller sums them
-// (one process: into the same blocks; MPI: onto ranges of screen tiles, splat/bricks.h),
-// and SlabCompositor composites the summed blocks of its tiles group after group, front to
-// back in visiting order, so memory stays bounded by one group.
+// Exact sort-last bricks for the image-aligned splatter (docs/parallel.md). A slab's
+// optical depth and emission (or its density integral) are sums over kernels of their sections in
+// the slab (docs/design.md "Sheets"), so summing every slab's sheets over the bricks, each brick
+// contributing the sections of the kernels of the samples it owns (every kernel once: no ghost
+// kernel, no clip plane), and compositing only the sums gives the one-process frame to float
+// rounding. The core stays free of MPI: BrickSheets gives one brick's sheets of a group of slabs as
+// plain float blocks, the caller sums them (one process: into the same blocks; MPI: onto ranges of
+// screen tiles, splat/bricks.h), and SlabCompositor composites the summed blocks of its tiles group
+// after group, front to back in visiting order, so memory stays bounded by one group.
 //
 // Layout of a group of `count` slabs from `first` (visiting order) over tiles [t0, t1):
 // tile t's slab first + k is the block at ((t - t0) count + k) B floats, B = channels

@@ -1,5 +1,5 @@
 #pragma once
-// Surface export (issue 21): the iso surface f(x) = level of the same reconstructed field the
+// Surface export: the iso surface f(x) = level of the same reconstructed field the
 // renderers draw, f(x) = b + sum_i (d_i - b) h(S^-1 (x - x_i)) (background value b included),
 // as a triangle mesh in world coordinates. The splatted `--mode iso` image is the first hit of
 // this surface along each pixel ray.

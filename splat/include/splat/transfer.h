@@ -26,7 +26,7 @@ class TransferFunction {
     /// maps them to absolute densities (presets are normalized; JSON files say which).
     bool normalized = false;
     /// The render mode the function was made for (presets mip-gray, xray; a "mode" key in a
-    /// JSON file); none for plain colour maps. An explicit --mode wins (README "Techniques").
+    /// JSON file); none for plain colour maps. An explicit --mode wins (docs/techniques.md).
     std::optional<RenderMode> mode;
 
     /// Presets: ct-bone, ct-soft, mri-head, gray-ramp (normalized domain); mip-gray (mode

@@ -1,5 +1,5 @@
 #pragma once
-// Volume viewing through the reconstructed field (splat/DESIGN.md "The model"): slices,
+// Volume viewing through the reconstructed field (docs/design.md "The model"): slices,
 // multiplanar reconstruction (axis-aligned and oblique planes) and curved planar reformation
 // along a polyline, all evaluating f(x) = sum_i d_i h(S^-1 (x - x_i)) with the reference ray
 // caster's field evaluator (splat/src/reference/field.h), so that what a view shows is exactly

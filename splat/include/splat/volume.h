@@ -34,7 +34,7 @@ struct Volume {
     /// a volume-frame position x. Loaders put here what is left of a file's index-to-world
     /// affine after the nearest axis permutation and flips (an oblique acquisition); the
     /// renderers work in the volume's frame and the Camera turns its world parameters into
-    /// it (splat/DESIGN.md "World frame"). Identity: the volume frame is the world frame.
+    /// it (docs/design.md "World frame"). Identity: the volume frame is the world frame.
     glm::dmat3 direction{1.0};
     /// The samples of an owned float volume: dims.x * dims.y * dims.z, x fastest (the
     /// loaders fill it). Empty for a borrowed or typed volume (sampleData() is then the
@@ -43,10 +43,9 @@ struct Volume {
     std::string source;  ///< how it was obtained, e.g. "NIfTI-1 int16 (ch2.nii.gz)"
     /// Warnings about the input, "; " separated: anything accepted with an assumption or
     /// an ignored field (sheared axes made a rotation, 4D file's first volume, DICOM gantry
-    /// tilt, NaNs replaced, ...). Every command prints it (README "Input files and bad
-    /// input" lists the cases).
+    /// tilt, NaNs replaced, ...). Every command prints it (docs/input-files.md lists the cases).
     std::string note;
-    /// Background value b (issue 21, splat/DESIGN.md "Reconstructed fields"): what the data
+    /// Background value b (docs/design.md "Reconstructed fields"): what the data
     /// hold where nothing is (air at -1000 HU in CT, 0 in MR magnitude and signed fields).
     /// The reconstructed field is f(x) = b + sum_i (d_i - b) h(x - x_i): it tends to b
     /// outside the volume and across clipped regions, and "empty" means "equal to b".
@@ -121,7 +120,7 @@ struct Volume {
     bool rotated() const { return direction != glm::dmat3(1.0); }
     /// World position of the volume centre, index (n - 1) / 2 on every axis.
     glm::dvec3 center() const { return world((glm::dvec3(dims) - 1.0) * 0.5); }
-    /// Smallest spacing: the world length of "one voxel" in splat/DESIGN.md.
+    /// Smallest spacing: the world length of "one voxel" in docs/design.md.
     double minSpacing() const { return glm::min(spacing.x, glm::min(spacing.y, spacing.z)); }
     /// Memory the samples take, in bytes (the caller's, for a borrowed volume).
     std::size_t bytes() const {
@@ -146,7 +145,7 @@ std::uint64_t checkedVoxelCount(const glm::ivec3& dims, const std::string& what)
 /// Throws splat::Error naming `what` (a file name or description) otherwise.
 Volume makeVolume(const glm::ivec3& dims, const glm::dvec3& spacing, const std::string& what);
 
-/// The default background value rule (splat/DESIGN.md, Decisions): the median of the
+/// The default background value rule (docs/decisions.md): the median of the
 /// finite samples on the volume's six outer faces. Right for CT in HU (air, about -1000, or
 /// the scanner's padding fills the faces), MR magnitude (0) and signed fields such as phase
 /// or velocity (0 around the object, not the minimum). Files that state a value (DICOM Pixel

@@ -1,6 +1,6 @@
 #pragma once
 // Loading and saving volumes. The format is chosen by extension or, for folders, by
-// content. See splat/DESIGN.md ("Command line") for the VOLUME syntax.
+// content. See docs/design.md "Command line" for the VOLUME syntax.
 #include <optional>
 #include <string>
 #include <vector>

@@ -78,7 +78,8 @@ IcetCompositor::IcetCompositor() {
     icetSetDepthFormat(ICET_IMAGE_DEPTH_NONE);
     icetCompositeMode(ICET_COMPOSITE_MODE_BLEND);
     icetEnable(ICET_ORDERED_COMPOSITE);
-    // Radix-k: the single-image strategy of IceT's large-scale results (README).
+    // Radix-k: the single-image strategy of IceT's large-scale results (docs/parallel.md
+    // "Direct-send beside IceT").
     icetStrategy(ICET_STRATEGY_SEQUENTIAL);
     icetSingleImageStrategy(ICET_SINGLE_IMAGE_STRATEGY_RADIXK);
     checkIcet("setting up its context");

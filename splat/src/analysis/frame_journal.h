@@ -1,5 +1,5 @@
 #pragma once
-// A journal of rendered frames for resuming an interrupted analysis (issue 23): each frame
+// A journal of rendered frames for resuming an interrupted analysis: each frame
 // is one file written atomically (splat/atomic_file.h) holding its pixels bit for bit, the
 // stats the analysis uses, and an FNV-1a 64 checksum; a frame is read back only when its
 // size and checksum match, so a resumed analysis measures exactly the images of an

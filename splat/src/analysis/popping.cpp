@@ -1,4 +1,4 @@
-// Popping-artifact analysis (see splat/popping.h and splat/DESIGN.md, "Artifact analysis").
+// Popping-artifact analysis (see splat/popping.h and docs/design.md "Artifact analysis").
 #include "splat/popping.h"
 
 #include <algorithm>

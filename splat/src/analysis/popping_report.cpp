@@ -334,7 +334,7 @@ json summaryJson(const PoppingResult& r) {
         o["median_error"] = number(median(s.e));
         o["ms_per_frame"] = number(s.msPerFrame);
         o["total_ms"] = number(s.totalMs);
-        // Views whose pixels the splatter handed to the reference (issue 24): listed, so
+        // Views whose pixels the splatter handed to the reference: listed, so
         // that a flat signal there is not read as "no popping".
         o["exact_views"] = json::array();
         for (std::size_t n = 0; n < s.exactPixels.size(); ++n)

@@ -10,7 +10,7 @@
 //
 // Its physical space is LPS, as ITK (and so SimpleITK, 3D Slicer, elastix) writes it:
 // TransformMatrix and Offset are LPS and AnatomicalOrientation only names the matrix's
-// axes; both are turned into splat's world frame, RAS (splat/DESIGN.md "World frame").
+// axes; both are turned into splat's world frame, RAS (docs/design.md "World frame").
 #include <cmath>
 #include <map>
 #include <sstream>

@@ -8,7 +8,7 @@
 // the header values are checked here, in 64-bit arithmetic, before anything is
 // allocated, and only the first volume's bytes are read (a 4D series is not loaded to
 // keep one volume). Values go through the intensity scaling and the orientation (sform
-// preferred, then qform, else pixdim). README "Input files and bad input" lists what is
+// preferred, then qform, else pixdim). docs/input-files.md lists what is
 // refused and what is only warned about.
 #include <nifti2_io.h>
 #include <zlib.h>

@@ -7,7 +7,7 @@
 // use: type, dimension (2 or 3), sizes, encoding (all five: raw, gzip/gz, bzip2/bz2,
 // text/txt/ascii, hex), endian, spacings or space (or space dimension) with space
 // directions and space origin, byte skip, line skip. Geometry in a named space is turned
-// into splat's world frame, RAS (splat/DESIGN.md "World frame").
+// into splat's world frame, RAS (docs/design.md "World frame").
 #include <cctype>
 #include <cmath>
 #include <initializer_list>

@@ -1,7 +1,7 @@
 #pragma once
 // Where a volume file keeps its samples and how they become the model's volume: what a
 // loader learns from the header (private, not installed). With it a brick is read alone
-// (README "Beyond one machine", issue 26): the rows of the brick's box in the file's own
+// (docs/parallel.md): the rows of the brick's box in the file's own
 // index order are read by byte ranges (pread) from a raw-stored file, or picked out of the
 // decompressed stream of a compressed one, decoded and scaled exactly as the whole-file
 // loader does, and moved to the model's axes by the same signed permutation

@@ -4,7 +4,7 @@
 // Every loader does the same three things once it has parsed its header: read the
 // sample bytes (possibly gzip/zlib-compressed), decode typed samples of either byte
 // order into float, and turn the file's index-to-world matrix into the axis-aligned
-// model of splat/DESIGN.md (flips and permutations applied to the data, oblique rest
+// model of docs/design.md (flips and permutations applied to the data, oblique rest
 // reported). Those pieces live here so no loader has its own copy.
 #include <array>
 #include <cstddef>

@@ -124,7 +124,7 @@ Volume loadVolume(const std::string& spec, const LoadOptions& options) {
         }
     }
     detail::applyNonFinitePolicy(v, options.nonFinite, spec);
-    // Background value b (issue 21): a loader that read it from the file said so; otherwise
+    // Background value b: a loader that read it from the file said so; otherwise
     // the common rule, and synthetic volumes (made around an empty 0) keep 0.
     if (v.backgroundSource == Volume{}.backgroundSource) {
         if (spec.rfind("synthetic:", 0) == 0) {

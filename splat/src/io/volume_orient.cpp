@@ -2,7 +2,7 @@
 //
 // Files store samples along their own index axes; the affine x = t + M p says where
 // each index step goes in world space (RAS+: NIfTI sform/qform, NRRD space directions and
-// DICOM/MetaImage LPS converted by their loaders). splat/DESIGN.md's volume has its index
+// DICOM/MetaImage LPS converted by their loaders). docs/design.md's volume has its index
 // axes along the axes of its own frame with positive spacing, and a rotation `direction`
 // from that frame to the world. We find the signed permutation closest to M (largest total
 // |cosine| between each file axis and the world axis it is assigned to), reorder and flip

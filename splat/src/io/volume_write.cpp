@@ -89,7 +89,7 @@ void saveNifti(const std::string& path, const Volume& v) {
     nifti_image_write(nim);
     nifti_image_free(nim);
     // niftilib does not report a failed write (a full disk): the file is read back whole
-    // and compared before it replaces anything (issue 23).
+    // and compared before it replaces anything.
     nifti_image* back = nifti_image_read(tmp.string().c_str(), 1);
     const std::string expected = floatBytes(v);
     const bool whole = back && back->data && std::size_t(back->nvox) * back->nbyper == floatSize &&
@@ -101,7 +101,7 @@ void saveNifti(const std::string& path, const Volume& v) {
 
 void saveNrrd(const std::string& path, const Volume& v) {
     checkWritable(v, path);
-    // World (RAS) axes and origin: direction applied (splat/DESIGN.md "World frame").
+    // World (RAS) axes and origin: direction applied (docs/design.md "World frame").
     auto vec = [](const glm::dvec3& a) {
         std::ostringstream o;
         o << '(' << fmt(a.x) << ',' << fmt(a.y) << ',' << fmt(a.z) << ')';

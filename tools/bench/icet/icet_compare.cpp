@@ -1,12 +1,11 @@
-// Sort-last compositing, splat's direct-send against IceT (issue 26, README "Beyond one
-// machine" -> "Memory, scaling and a model"). Under `mpirun -np P` every rank holds one
-// partial RGBA float image of W x H with premultiplied colour and all ranks share one
-// visibility order. The partial images are either synthetic (a soft disc, different per
-// rank, transparent outside it, as a brick's projection is) or, with --volume SPEC, the
-// real partial images of splat's bricked render: rank 0 renders SPEC in P bricks
-// (renderBricked, axis splatter, transfer function gray-ramp, azimuth 30, elevation 15),
-// keeps the partial images and the k-d visibility order that renderBricked hands to its
-// BrickGroup, and sends brick b's image to rank b. The images are composited
+// Sort-last compositing, splat's direct-send against IceT (docs/parallel.md "Memory,
+// scaling and a model"). Under `mpirun -np P` every rank holds one partial RGBA float image of W x
+// H with premultiplied colour and all ranks share one visibility order. The partial images are
+// either synthetic (a soft disc, different per rank, transparent outside it, as a brick's
+// projection is) or, with --volume SPEC, the real partial images of splat's bricked render: rank 0
+// renders SPEC in P bricks (renderBricked, axis splatter, transfer function gray-ramp, azimuth 30,
+// elevation 15), keeps the partial images and the k-d visibility order that renderBricked hands to
+// its BrickGroup, and sends brick b's image to rank b. The images are composited
 //   (a) by splat::mpi's BrickGroup::composite (the code `splat render --bricks` runs),
 //       called as it is, one brick per rank: direct-send (MPI_Alltoallv of the row spans of
 //       the strips, each strip composited front to back, MPI_Gatherv of the spans to rank 0)

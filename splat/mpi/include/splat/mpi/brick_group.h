@@ -1,6 +1,6 @@
 #pragma once
-// Sort-last bricked rendering over MPI (issue 26): the BrickGroup of splat/bricks.h on the
-// ranks of the job, with two compositors of the partial images (README "Beyond one machine",
+// Sort-last bricked rendering over MPI: the BrickGroup of splat/bricks.h on the
+// ranks of the job, with two compositors of the partial images (docs/parallel.md,
 // "Direct-send beside IceT"):
 //
 // - Direct-send (Hsu 1993, "Segmented ray casting for data parallel volume rendering";

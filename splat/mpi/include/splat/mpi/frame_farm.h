@@ -1,5 +1,5 @@
 #pragma once
-// Frame-parallel sequences over MPI (issue 26): the leader's FrameFarm hands the views of a
+// Frame-parallel sequences over MPI: the leader's FrameFarm hands the views of a
 // sequence to the ranks dynamically (two in flight per worker, the leader renders one
 // whenever no result is waiting), receives the frames and gives them to the sequence's sink
 // in view order; every worker holds the same Scene and serves views until the leader stops

@@ -1,5 +1,5 @@
 #pragma once
-// One MPI job of the splat program (issue 26, README "Beyond one machine"): rank 0 (the
+// One MPI job of the splat program (docs/parallel.md): rank 0 (the
 // leader) runs the command and writes every output; the other ranks (workers) render what
 // the leader asks for and write nothing. This module is the only code that calls MPI; it
 // uses only the MPI standard (OpenMPI and MPICH).
