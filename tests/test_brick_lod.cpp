@@ -1,4 +1,4 @@
-// Level of detail per brick and view (issue 27, `--lod brick`, splat/src/model/brick_lod.h):
+// Level of detail per brick and view (`--lod brick`, splat/src/model/brick_lod.h):
 // the bricks' levels from the projected voxel size and the pyramid's detail, frames mixing
 // levels (the sum of a frame per level in X-ray) against the full-resolution splatter and the
 // pixel-filtered reference, mass, thread counts, perspective, a background value b != 0.
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "frame/frame.h"
+#include "dispatch/dispatch.h"
 #include "model/brick_lod.h"
 #include "model/level_of_detail.h"
 #include "model/scene_impl.h"
