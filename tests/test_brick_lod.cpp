@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "frame/frame.h"
+#include "dispatch/dispatch.h"
 #include "model/brick_lod.h"
 #include "model/level_of_detail.h"
 #include "model/scene_impl.h"

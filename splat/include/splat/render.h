@@ -1,5 +1,5 @@
 #pragma once
-// Rendering in one call. The frame pipeline (splat/src/frame/renderer.cpp):
+// Rendering in one call. The splatters' frame pipeline (splat/src/splatters/splat_frame.cpp):
 //   volume -> classify -> splat list (once, in a Scene)
 //   -> shade -> project -> order (visiting keys) -> bin to tiles
 //   -> splatter: cut kernels into sheets (axis-aligned | image-aligned) -> composite -> image

@@ -3,9 +3,9 @@
 // from any number of views by any renderer (axis-aligned sheets, image-aligned sheets,
 // reference ray caster). It holds the resolved transfer function, the classified splat
 // list (only the voxels the transfer function keeps), the kernel and its footprint tables,
-// and, made when a renderer first needs them, the per-axis visiting orders of the
-// axis-aligned splatter, the slab-section table of the image-aligned one and the dense
-// field the reference ray caster reads. A Scene may be rendered from several threads at
+// and each renderer's own state, made when that renderer first needs it (the axis-aligned
+// splatter's cells, the image-aligned one's slab-section table and slice orders, the
+// reference ray caster's dense field). A Scene may be rendered from several threads at
 // once (each frame takes its own workspace).
 #include <memory>
 
@@ -55,7 +55,7 @@ class Scene {
     const SplatList& splats() const;
     const footprint::Kernel& kernel() const;
 
-    struct Impl;  ///< the frame stages' view of the Scene (splat/src)
+    struct Impl;  ///< the renderers' view of the Scene (splat/src/model/scene_impl.h)
     const Impl& impl() const { return *impl_; }
 
   private:

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "frame/clip_cut.h"
-#include "frame/transfer_table.h"
 #include "model/shading_model.h"
+#include "model/transfer_table.h"
 #include "splat/image.h"
 #include "splat/settings.h"
 
@@ -146,7 +146,7 @@ enum class SheetSource {
 /// the pixel and its label (a select, not a sum: labels are never interpolated).
 inline constexpr int kLabelChannels = 6;
 
-/// Everything a policy may need of the frame (built once per frame by frame/renderer.cpp).
+/// Everything a policy may need of the frame (built once per frame: frame/policy_context.h).
 struct PolicyContext {
     RenderMode mode = RenderMode::Dvr;
     Classification classification = Classification::Pre;

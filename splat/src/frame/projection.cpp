@@ -127,4 +127,19 @@ PixelRect SplatProjector::projectPerspective(const glm::dvec3& w, float& sx, flo
     return footprintRect(sx, sy, e, width_, height_);
 }
 
+std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& axis) {
+    if (!camera.perspective()) return {};
+    const int w = camera.width(), h = camera.height();
+    std::vector<float> scale(std::size_t(w) * h);
+    const double ref = std::abs(glm::dot(camera.view, axis));
+    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+        for (int y = rows.begin(); y != rows.end(); ++y)
+            for (int x = 0; x < w; ++x) {
+                const Ray r = camera.ray(x + 0.5, y + 0.5);
+                scale[std::size_t(y) * w + x] = float(ref / std::abs(glm::dot(r.dir, axis)));
+            }
+    });
+    return scale;
+}
+
 }  // namespace splat

@@ -179,4 +179,8 @@ class SplatProjector {
     footprint::EllipticalFootprint shared_;
 };
 
+/// Per-pixel path-length factor of perspective rays through sheets with normal `axis`:
+/// |view . axis| / |dir . axis|; empty for orthographic views.
+std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& axis);
+
 }  // namespace splat

@@ -79,4 +79,17 @@ void binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& orde
     });
 }
 
+void orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys,
+                const std::vector<std::uint32_t>* base, std::vector<std::uint32_t>& order) {
+    std::vector<std::uint32_t> start(std::size_t(keys) + 1, 0);
+    for (std::uint32_t k : key) ++start[std::size_t(k) + 1];
+    for (std::size_t k = 0; k < keys; ++k) start[k + 1] += start[k];
+    const std::size_t n = key.size();
+    order.resize(n);
+    for (std::size_t q = 0; q < n; ++q) {
+        const std::uint32_t s = base ? (*base)[q] : std::uint32_t(q);
+        order[start[key[s]]++] = s;
+    }
+}
+
 }  // namespace splat

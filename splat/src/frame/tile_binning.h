@@ -62,6 +62,12 @@ struct TileBins {
     std::vector<std::uint32_t> counts;  ///< scratch: per chunk and tile
 };
 
+/// Stage "order" (the visiting order binning follows): a stable counting sort of the
+/// elements of `base` (or 0 .. key.size() - 1 when `base` is null) by key[element], keys in
+/// [0, keys).
+void orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys,
+                const std::vector<std::uint32_t>* base, std::vector<std::uint32_t>& order);
+
 /// Bins the splats listed in `order` (visiting order) to tiles, into `bins` (its arrays
 /// are reused across frames); key[id] and span[id] are splat id's sheets (SheetRecord).
 void binToTiles(const ProjectedSplats& p, const std::vector<std::uint32_t>& order,

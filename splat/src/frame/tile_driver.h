@@ -87,10 +87,6 @@ class DenormalsAreZero {
 #endif
 };
 
-/// Per-pixel path-length factor of perspective rays through sheets with normal `axis`:
-/// |view . axis| / |dir . axis|; empty for orthographic views.
-std::vector<float> perspectivePathScale(const Camera& camera, const glm::dvec3& axis);
-
 /// The values a splat contributes to a sheet, in the channels of the policy's source.
 template <class Policy>
 inline void splatValues(const TileInputs& in, std::uint32_t id, float (&v)[Policy::kChannels]) {
@@ -260,7 +256,7 @@ inline TileAccumulator makeTileAccumulator(const TileInputs& in, const TileGrid&
     const int w = std::min(g.tileSize, g.width - ox), h = std::min(g.tileSize, g.height - oy);
     TileAccumulator acc(w, h, in.settings.order,
                         terminates ? in.settings.quality.earlyTermination : 0.0, surface);
-    acc.setOrigin(ox, oy, g.width);  // issue 13: per-pixel clip cut
+    acc.setOrigin(ox, oy, g.width);  // the per-pixel clip cut reads pixel positions
     return acc;
 }
 
@@ -296,7 +292,7 @@ Image rasterizeTiles(const TileInputs& in, const Policy& policy, const Cutter& c
         if (progress.stopped()) return;
         const DenormalsAreZero ftz;  // footprint tails must not hit slow denormal paths
         const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
-        constexpr bool surface = kSurfacePolicy<Policy>;  // issue 13: also when clipped
+        constexpr bool surface = kSurfacePolicy<Policy>;  // also when clipped
         TileAccumulator acc = makeTileAccumulator(in, g, t, Policy::kTerminates, surface);
         if (in.bins.begin[t] != in.bins.begin[t + 1]) {
             Ring& r = rings.local();

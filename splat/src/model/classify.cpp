@@ -187,42 +187,48 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
     return classify(volume, tf, mode, classification, radius, o);
 }
 
-SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
-                   Classification classification, double radius, const ClassifyOptions& options) {
-    const bool normals = options.normals;
-    const glm::ivec3 d = volume.dims;
-    if (d.x > 65535 || d.y > 65535 || d.z > 65535)
-        throw Error("volume dimension above 65535 is not supported by the splat list");
-    if (tf.normalized)
-        throw Error("internal: transfer function must be resolved before classification");
+namespace {
 
-    const bool usesTf = mode == RenderMode::Dvr;
-    const bool pre = usesTf && classification == Classification::Pre;
-    glm::ivec3 bricks(0);
-    std::vector<char> need;
-    if (usesTf && !pre) need = neededBricks(volume, tf, int(std::ceil(radius)), bricks);
+/// Which voxels classify keeps and what each carries: the options resolved for one volume.
+struct VoxelRule {
+    const Volume& volume;
+    const TransferFunction& tf;
+    const ClassifyOptions& options;
+    bool usesTf, pre, edges, gradients, clips, labelled, intensity;
+    glm::ivec3 bricks{0};
+    std::vector<char> need;  ///< per brick of kBrick^3 (post-classification only)
+    float maxGradient = 0, invMaxGradient = 0;
+    glm::dvec3 clipMargin;
+    std::vector<std::uint16_t> shown;  ///< labels: the shown label of every voxel
+    std::vector<std::uint8_t> near;    ///< labels: voxels within the radius of a shown label
 
-    const bool edges = pre && options.edges.enabled();
-    const bool gradients = options.gradients;
-    const float maxGradient = edges || gradients ? maxGradientMagnitude(volume) : 0.0f;
-    const float invMaxGradient = maxGradient > 0.0f ? 1.0f / maxGradient : 0.0f;
-    // Edge enhancement of pre-classified opacity: the factor of voxel (i, j, k).
-    auto edgeOf = [&](int i, int j, int k) {
+    VoxelRule(const Volume& v, const TransferFunction& t, RenderMode mode,
+              Classification classification, double radius, const ClassifyOptions& o)
+        : volume(v), tf(t), options(o) {
+        usesTf = mode == RenderMode::Dvr;
+        pre = usesTf && classification == Classification::Pre;
+        if (usesTf && !pre) need = neededBricks(volume, tf, int(std::ceil(radius)), bricks);
+        edges = pre && options.edges.enabled();
+        gradients = options.gradients;
+        maxGradient = edges || gradients ? maxGradientMagnitude(volume) : 0.0f;
+        invMaxGradient = maxGradient > 0.0f ? 1.0f / maxGradient : 0.0f;
+        clips = options.clipping.enabled();
+        clipMargin = (options.clipMargin > 0 ? options.clipMargin : radius) * volume.spacing;
+        labelled = options.labels && options.labels->enabled;
+        intensity = !labelled || options.labels->volume != nullptr;
+        if (labelled) {
+            shown = shownLabels(volume, *options.labels);
+            near = nearLabels(volume, shown, int(std::ceil(radius)));
+        }
+    }
+
+    /// Edge enhancement of pre-classified opacity: the factor of voxel (i, j, k).
+    float edgeOf(int i, int j, int k) const {
         return edgeFactor(options.edges,
                           float(glm::length(gradientAt(volume, i, j, k))) * invMaxGradient);
-    };
-    const bool clips = options.clipping.enabled();
-    const glm::dvec3 clipMargin =
-        (options.clipMargin > 0 ? options.clipMargin : radius) * volume.spacing;
-    const bool labelled = options.labels && options.labels->enabled;
-    const bool intensity = !labelled || options.labels->volume != nullptr;
-    std::vector<std::uint16_t> shown;
-    std::vector<std::uint8_t> near;
-    if (labelled) {
-        shown = shownLabels(volume, *options.labels);
-        near = nearLabels(volume, shown, int(std::ceil(radius)));
     }
-    auto keep = [&](int i, int j, int k, float value) {
+
+    bool keep(int i, int j, int k, float value) const {
         // Clipping keeps every voxel whose kernel reaches the kept region: the renderers cut
         // the reconstructed field at the planes and box (model/clip_region.h).
         if (clips && !keepsNear(options.clipping, volume.world(glm::dvec3(i, j, k)), clipMargin))
@@ -237,22 +243,40 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
             return false;
         if (need.empty()) return true;
         return need[(std::size_t(k / kBrick) * bricks.y + j / kBrick) * bricks.x + i / kBrick] != 0;
-    };
+    }
 
-    // Two passes over z-slices (count, then fill) keep the list in (k, j, i) order for
-    // any thread count.
-    // Emission depends on the value alone unless edge enhancement scales it per voxel: then
-    // the distinct kept values (gathered by the count pass) may index a palette.
-    const bool byValue = options.compactEmission && !edges;
+    /// (rho, e) of a voxel of value `value` (its edge factor, if any, applied by the caller).
+    glm::vec4 emissionOf(float value) const {
+        if (!(usesTf && intensity)) return glm::vec4(0.0f);
+        const glm::vec4 c = tf.sample(value);
+        const float rho = tf.extinctionFromOpacity(c.a);
+        return glm::vec4(rho, c.r * rho, c.g * rho, c.b * rho);
+    }
+};
+
+/// The kept voxels per z-slice: slice k's splats are list positions [start[k], start[k + 1]).
+/// With `byValue`, also the distinct kept values, sorted (gathered only while they may fit
+/// a palette: more than kPaletteSize of them means no palette).
+struct KeptVoxels {
+    std::vector<std::size_t> start;
+    std::vector<float> distinct;
+};
+
+/// Step "count": the first of two passes over z-slices (count, then fill), which keep the
+/// list in (k, j, i) order for any thread count.
+KeptVoxels countKept(const VoxelRule& rule, bool byValue) {
+    const glm::ivec3 d = rule.volume.dims;
+    KeptVoxels kept;
     std::vector<std::vector<float>> sliceValues(byValue ? std::size_t(d.z) : 0);
-    std::vector<std::size_t> count(std::size_t(d.z) + 1, 0);
+    std::vector<std::size_t>& count = kept.start;
+    count.assign(std::size_t(d.z) + 1, 0);
     tbb::parallel_for(0, d.z, [&](int k) {
         std::size_t n = 0;
         std::vector<float> values;
         for (int j = 0; j < d.y; ++j)
             for (int i = 0; i < d.x; ++i) {
-                const float value = volume.at(i, j, k);
-                if (!keep(i, j, k, value)) continue;
+                const float value = rule.volume.at(i, j, k);
+                if (!rule.keep(i, j, k, value)) continue;
                 ++n;
                 if (byValue && (values.empty() || values.back() != value)) values.push_back(value);
             }
@@ -264,7 +288,7 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
         count[std::size_t(k) + 1] = n;
     });
     for (int k = 0; k < d.z; ++k) count[std::size_t(k) + 1] += count[std::size_t(k)];
-    std::vector<float> distinct;
+    std::vector<float>& distinct = kept.distinct;
     for (auto& v : sliceValues) {
         distinct.insert(distinct.end(), v.begin(), v.end());
         std::vector<float>().swap(v);
@@ -276,62 +300,72 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
     }
     std::sort(distinct.begin(), distinct.end());
     distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
-    const bool paletted = byValue && count.back() > 0 && distinct.size() <= kPaletteSize;
-    // (rho, e) of a voxel of value `value` (its edge factor, if any, applied by the caller).
-    auto emissionOf = [&](float value) {
-        if (!(usesTf && intensity)) return glm::vec4(0.0f);
-        const glm::vec4 c = tf.sample(value);
-        const float rho = tf.extinctionFromOpacity(c.a);
-        return glm::vec4(rho, c.r * rho, c.g * rho, c.b * rho);
-    };
+    return kept;
+}
 
+/// Step "allocate": a list of `n` splats with the arrays the rule asks for, emission by
+/// palette index when `paletted` (the palette made here from `distinct`).
+SplatList allocateList(const VoxelRule& rule, std::size_t n, bool paletted, bool normals,
+                       const std::vector<float>& distinct) {
+    const Volume& volume = rule.volume;
     SplatList s;
     const float b = volume.background;
     s.background = b;
-    s.gradientScale = maxGradient;
-    const std::size_t n = count.back();
+    s.gradientScale = rule.maxGradient;
     s.voxels = volume.voxelCount();
     s.origin = volume.origin;
     s.spacing = volume.spacing;
     if (paletted) {
         s.palette.resize(distinct.size());
-        for (std::size_t q = 0; q < distinct.size(); ++q) s.palette[q] = emissionOf(distinct[q]);
+        for (std::size_t q = 0; q < distinct.size(); ++q)
+            s.palette[q] = rule.emissionOf(distinct[q]);
         s.paletteDensity = distinct;
         for (float& v : s.paletteDensity) v -= b;
         s.emissionIndex.resize(n);
     } else {
         s.density.resize(n);
-        // Only what the mode needs (issue 24): mip, x-ray and iso read the density alone, so
-        // their splats carry no emission (16 bytes a splat less).
-        if (usesTf)
+        // Only what the mode needs: mip, x-ray and iso read the density alone, so their
+        // splats carry no emission (16 bytes a splat less).
+        if (rule.usesTf)
             for (auto* a : {&s.extinction, &s.r, &s.g, &s.b}) a->resize(n);
     }
     for (auto* a : {&s.i, &s.j, &s.k}) a->resize(n);
     if (normals)
         for (auto* a : {&s.nx, &s.ny, &s.nz}) a->resize(n);
-    if (gradients)
+    if (rule.gradients)
         for (auto* a : {&s.gx, &s.gy, &s.gz}) a->resize(n);
-    if (labelled) s.label.resize(n);
+    if (rule.labelled) s.label.resize(n);
+    return s;
+}
+
+/// Step "fill": the second pass, every kept voxel of slice k written at positions from
+/// kept.start[k] on.
+void fillList(const VoxelRule& rule, const KeptVoxels& kept, bool paletted, bool normals,
+              SplatList& s) {
+    const Volume& volume = rule.volume;
+    const glm::ivec3 d = volume.dims;
+    const float b = volume.background;
+    const std::vector<float>& distinct = kept.distinct;
     tbb::parallel_for(0, d.z, [&](int k) {
-        std::size_t o = count[std::size_t(k)];
+        std::size_t o = kept.start[std::size_t(k)];
         for (int j = 0; j < d.y; ++j)
             for (int i = 0; i < d.x; ++i) {
                 const float value = volume.at(i, j, k);
-                if (!keep(i, j, k, value)) continue;
+                if (!rule.keep(i, j, k, value)) continue;
                 s.i[o] = std::uint16_t(i);
                 s.j[o] = std::uint16_t(j);
                 s.k[o] = std::uint16_t(k);
                 if (!paletted) s.density[o] = value - b;
-                if (labelled) s.label[o] = float(shown[volume.index(i, j, k)]);
+                if (rule.labelled) s.label[o] = float(rule.shown[volume.index(i, j, k)]);
                 if (paletted) {
                     s.emissionIndex[o] =
                         std::uint16_t(std::lower_bound(distinct.begin(), distinct.end(), value) -
                                       distinct.begin());
-                } else if (usesTf) {
-                    glm::vec4 e = emissionOf(value);
-                    if (edges && e.x != 0.0f) {
-                        const float f = edgeOf(i, j, k);
-                        const glm::vec4 c = tf.sample(value);
+                } else if (rule.usesTf) {
+                    glm::vec4 e = rule.emissionOf(value);
+                    if (rule.edges && e.x != 0.0f) {
+                        const float f = rule.edgeOf(i, j, k);
+                        const glm::vec4 c = rule.tf.sample(value);
                         e.x *= f;
                         e = glm::vec4(e.x, c.r * e.x, c.g * e.x, c.b * e.x);
                     }
@@ -346,7 +380,7 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                     s.ny[o] = float(n.y);
                     s.nz[o] = float(n.z);
                 }
-                if (gradients) {
+                if (rule.gradients) {
                     const glm::dvec3 g = gradientAt(volume, i, j, k);
                     s.gx[o] = float(g.x);
                     s.gy[o] = float(g.y);
@@ -355,6 +389,26 @@ SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode 
                 ++o;
             }
     });
+}
+
+}  // namespace
+
+SplatList classify(const Volume& volume, const TransferFunction& tf, RenderMode mode,
+                   Classification classification, double radius, const ClassifyOptions& options) {
+    const glm::ivec3 d = volume.dims;
+    if (d.x > 65535 || d.y > 65535 || d.z > 65535)
+        throw Error("volume dimension above 65535 is not supported by the splat list");
+    if (tf.normalized)
+        throw Error("internal: transfer function must be resolved before classification");
+    const VoxelRule rule(volume, tf, mode, classification, radius, options);
+    // Emission depends on the value alone unless edge enhancement scales it per voxel: then
+    // the distinct kept values (gathered by the count pass) may index a palette.
+    const bool byValue = options.compactEmission && !rule.edges;
+    const KeptVoxels kept = countKept(rule, byValue);
+    const std::size_t n = kept.start.back();
+    const bool paletted = byValue && n > 0 && kept.distinct.size() <= kPaletteSize;
+    SplatList s = allocateList(rule, n, paletted, options.normals, kept.distinct);
+    fillList(rule, kept, paletted, options.normals, s);
     return s;
 }
 

@@ -1,4 +1,5 @@
-// splat::Scene (the view-independent state, built once), splat::Renderer and render().
+// splat::Scene: the model of a volume rendering (the view-independent state, built once) and
+// the rule for what a frame may change. Its frames are rendered by dispatch/.
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -7,14 +8,10 @@
 #include <string>
 #include <tuple>
 
-#include "frame/frame.h"
 #include "model/clip_region.h"
 #include "model/level_of_detail.h"
 #include "model/scene_impl.h"
-#include "reference/field.h"
-#include "reference/reference_frame.h"
 #include "splat/error.h"
-#include "splat/render.h"
 
 namespace splat {
 
@@ -76,7 +73,7 @@ void validateScene(const Volume& v, const RenderSettings& s) {
     if (!v.hasSamples())
         throw Error("volume is empty or its sample count does not match its dimensions");
     validateGeometry(v);
-    // The loaders' NaN policy at the library boundary (issue 24): an in-memory volume with
+    // The loaders' NaN policy at the library boundary: an in-memory volume with
     // NaN/Inf samples is refused, not rendered differently by each renderer.
     // The values are scanned, whatever the storage (a scale can overflow float).
     // Serial: validation runs before the Scene's thread arena exists (threads = 1 means one).
@@ -111,7 +108,7 @@ bool sameClipping(const Clipping& a, const Clipping& b) {
     return true;
 }
 
-/// The one rule for what a frame may change (issue 24): the settings that belong to a Scene
+/// The one rule for what a frame may change: the settings that belong to a Scene
 /// (its classification and tables) are fixed at construction; a frame that differs in one of
 /// them is refused with the field's name, never silently rendered with the Scene's value.
 /// Returns the first such field of `frame` that differs from both the settings the Scene was
@@ -164,17 +161,29 @@ void runOnThreads(int threads, const std::function<void()>& f) {
     }
 }
 
-void orderByKey(const std::vector<std::uint32_t>& key, std::uint32_t keys,
-                const std::vector<std::uint32_t>* base, std::vector<std::uint32_t>& order) {
-    std::vector<std::uint32_t> start(std::size_t(keys) + 1, 0);
-    for (std::uint32_t k : key) ++start[std::size_t(k) + 1];
-    for (std::size_t k = 0; k < keys; ++k) start[k + 1] += start[k];
-    const std::size_t n = key.size();
-    order.resize(n);
-    for (std::size_t q = 0; q < n; ++q) {
-        const std::uint32_t s = base ? (*base)[q] : std::uint32_t(q);
-        order[start[key[s]]++] = s;
-    }
+void validateFrame(const RenderSettings& s) {
+    const Quality& q = s.quality;
+    if (!(q.slab > 0) || !std::isfinite(q.slab) || q.slab > 1e4)
+        throw Error("slab thickness must be a positive number of voxels (got " +
+                    std::to_string(q.slab) + ")");
+    if (s.renderer == RendererKind::Sheet && q.slab < 1e-3)
+        throw Error("slab thickness below 0.001 voxels would need millions of sheets");
+    if (!(q.earlyTermination >= 0 && q.earlyTermination < 1))
+        throw Error("early termination threshold must be in [0, 1)");
+    if (q.tileSize < 8 || q.tileSize > 64) throw Error("tile size must be between 8 and 64 pixels");
+    if (!(q.lod >= 0 && q.lod <= 64))
+        throw Error("level of detail threshold must be between 0 (off) and 64 pixels per voxel");
+    if (!(q.pixelFilter >= 0 && q.pixelFilter <= 4))
+        throw Error("pixel filter sigma must be between 0 (point sampling) and 4 pixels");
+    if (!(q.pixelFilterTolerance > 0) || !std::isfinite(q.pixelFilterTolerance))
+        throw Error("pixel filter tolerance must be a positive number");
+    if (s.threads < 0 || s.threads > 1024)
+        throw Error("thread count must be between 0 (all) and 1024");
+    if (!(q.referenceStep >= 0) || !(q.referenceTolerance > 0))
+        throw Error("reference step must be >= 0 (0: automatic) and tolerance positive");
+    for (int c = 0; c < 4; ++c)
+        if (!(s.background[c] >= 0 && s.background[c] <= 1))
+            throw Error("background must be in [0, 1]");
 }
 
 Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
@@ -245,104 +254,6 @@ const Scene::Impl* Scene::Impl::coarser() const {
     return coarser_.get();
 }
 
-const Scene::Impl::SliceOrder& Scene::Impl::sliceOrder(int axis) const {
-    std::lock_guard<std::mutex> lock(lazyMutex_);
-    if (!sliceOrder_[axis]) {
-        const std::vector<std::uint16_t>& index =
-            axis == 0 ? splats.i : (axis == 1 ? splats.j : splats.k);
-        auto o = std::make_unique<SliceOrder>();
-        // Counting sort on the 16-bit slice indices (no widened copy of the keys).
-        o->start.assign(std::size_t(volume->dims[axis]) + 1, 0);
-        for (std::uint16_t q : index) ++o->start[std::size_t(q) + 1];
-        for (std::size_t q = 1; q < o->start.size(); ++q) o->start[q] += o->start[q - 1];
-        if (axis != 2) {  // axis 2: the list is in (k, j, i) order already
-            std::vector<std::uint32_t> next(o->start.begin(), o->start.end() - 1);
-            o->order.resize(index.size());
-            for (std::size_t n = 0; n < index.size(); ++n)
-                o->order[next[index[n]]++] = std::uint32_t(n);
-        }
-        sliceOrder_[axis] = std::move(o);
-    }
-    return *sliceOrder_[axis];
-}
-
-const std::vector<std::uint32_t>& Scene::Impl::cellStarts() const {
-    std::lock_guard<std::mutex> lock(lazyMutex_);
-    if (!cellStarts_) {
-        const std::size_t cx = std::size_t(cellsX()),
-                          rows = std::size_t(volume->dims.y) * volume->dims.z;
-        auto start = std::make_unique<std::vector<std::uint32_t>>(rows * cx + 1, 0);
-        std::vector<std::uint32_t>& st = *start;
-        const std::size_t n = splats.size();
-        for (std::size_t q = 0; q < n; ++q) {
-            const std::size_t row = std::size_t(splats.k[q]) * volume->dims.y + splats.j[q];
-            ++st[row * cx + splats.i[q] / kCellWidth + 1];
-        }
-        const glm::ivec3 b = bricks();
-        auto counts = std::make_unique<std::vector<std::uint32_t>>(std::size_t(b.x) * b.y * b.z, 0);
-        for (std::size_t row = 0; row < rows; ++row) {
-            const std::size_t j = row % std::size_t(volume->dims.y), k = row / volume->dims.y;
-            const std::size_t brickRow = (k / kCellWidth * b.y + j / kCellWidth) * b.x;
-            for (std::size_t c = 0; c < cx; ++c) (*counts)[brickRow + c] += st[row * cx + c + 1];
-        }
-        for (std::size_t c = 1; c < st.size(); ++c) st[c] += st[c - 1];
-        cellStarts_ = std::move(start);
-        brickCounts_ = std::move(counts);
-    }
-    return *cellStarts_;
-}
-
-const std::vector<std::uint32_t>& Scene::Impl::brickCounts() const {
-    cellStarts();
-    return *brickCounts_;
-}
-
-const footprint::SlabTable& Scene::Impl::slabTable() const {
-    std::lock_guard<std::mutex> lock(lazyMutex_);
-    if (!slabTable_) {
-        try {
-            slabTable_ = std::make_unique<footprint::SlabTable>(
-                kernel, settings.quality.slabRadialResolution,
-                settings.quality.slabDepthResolution);
-        } catch (const std::invalid_argument& e) {
-            throw Error(std::string("slab table: ") + e.what());
-        }
-    }
-    return *slabTable_;
-}
-
-const ReferenceField& Scene::Impl::referenceField() const {
-    std::lock_guard<std::mutex> lock(lazyMutex_);
-    if (!field_) {
-        validateReferenceKernel(kernel);
-        if (splats.paletted() && fieldLayout(settings, splats) == FieldLayout::Emission) {
-            // The field reads the emission arrays: a full copy (the other layouts expand
-            // the densities alone, in ReferenceField).
-            SplatList full = splats;
-            full.expandEmission();
-            field_ = std::make_shared<ReferenceField>(*volume, full, kernel,
-                                                      fieldLayout(settings, full));
-        } else {
-            field_ = std::make_shared<ReferenceField>(*volume, splats, kernel,
-                                                      fieldLayout(settings, splats));
-        }
-    }
-    return *field_;
-}
-
-std::unique_ptr<FrameWorkspace> Scene::Impl::acquireWorkspace() const {
-    std::lock_guard<std::mutex> lock(poolMutex_);
-    if (pool_.empty()) return std::make_unique<FrameWorkspace>();
-    std::unique_ptr<FrameWorkspace> w = std::move(pool_.back());
-    pool_.pop_back();
-    return w;
-}
-
-void Scene::Impl::releaseWorkspace(std::unique_ptr<FrameWorkspace> w) const {
-    std::lock_guard<std::mutex> lock(poolMutex_);
-    pool_.push_back(std::move(w));
-}
-
 Scene::Scene(std::shared_ptr<const Volume> volume, const RenderSettings& settings) {
     if (!volume) throw Error("scene: no volume");
     validateScene(*volume, settings);
@@ -375,10 +286,6 @@ const RenderSettings& Scene::settings() const { return impl_->settings; }
 const SplatList& Scene::splats() const { return impl_->splats; }
 const footprint::Kernel& Scene::kernel() const { return impl_->kernel; }
 
-Image Scene::render(const RenderSettings& frame, RenderStats* stats) const {
-    return renderFrame(*impl_, frameSettings(frame), stats);
-}
-
 RenderSettings Scene::frameSettings(const RenderSettings& frame) const {
     const std::string field = changedSceneField(frame, impl_->given, impl_->settings);
     if (!field.empty())
@@ -395,46 +302,6 @@ RenderSettings Scene::frameSettings(const RenderSettings& frame) const {
         s.isoNormalized = false;
     }
     return s;
-}
-
-Image Scene::renderIsoDepth(const RenderSettings& frame, RenderStats* stats) const {
-    const RenderSettings s = frameSettings(frame);
-    if (s.mode != RenderMode::Iso) throw Error("scene: hit depths exist only in iso mode");
-    Image depth;
-    renderFrame(*impl_, s, stats, &depth);
-    return depth;
-}
-
-Image Scene::render(RendererKind renderer, const CameraParams& camera, RenderStats* stats) const {
-    RenderSettings s = impl_->settings;
-    s.renderer = renderer;
-    s.camera = camera;
-    return renderFrame(*impl_, s, stats);
-}
-
-Renderer::Renderer(const Volume& volume, const RenderSettings& settings)
-    : scene_(volume, settings), settings_(scene_.settings()) {
-    settings_.renderer = settings.renderer;
-}
-
-Renderer::Renderer(Volume&& volume, const RenderSettings& settings)
-    : Renderer(std::make_shared<const Volume>(std::move(volume)), settings) {}
-
-Renderer::Renderer(std::shared_ptr<const Volume> volume, const RenderSettings& settings)
-    : scene_(std::move(volume), settings), settings_(scene_.settings()) {
-    settings_.renderer = settings.renderer;
-}
-
-Image Renderer::render(RenderStats* stats) const { return scene_.render(settings_, stats); }
-
-Image Renderer::render(const CameraParams& camera, RenderStats* stats) const {
-    RenderSettings s = settings_;
-    s.camera = camera;
-    return scene_.render(s, stats);
-}
-
-Image render(const Volume& volume, const RenderSettings& settings, RenderStats* stats) {
-    return Renderer(volume, settings).render(stats);
 }
 
 }  // namespace splat

@@ -1,5 +1,6 @@
 #pragma once
-// The reference ray caster as a frame stage: it reads a Scene's prebuilt field.
+// The reference ray caster as a renderer of a Scene's frames: it reads the Scene's field.
+#include "model/scene_impl.h"
 #include "reference/field.h"
 #include "splat/camera.h"
 #include "splat/image.h"
@@ -35,5 +36,15 @@ void validateReferenceKernel(const footprint::Kernel& kernel);
 /// adaptivity 1.75 kernel standard deviations (sqrt of Kernel::variance) clamped to
 /// [0.25, 1] (1 for the default Gaussian, 0.57 voxels), else 0.25.
 double referenceStepFor(RenderMode mode, double kernelDeviation, bool panelAdaptive);
+
+/// The reference's frame of `scene` seen by `camera`, on the calling thread's arena: the
+/// Scene's field (made on first use), or for shaded scenes a field of this view's shaded
+/// emission. With `depth` (iso only): the hit depths as well.
+Image referenceFrame(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
+                     RenderStats& stats, Image* depth);
+/// referenceFrame through the Gaussian pixel filter (Quality::pixelFilter, pixel_filter.h);
+/// an iso depth image stays point-sampled (a filtered depth is no surface's depth).
+Image filteredReferenceFrame(const Scene::Impl& scene, const Camera& camera,
+                             const RenderSettings& s, RenderStats& stats, Image* depth);
 
 }  // namespace splat

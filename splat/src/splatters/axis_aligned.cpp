@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <mutex>
 
 #include "footprint/lanes.h"
 #include "splatters/splatter.h"
@@ -170,6 +172,240 @@ struct WholeFootprints {
     }
 };
 
+/// The axis-aligned splatter's state per scene (Scene::Impl::state), made on first use: the
+/// splat list cut into cells of kCellWidth voxels along i within each row (k, j): cell
+/// (k * dims.y + j) * cellsX + c holds the splats of row (k, j) with i in
+/// [c kCellWidth, (c + 1) kCellWidth), at list positions [start[cell], start[cell + 1])
+/// (the list is in (k, j, i) order, so cells are consecutive). The splatter reads any slab of
+/// kCellWidth slices along any axis from it in runs of consecutive splats, without a sorted
+/// copy of the list per axis.
+class CellIndex {
+  public:
+    static constexpr int kCellWidth = 8;
+    explicit CellIndex(const Scene::Impl& scene) : scene_(scene) {}
+    int cellsX() const { return (scene_.volume->dims.x + kCellWidth - 1) / kCellWidth; }
+    /// Bricks of kCellWidth^3 voxels along each axis.
+    glm::ivec3 bricks() const { return (scene_.volume->dims + (kCellWidth - 1)) / kCellWidth; }
+    const std::vector<std::uint32_t>& cellStarts() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!cellStarts_) count();
+        return *cellStarts_;
+    }
+    /// Splats per brick, brick (bi, bj, bk) at (bk * bricks.y + bj) * bricks.x + bi: a slab
+    /// along any axis is one layer of these bricks.
+    const std::vector<std::uint32_t>& brickCounts() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!cellStarts_) count();
+        return *brickCounts_;
+    }
+
+  private:
+    /// Makes cellStarts_ and brickCounts_ (one pass over the list).
+    void count() {
+        const SplatList& splats = scene_.splats;
+        const glm::ivec3 dims = scene_.volume->dims;
+        const std::size_t cx = std::size_t(cellsX()), rows = std::size_t(dims.y) * dims.z;
+        auto start = std::make_unique<std::vector<std::uint32_t>>(rows * cx + 1, 0);
+        std::vector<std::uint32_t>& st = *start;
+        const std::size_t n = splats.size();
+        for (std::size_t q = 0; q < n; ++q) {
+            const std::size_t row = std::size_t(splats.k[q]) * dims.y + splats.j[q];
+            ++st[row * cx + splats.i[q] / kCellWidth + 1];
+        }
+        const glm::ivec3 b = bricks();
+        auto counts = std::make_unique<std::vector<std::uint32_t>>(std::size_t(b.x) * b.y * b.z, 0);
+        for (std::size_t row = 0; row < rows; ++row) {
+            const std::size_t j = row % std::size_t(dims.y), k = row / dims.y;
+            const std::size_t brickRow = (k / kCellWidth * b.y + j / kCellWidth) * b.x;
+            for (std::size_t c = 0; c < cx; ++c) (*counts)[brickRow + c] += st[row * cx + c + 1];
+        }
+        for (std::size_t c = 1; c < st.size(); ++c) st[c] += st[c - 1];
+        cellStarts_ = std::move(start);
+        brickCounts_ = std::move(counts);
+    }
+
+    const Scene::Impl& scene_;
+    std::mutex mutex_;
+    std::unique_ptr<std::vector<std::uint32_t>> cellStarts_, brickCounts_;
+};
+
+/// The axis-aligned splatter's chunks (SheetChunks::gather): chunk c is the slab of
+/// kCellWidth slices c-th in visiting order, read from the scene's cells (CellIndex) in runs
+/// of consecutive splats (no sorted copy of the list), leaving out the bricks found hidden.
+/// Binning sorts each tile's records by slice.
+class SlabGather {
+  public:
+    static constexpr int kWidth = CellIndex::kCellWidth;
+
+    SlabGather(const Scene::Impl& scene, CellIndex& index, int axis, std::size_t slabs,
+               bool ascending)
+        : scene_(scene),
+          cells_(index.cellStarts()),
+          brickCounts_(index.brickCounts()),
+          bricks_(index.bricks()),
+          cellsX_(std::size_t(index.cellsX())),
+          m_(axis),
+          u_(axis == 0 ? 1 : 0),
+          v_(axis == 2 ? 1 : 2),
+          slabs_(slabs),
+          ascending_(ascending) {}
+
+    /// Lists chunk c's splats into `ids`, cut into `runs`; returns the splats left out.
+    std::size_t operator()(std::size_t c, std::vector<std::uint32_t>& ids,
+                           std::vector<std::uint32_t>& runs, const BrickTest& visible) {
+        const std::size_t slab = ascending_ ? c : slabs_ - 1 - c;
+        const std::size_t hidden = markBricks(slab, visible);
+        listCells(slab);
+        joinParts(ids, runs);
+        return hidden;
+    }
+
+  private:
+    /// The slab's slices along the axis: [first, end).
+    std::size_t firstSlice(std::size_t slab) const { return slab * kWidth; }
+    std::size_t endSlice(std::size_t slab) const {
+        return std::min<std::size_t>(firstSlice(slab) + kWidth, scene_.volume->dims[m_]);
+    }
+    std::size_t bricksU() const { return std::size_t(bricks_[u_]); }
+    std::size_t bricksV() const { return std::size_t(bricks_[v_]); }
+    /// Whether the brick holding voxel (iu, iv) of the slab (u, v: the other two axes) is
+    /// read.
+    bool shown(std::size_t iu, std::size_t iv) const {
+        return state_[iv / kWidth * bricksU() + iu / kWidth] != 0;
+    }
+
+    /// The slab is one layer of bricks of kWidth^3 voxels. Each is tested as one against the
+    /// tiles' opacity: the cells of an empty or hidden brick are not read at all
+    /// (state_[bu + bv * bricksU] = 0), the splats of a hidden one counted from brickCounts.
+    /// Cells of the others are read in the same order as without bricks, so the image is the
+    /// same. Returns the splats of the hidden bricks.
+    std::size_t markBricks(std::size_t slab, const BrickTest& visible) {
+        const int m = m_, u = u_, v = v_;
+        const glm::ivec3 d = scene_.volume->dims, nb = bricks_;
+        const std::size_t q0 = firstSlice(slab), q1 = endSlice(slab);
+        const std::size_t nu = bricksU(), nv = bricksV();
+        state_.assign(nu * nv, 0);
+        std::vector<std::size_t> left(nv, 0);
+        tbb::parallel_for(std::size_t(0), nv, [&](std::size_t bv) {
+            for (std::size_t bu = 0; bu < nu; ++bu) {
+                glm::ivec3 bi;
+                bi[m] = int(slab);
+                bi[u] = int(bu);
+                bi[v] = int(bv);
+                const std::uint32_t n =
+                    brickCounts_[(std::size_t(bi.z) * nb.y + std::size_t(bi.y)) * nb.x + bi.x];
+                if (n == 0) continue;
+                glm::ivec3 lo = bi * kWidth, hi = glm::min(d, lo + kWidth) - 1;
+                lo[m] = int(q0);
+                hi[m] = int(q1) - 1;
+                if (visible(lo, hi))
+                    state_[bv * nu + bu] = 1;
+                else
+                    left[bv] += n;
+            }
+        });
+        std::size_t hidden = 0;
+        for (std::size_t h : left) hidden += h;
+        return hidden;
+    }
+
+    /// The cells of the shown bricks, listed in parts (in parallel; joined in order by
+    /// joinParts): part p holds slice q0 + p / bricksV (m = 0: all of them) and the v-brick
+    /// p % bricksV. One run per non-empty cell (m = 0: per slice of kWidth cells): its splats
+    /// lie on one line of voxels between its first and last, in one sheet.
+    void listCells(std::size_t slab) {
+        const int m = m_;
+        const glm::ivec3 d = scene_.volume->dims;
+        const std::size_t q0 = firstSlice(slab), q1 = endSlice(slab);
+        const std::size_t ny = std::size_t(d.y), cx = cellsX_, nv = bricksV();
+        const std::vector<std::uint32_t>& cells = cells_;
+        nParts_ = m == 0 ? nv : (q1 - q0) * nv;
+        if (parts_.size() < nParts_) parts_.resize(nParts_);
+        tbb::parallel_for(std::size_t(0), nParts_, [&](std::size_t p) {
+            GatherPart& part = parts_[p];
+            part.ids.clear();
+            part.runs.clear();
+            auto add = [&](std::size_t cell) {
+                if (cells[cell] == cells[cell + 1]) return;
+                for (std::size_t q = cells[cell]; q < cells[cell + 1]; ++q)
+                    part.ids.push_back(std::uint32_t(q));
+                part.runs.push_back(std::uint32_t(part.ids.size()));
+            };
+            const std::size_t bv = p % nv, slice = q0 + p / nv;
+            const std::size_t v0 = bv * kWidth, v1 = std::min<std::size_t>(v0 + kWidth, d[v_]);
+            if (m == 2) {  // u = i (one cell per brick), v = j
+                for (std::size_t j = v0; j < v1; ++j)
+                    for (std::size_t ci = 0; ci < cx; ++ci)
+                        if (shown(ci * kWidth, j)) add((slice * ny + j) * cx + ci);
+            } else if (m == 1) {  // u = i, v = k: slice-major, already in sheet order
+                for (std::size_t k = v0; k < v1; ++k)
+                    for (std::size_t ci = 0; ci < cx; ++ci)
+                        if (shown(ci * kWidth, k)) add((k * ny + slice) * cx + ci);
+            } else {  // u = j, v = k; the slab is cell column `slab`
+                listColumnCells(slab, v0, v1, part);
+            }
+        });
+    }
+
+    /// Axis 0: a cell's splats lie in different slices, so the cells of kWidth rows j are
+    /// listed slice by slice instead, each slice's splats one run along j (per slice the
+    /// same order as row by row: k, then j), for the v-bricks' rows k in [v0, v1).
+    void listColumnCells(std::size_t slab, std::size_t v0, std::size_t v1, GatherPart& part) const {
+        const std::size_t q0 = firstSlice(slab), q1 = endSlice(slab);
+        const std::size_t ny = std::size_t(scene_.volume->dims.y), cx = cellsX_;
+        const std::vector<std::uint32_t>& cells = cells_;
+        const std::vector<std::uint16_t>& si = scene_.splats.i;
+        std::uint32_t at[kWidth], stop[kWidth];
+        for (std::size_t k = v0; k < v1; ++k)
+            for (std::size_t j0 = 0; j0 < ny; j0 += kWidth) {
+                if (!shown(j0, k)) continue;
+                const std::size_t rows = std::min<std::size_t>(kWidth, ny - j0);
+                for (std::size_t r = 0; r < rows; ++r) {
+                    const std::size_t cell = (k * ny + j0 + r) * cx + slab;
+                    at[r] = cells[cell];
+                    stop[r] = cells[cell + 1];
+                }
+                for (std::size_t i = q0; i < q1; ++i) {
+                    const std::size_t before = part.ids.size();
+                    for (std::size_t r = 0; r < rows; ++r)
+                        while (at[r] < stop[r] && si[at[r]] == i) part.ids.push_back(at[r]++);
+                    if (part.ids.size() != before)
+                        part.runs.push_back(std::uint32_t(part.ids.size()));
+                }
+            }
+    }
+
+    /// The parts' splats and runs, joined in order.
+    void joinParts(std::vector<std::uint32_t>& ids, std::vector<std::uint32_t>& runs) const {
+        std::size_t total = 0, runCount = 0;
+        for (std::size_t p = 0; p < nParts_; ++p) {
+            total += parts_[p].ids.size();
+            runCount += parts_[p].runs.size();
+        }
+        ids.resize(total);
+        runs.resize(runCount + 1);
+        runs[0] = 0;
+        std::size_t at = 0, r = 1;
+        for (std::size_t p = 0; p < nParts_; ++p) {
+            std::copy(parts_[p].ids.begin(), parts_[p].ids.end(), ids.begin() + std::ptrdiff_t(at));
+            for (std::uint32_t e : parts_[p].runs) runs[r++] = std::uint32_t(at + e);
+            at += parts_[p].ids.size();
+        }
+    }
+
+    const Scene::Impl& scene_;
+    const std::vector<std::uint32_t>& cells_;
+    const std::vector<std::uint32_t>& brickCounts_;
+    glm::ivec3 bricks_;
+    std::size_t cellsX_;
+    int m_, u_, v_;
+    std::size_t slabs_;
+    bool ascending_;
+    std::vector<std::uint8_t> state_;  ///< per brick of the slab: read (1) or not
+    std::vector<GatherPart> parts_;
+    std::size_t nParts_ = 0;
+};
+
 class AxisAligned final : public Splatter {
   public:
     SheetPlan order(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
@@ -188,126 +424,10 @@ class AxisAligned final : public Splatter {
         plan.normal = glm::dvec3(0.0);
         plan.normal[m] = 1.0;
         // Visiting order: slabs of kCellWidth slices in visibility order for the compositing
-        // direction, each read from the scene's cells in runs of consecutive splats (no sorted
-        // copy of the list); binning sorts each tile's records by slice.
-        const Scene::Impl& sc = scene;
-        const std::vector<std::uint32_t>& cells = scene.cellStarts();
-        constexpr int kWidth = Scene::Impl::kCellWidth;
-        const std::size_t slabs = (plan.sheets + kWidth - 1) / kWidth;
-        const bool ascending = plan.ascending;
+        // direction.
+        const std::size_t slabs = (plan.sheets + SlabGather::kWidth - 1) / SlabGather::kWidth;
         work.chunks.count = slabs;
-        const std::vector<std::uint32_t>& brickCounts = scene.brickCounts();
-        work.chunks.gather = [&sc, &cells, &brickCounts, m, slabs, ascending,
-                              state = std::vector<std::uint8_t>(),
-                              parts = std::vector<GatherPart>()](std::size_t c,
-                                                                 std::vector<std::uint32_t>& ids,
-                                                                 std::vector<std::uint32_t>& runs,
-                                                                 const BrickTest& visible) mutable {
-            const glm::ivec3 d = sc.volume->dims, nb = sc.bricks();
-            const std::size_t slab = ascending ? c : slabs - 1 - c, cx = std::size_t(sc.cellsX());
-            const std::size_t q0 = slab * kWidth, q1 = std::min<std::size_t>(q0 + kWidth, d[m]);
-            // The slab is one layer of bricks of kWidth^3 voxels (u, v: the other two axes).
-            // Each is tested as one against the tiles' opacity: the cells of an empty or hidden
-            // brick are not read at all (state[bu + bv * nb[u]] = 0), the splats of a hidden
-            // one counted from brickCounts. Cells of the others are read in the same order
-            // as without bricks, so the image is the same.
-            const int u = m == 0 ? 1 : 0, v = m == 2 ? 1 : 2;
-            const std::size_t bricksU = std::size_t(nb[u]), bricksV = std::size_t(nb[v]);
-            state.assign(bricksU * bricksV, 0);
-            std::vector<std::size_t> left(bricksV, 0);
-            tbb::parallel_for(std::size_t(0), bricksV, [&](std::size_t bv) {
-                for (std::size_t bu = 0; bu < bricksU; ++bu) {
-                    glm::ivec3 bi;
-                    bi[m] = int(slab);
-                    bi[u] = int(bu);
-                    bi[v] = int(bv);
-                    const std::uint32_t n =
-                        brickCounts[(std::size_t(bi.z) * nb.y + std::size_t(bi.y)) * nb.x + bi.x];
-                    if (n == 0) continue;
-                    glm::ivec3 lo = bi * kWidth, hi = glm::min(d, lo + kWidth) - 1;
-                    lo[m] = int(q0);
-                    hi[m] = int(q1) - 1;
-                    if (visible(lo, hi))
-                        state[bv * bricksU + bu] = 1;
-                    else
-                        left[bv] += n;
-                }
-            });
-            auto shown = [&](std::size_t iu, std::size_t iv) {
-                return state[iv / kWidth * bricksU + iu / kWidth] != 0;
-            };
-            // The cells are listed in parts (in parallel, then joined in order): part p holds
-            // slice q0 + p / bricksV (m = 0: all of them) and the v-brick p % bricksV. One
-            // run per non-empty cell (m = 0: per slice of kWidth cells): its splats lie on
-            // one line of voxels between its first and last, in one sheet.
-            const std::size_t ny = std::size_t(d.y);
-            const std::size_t nParts = m == 0 ? bricksV : (q1 - q0) * bricksV;
-            if (parts.size() < nParts) parts.resize(nParts);
-            tbb::parallel_for(std::size_t(0), nParts, [&](std::size_t p) {
-                GatherPart& part = parts[p];
-                part.ids.clear();
-                part.runs.clear();
-                auto add = [&](std::size_t cell) {
-                    if (cells[cell] == cells[cell + 1]) return;
-                    for (std::size_t q = cells[cell]; q < cells[cell + 1]; ++q)
-                        part.ids.push_back(std::uint32_t(q));
-                    part.runs.push_back(std::uint32_t(part.ids.size()));
-                };
-                const std::size_t bv = p % bricksV, slice = q0 + p / bricksV;
-                const std::size_t v0 = bv * kWidth, v1 = std::min<std::size_t>(v0 + kWidth, d[v]);
-                if (m == 2) {  // u = i (one cell per brick), v = j
-                    for (std::size_t j = v0; j < v1; ++j)
-                        for (std::size_t ci = 0; ci < cx; ++ci)
-                            if (shown(ci * kWidth, j)) add((slice * ny + j) * cx + ci);
-                } else if (m == 1) {  // u = i, v = k: slice-major, already in sheet order
-                    for (std::size_t k = v0; k < v1; ++k)
-                        for (std::size_t ci = 0; ci < cx; ++ci)
-                            if (shown(ci * kWidth, k)) add((k * ny + slice) * cx + ci);
-                } else {  // u = j, v = k; the slab is cell column `slab`
-                    // A cell's splats lie in different slices here: the cells of kWidth rows
-                    // j are listed slice by slice instead, each slice's splats one run along
-                    // j (per slice the same order as row by row: k, then j).
-                    const std::vector<std::uint16_t>& si = sc.splats.i;
-                    std::uint32_t at[kWidth], stop[kWidth];
-                    for (std::size_t k = v0; k < v1; ++k)
-                        for (std::size_t j0 = 0; j0 < ny; j0 += kWidth) {
-                            if (!shown(j0, k)) continue;
-                            const std::size_t rows = std::min<std::size_t>(kWidth, ny - j0);
-                            for (std::size_t r = 0; r < rows; ++r) {
-                                const std::size_t cell = (k * ny + j0 + r) * cx + slab;
-                                at[r] = cells[cell];
-                                stop[r] = cells[cell + 1];
-                            }
-                            for (std::size_t i = q0; i < q1; ++i) {
-                                const std::size_t before = part.ids.size();
-                                for (std::size_t r = 0; r < rows; ++r)
-                                    while (at[r] < stop[r] && si[at[r]] == i)
-                                        part.ids.push_back(at[r]++);
-                                if (part.ids.size() != before)
-                                    part.runs.push_back(std::uint32_t(part.ids.size()));
-                            }
-                        }
-                }
-            });
-            std::size_t total = 0, runCount = 0;
-            for (std::size_t p = 0; p < nParts; ++p) {
-                total += parts[p].ids.size();
-                runCount += parts[p].runs.size();
-            }
-            ids.resize(total);
-            runs.resize(runCount + 1);
-            runs[0] = 0;
-            std::size_t at = 0, r = 1;
-            for (std::size_t p = 0; p < nParts; ++p) {
-                std::copy(parts[p].ids.begin(), parts[p].ids.end(),
-                          ids.begin() + std::ptrdiff_t(at));
-                for (std::uint32_t e : parts[p].runs) runs[r++] = std::uint32_t(at + e);
-                at += parts[p].ids.size();
-            }
-            std::size_t hidden = 0;
-            for (std::size_t h : left) hidden += h;
-            return hidden;
-        };
+        work.chunks.gather = SlabGather(scene, scene.state<CellIndex>(), m, slabs, plan.ascending);
         stats.sheetAxis = m;
         stats.sheetSign = sa.sign;
         return plan;

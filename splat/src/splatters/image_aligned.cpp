@@ -15,10 +15,13 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <mutex>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 
 #include "footprint/lanes.h"
+#include "footprint/slab_table.h"
 #include "splat/error.h"
 #include "splatters/splatter.h"
 
@@ -346,6 +349,54 @@ struct SlabSections {
     }
 };
 
+/// The image-aligned splatter's state per scene (Scene::Impl::state), each part made on
+/// first use: the slab-section table and the splats ordered (stably) by slice index along an
+/// axis.
+class SlabState {
+  public:
+    explicit SlabState(const Scene::Impl& scene) : scene_(scene) {}
+
+    const footprint::SlabTable& slabTable() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!slabTable_) {
+            const Quality& q = scene_.settings.quality;
+            try {
+                slabTable_ = std::make_unique<footprint::SlabTable>(
+                    scene_.kernel, q.slabRadialResolution, q.slabDepthResolution);
+            } catch (const std::invalid_argument& e) {
+                throw Error(std::string("slab table: ") + e.what());
+            }
+        }
+        return *slabTable_;
+    }
+
+    /// The splat indices in slice order along `axis`, or null for axis 2: the list is in
+    /// (k, j, i) order already, so the order is the identity and is not stored.
+    const std::vector<std::uint32_t>* sliceOrder(int axis) {
+        if (axis == 2) return nullptr;
+        std::lock_guard<std::mutex> lock(mutex_);
+        std::unique_ptr<std::vector<std::uint32_t>>& o = sliceOrder_[axis];
+        if (!o) {
+            const SplatList& splats = scene_.splats;
+            const std::vector<std::uint16_t>& index = axis == 0 ? splats.i : splats.j;
+            // Counting sort on the 16-bit slice indices (no widened copy of the keys).
+            std::vector<std::uint32_t> next(std::size_t(scene_.volume->dims[axis]) + 1, 0);
+            for (std::uint16_t q : index) ++next[std::size_t(q) + 1];
+            for (std::size_t q = 1; q < next.size(); ++q) next[q] += next[q - 1];
+            o = std::make_unique<std::vector<std::uint32_t>>(index.size());
+            for (std::size_t n = 0; n < index.size(); ++n)
+                (*o)[next[index[n]]++] = std::uint32_t(n);
+        }
+        return o.get();
+    }
+
+  private:
+    const Scene::Impl& scene_;
+    std::mutex mutex_;
+    std::unique_ptr<footprint::SlabTable> slabTable_;
+    std::unique_ptr<std::vector<std::uint32_t>> sliceOrder_[2];
+};
+
 class ImageAligned final : public Splatter {
   public:
     SheetPlan order(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
@@ -370,7 +421,7 @@ class ImageAligned final : public Splatter {
     }
 
     Image rasterize(const TileInputs& in, FrameWorkspace&, RenderStats* stats) const override {
-        const SlabSections cutter{in, in.scene.slabTable(),
+        const SlabSections cutter{in, in.scene.state<SlabState>().slabTable(),
                                   in.settings.order == CompositeOrder::FrontToBack};
         return rasterizeWithPolicy(in, cutter, stats);
     }
@@ -406,7 +457,7 @@ SheetPlan orderOnSlabs(const Scene::Impl& scene, const Camera& camera, const Ren
     // Within a slab, splats are visited in slice order along the major axis, which keeps
     // the accesses to the splat arrays coherent.
     const int m = sheetAxis(camera.view, scene.volume->spacing).axis;
-    orderByKey(work.key, slabs, scene.sliceOrder(m).base(), work.order);
+    orderByKey(work.key, slabs, scene.state<SlabState>().sliceOrder(m), work.order);
     SheetPlan plan;
     plan.sheets = slabs;
     plan.ring = std::uint32_t(span);
@@ -423,7 +474,7 @@ void addSlabSheets(const TileInputs& in, std::uint32_t first, std::uint32_t coun
     withPolicy(in.policy, [&](const auto& policy) {
         using Policy = std::decay_t<decltype(policy)>;
         constexpr int NCh = Policy::kChannels;
-        const SlabSections cutter{in, in.scene.slabTable(),
+        const SlabSections cutter{in, in.scene.state<SlabState>().slabTable(),
                                   in.settings.order == CompositeOrder::FrontToBack, first,
                                   first + count};
         const TileGrid& g = in.bins.grid;

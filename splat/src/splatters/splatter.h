@@ -7,6 +7,7 @@
 // axis_aligned.cpp: Westover's sheets along the volume axis (whole footprints);
 // image_aligned.cpp: Mueller & Crawfis's slabs parallel to the image (slab sections).
 #include "frame/tile_driver.h"
+#include "frame/workspace.h"
 #include "model/scene_impl.h"
 
 namespace splat {
@@ -53,5 +54,11 @@ struct SheetAxis {
     int axis, sign;
 };
 SheetAxis sheetAxis(const glm::dvec3& view, const glm::dvec3& spacing);
+
+/// The splatters' frame of `scene` (a Scene or one level of detail of it) seen by `camera`
+/// (splatters/splat_frame.cpp): settings.renderer's stages shade -> project -> order -> bin ->
+/// tiles on the calling thread's arena. With `depth` (iso only): the hit depths as well.
+Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSettings& settings,
+                 RenderStats& stats, Image* depth);
 
 }  // namespace splat

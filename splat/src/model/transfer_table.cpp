@@ -1,5 +1,5 @@
 // The post-classification transfer table (see transfer_table.h).
-#include "frame/transfer_table.h"
+#include "model/transfer_table.h"
 
 namespace splat {
 

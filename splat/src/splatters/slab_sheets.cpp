@@ -1,5 +1,5 @@
 // Exact bricks for the image-aligned splatter (splat/slab_sheets.h): the frame pipeline of
-// frame/renderer.cpp up to the sheets (shade -> project -> order on the whole frame's slab
+// splatters/splat_frame.cpp up to the sheets (shade -> project -> order on the whole frame's slab
 // grid -> bin), then the tile sweep of one group of slabs at a time into blocks, and the
 // compositing of summed blocks through the mode's policy (SheetBuffer::flush), tile by tile.
 #include "splat/slab_sheets.h"
@@ -12,7 +12,7 @@
 #include <optional>
 #include <type_traits>
 
-#include "frame/frame.h"
+#include "frame/policy_context.h"
 #include "frame/stopwatch.h"
 #include "splat/bricks.h"
 #include "splat/error.h"
