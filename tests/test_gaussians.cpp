@@ -30,10 +30,11 @@ void writePly(const std::string& path, const std::string& format, const std::str
 
 std::string gaussianHeader(std::size_t n, int rest, const std::string& drop = "") {
     std::string h = "element vertex " + std::to_string(n) + "\n";
-    std::vector<std::string> names = {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"};
+    std::vector<std::string> names = {"x",  "y",      "z",      "nx",    "ny",
+                                      "nz", "f_dc_0", "f_dc_1", "f_dc_2"};
     for (int j = 0; j < rest; ++j) names.push_back("f_rest_" + std::to_string(j));
-    for (const char* p : {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2",
-                          "rot_3"})
+    for (const char* p :
+         {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"})
         names.push_back(p);
     for (const auto& p : names)
         if (p != drop) h += "property float " + p + "\n";
@@ -114,7 +115,9 @@ TEST_CASE("3DGS ply: malformed files get one line", "[gaussians]") {
     const std::vector<float> one(17, 0.0f);
     std::vector<float> good = one;
     good[13] = 1.0f;  // rot_0
-    auto oneLine = [](const std::string& m) { return !m.empty() && m.find('\n') == std::string::npos; };
+    auto oneLine = [](const std::string& m) {
+        return !m.empty() && m.find('\n') == std::string::npos;
+    };
 
     writePly(tmpFile("ascii.ply"), "ascii", gaussianHeader(1, 0), {});
     std::string m = errorOf(tmpFile("ascii.ply"));
@@ -133,7 +136,8 @@ TEST_CASE("3DGS ply: malformed files get one line", "[gaussians]") {
     CHECK(m.find("truncated vertex block") != std::string::npos);
 
     // Absurd counts are refused before anything is allocated.
-    writePly(tmpFile("huge.ply"), "binary_little_endian", gaussianHeader(4000000000000ull, 0), good);
+    writePly(tmpFile("huge.ply"), "binary_little_endian", gaussianHeader(4000000000000ull, 0),
+             good);
     m = errorOf(tmpFile("huge.ply"));
     CHECK(oneLine(m));
     CHECK(m.find("exceeds the limit") != std::string::npos);
@@ -144,7 +148,8 @@ TEST_CASE("3DGS ply: malformed files get one line", "[gaussians]") {
              "element face 0\nproperty list uchar int vertex_indices\n", {});
     CHECK(errorOf(tmpFile("mesh.ply")).find("no vertex element") != std::string::npos);
 
-    writePly(tmpFile("rest.ply"), "binary_little_endian", gaussianHeader(1, 5), std::vector<float>(22));
+    writePly(tmpFile("rest.ply"), "binary_little_endian", gaussianHeader(1, 5),
+             std::vector<float>(22));
     CHECK(errorOf(tmpFile("rest.ply")).find("f_rest") != std::string::npos);
 
     CHECK(errorOf(tmpFile("absent.ply")).find("cannot open") != std::string::npos);
@@ -164,8 +169,7 @@ TEST_CASE("Gaussian scenes: generator, bounds, geometry and colour", "[gaussians
     CHECK(hi.z == Approx(3.0));
     const Volume g = pop.geometry();
     CHECK(g.center().x == Approx(0.0).margin(1e-12));
-    CHECK(0.5 * glm::length(glm::dvec3(g.dims) * g.spacing) ==
-          Approx(0.5 * glm::length(hi - lo)));
+    CHECK(0.5 * glm::length(glm::dvec3(g.dims) * g.spacing) == Approx(0.5 * glm::length(hi - lo)));
     // Degree 0: colour = 0.5 + C0 dc, whatever the direction.
     CHECK(gaussianColour(pop, 0, {0, 1, 0}).x == Approx(1.0f));
     CHECK(gaussianColour(pop, 1, {1, 0, 0}).z == Approx(1.0f));

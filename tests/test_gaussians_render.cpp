@@ -60,7 +60,8 @@ GaussianRenderOptions with(GaussianRenderer r) {
 double maxDiff(const Image& a, const Image& b) {
     double m = 0;
     for (std::size_t i = 0; i < a.pixels.size(); ++i)
-        for (int c = 0; c < 4; ++c) m = std::max(m, double(std::abs(a.pixels[i][c] - b.pixels[i][c])));
+        for (int c = 0; c < 4; ++c)
+            m = std::max(m, double(std::abs(a.pixels[i][c] - b.pixels[i][c])));
     return m;
 }
 
@@ -97,13 +98,14 @@ TEST_CASE("3dgs: a lone Gaussian is the dilated EWA 2D Gaussian", "[gaussians]")
     CHECK(drawn > 500);
     CHECK(worst < 2e-6);
     // The centre (a pixel corner at 48, 40): alpha = 0.7 exp(-0.5 (0.25 C + 0.25 A - 0.5 B) / det).
-    CHECK(img.at(47, 39).a == Approx(0.7 * std::exp(-0.5 * (0.25 * C + 0.25 * A - 0.5 * B) / det)).epsilon(1e-5));
+    CHECK(img.at(47, 39).a ==
+          Approx(0.7 * std::exp(-0.5 * (0.25 * C + 0.25 * A - 0.5 * B) / det)).epsilon(1e-5));
 }
 
 TEST_CASE("3dgs: the perspective centre pixel has alpha min(0.99, o)", "[gaussians]") {
     for (float o : {0.6f, 1.0f}) {
-        const GaussianScene s = one({0.3f, 0.2f, -0.1f}, {0.2f, 0.4f, 0.3f}, {1, 0.2f, 0.1f, 0.3f}, o,
-                                    {1, 1, 1});
+        const GaussianScene s =
+            one({0.3f, 0.2f, -0.1f}, {0.2f, 0.4f, 0.3f}, {1, 0.2f, 0.1f, 0.3f}, o, {1, 1, 1});
         CameraParams cam;  // orbit about the Gaussian (the scene's centre)
         cam.width = cam.height = 65;
         cam.projection = Projection::Perspective;
@@ -117,8 +119,10 @@ TEST_CASE("3dgs: the perspective centre pixel has alpha min(0.99, o)", "[gaussia
 }
 
 TEST_CASE("3dgs: separate Gaussians composite independently; any thread count", "[gaussians]") {
-    const GaussianScene a = one({-1.5f, 0.5f, 0.3f}, {0.2f, 0.3f, 0.1f}, {1, 0.3f, 0, 0}, 0.9f, {1, 0, 0});
-    const GaussianScene b = one({1.2f, -0.4f, -0.2f}, {0.15f, 0.2f, 0.25f}, {1, 0, 0.4f, 0.1f}, 0.6f, {0, 1, 0.5f});
+    const GaussianScene a =
+        one({-1.5f, 0.5f, 0.3f}, {0.2f, 0.3f, 0.1f}, {1, 0.3f, 0, 0}, 0.9f, {1, 0, 0});
+    const GaussianScene b =
+        one({1.2f, -0.4f, -0.2f}, {0.15f, 0.2f, 0.25f}, {1, 0, 0.4f, 0.1f}, 0.6f, {0, 1, 0.5f});
     const CameraParams cam = ortho(128, 64, 0.05);
     for (GaussianRenderer r : {GaussianRenderer::Rasterizer, GaussianRenderer::PixelSorted,
                                GaussianRenderer::Sheet, GaussianRenderer::Reference}) {
@@ -129,8 +133,8 @@ TEST_CASE("3dgs: separate Gaussians composite independently; any thread count", 
         for (std::size_t i = 0; i < both.pixels.size(); ++i) {
             REQUIRE((ia.pixels[i].a == 0 || ib.pixels[i].a == 0));
             for (int c = 0; c < 4; ++c) {
-                worst = std::max(worst, double(std::abs(both.pixels[i][c] - ia.pixels[i][c] -
-                                                        ib.pixels[i][c])));
+                worst = std::max(
+                    worst, double(std::abs(both.pixels[i][c] - ia.pixels[i][c] - ib.pixels[i][c])));
                 ink += ia.pixels[i][c] + ib.pixels[i][c];
             }
         }
@@ -178,7 +182,8 @@ TEST_CASE("reference and sheet: a lone Gaussian is 1 - exp(-tau) of its marginal
     const float o = 0.75f;
     const GaussianScene s = one({0, 0, 0}, {0.6f, 0.9f, 0.3f}, q, o, {0.3f, 0.6f, 0.9f});
     const double c = std::cos(th), sn = std::sin(th), a2 = 0.36, c2 = 0.09;
-    const double A = (c * c * a2 + sn * sn * c2) / (ps * ps), C = (sn * sn * a2 + c * c * c2) / (ps * ps);
+    const double A = (c * c * a2 + sn * sn * c2) / (ps * ps),
+                 C = (sn * sn * a2 + c * c * c2) / (ps * ps);
     const double B = -(-c * sn * a2 + sn * c * c2) / (ps * ps), det = A * C - B * B;
     const double tauPeak = -std::log(1.0 - o);
     for (GaussianRenderer r : {GaussianRenderer::Reference, GaussianRenderer::Sheet}) {
@@ -188,7 +193,8 @@ TEST_CASE("reference and sheet: a lone Gaussian is 1 - exp(-tau) of its marginal
         for (int y = 0; y < img.height; ++y)
             for (int x = 0; x < img.width; ++x) {
                 const double dx = 40 - (x + 0.5), dy = 32 - (y + 0.5);
-                const double tau = tauPeak * std::exp(-0.5 * (C * dx * dx + A * dy * dy - 2 * B * dx * dy) / det);
+                const double tau =
+                    tauPeak * std::exp(-0.5 * (C * dx * dx + A * dy * dy - 2 * B * dx * dy) / det);
                 const double alpha = -std::expm1(-tau);
                 worst = std::max({worst, std::abs(img.at(x, y).a - alpha),
                                   std::abs(img.at(x, y).g - 0.6 * alpha)});
@@ -228,8 +234,8 @@ TEST_CASE("sheet converges to the reference as the slab thins", "[gaussians]") {
 
 TEST_CASE("a volume's splats as Gaussians: the reference renders the volume's model",
           "[gaussians]") {
-    // With a kernel radius of 5 sigma the volume kernel misses 1.5e-5 of the Gaussian's mass, so the
-    // Gaussians' density sum is the volume's pre-classified extinction field: the two exact
+    // With a kernel radius of 5 sigma the volume kernel misses 1.5e-5 of the Gaussian's mass, so
+    // the Gaussians' density sum is the volume's pre-classified extinction field: the two exact
     // references agree to their tolerances.
     const Volume v = makeSynthetic("blob", 16);
     RenderSettings s;

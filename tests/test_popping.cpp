@@ -225,7 +225,8 @@ TEST_CASE("popping: rounding is no event on a blob or a sphere (the precision fl
         CHECK(eventsOf(r, RendererKind::Reference).empty());
         double peak = 0;
         for (const Image& im : series(r, RendererKind::Reference).thumbnails)
-            for (const auto& p : im.pixels) peak = std::max({peak, double(p.r), double(p.g), double(p.b)});
+            for (const auto& p : im.pixels)
+                peak = std::max({peak, double(p.r), double(p.g), double(p.b)});
         CHECK(peak > 0.05);
         const RendererSeries& sheet = series(r, RendererKind::Sheet);
         CHECK(sheet.threshold >= 1e-6 * peak * 0.99);

@@ -34,7 +34,8 @@ CameraParams cameraOf(const RenderArgs& a) {
     c.elevationDeg = a.elevation;
     if (a.projection != "ortho" && a.projection != "perspective")
         throw UsageError("--projection must be ortho or perspective");
-    c.projection = a.projection == "perspective" ? Projection::Perspective : Projection::Orthographic;
+    c.projection =
+        a.projection == "perspective" ? Projection::Perspective : Projection::Orthographic;
     c.pixelSize = a.pixelSize;
     c.fovDeg = a.fov;
     c.distance = a.distance;
@@ -63,11 +64,10 @@ void printGaussianInfo(const std::string& spec) {
         sMax = std::max({sMax, sc.x, sc.y, sc.z});
     }
     std::printf("%s: %s\n", spec.c_str(), s.source.c_str());
-    std::printf("Gaussians: %zu, SH degree %d (%d coefficients per channel), %.1f MiB\n",
-                s.size(), s.shDegree, s.shCount(),
-                double(s.size()) * (11 + 3 * s.shCount()) * 4 / 1048576.0);
-    std::printf("means:     x %g .. %g, y %g .. %g, z %g .. %g\n", lo.x, hi.x, lo.y, hi.y,
-                lo.z, hi.z);
+    std::printf("Gaussians: %zu, SH degree %d (%d coefficients per channel), %.1f MiB\n", s.size(),
+                s.shDegree, s.shCount(), double(s.size()) * (11 + 3 * s.shCount()) * 4 / 1048576.0);
+    std::printf("means:     x %g .. %g, y %g .. %g, z %g .. %g\n", lo.x, hi.x, lo.y, hi.y, lo.z,
+                hi.z);
     std::printf("opacity:   %g .. %g\n", oMin, oMax);
     std::printf("scale:     %g .. %g (standard deviations, world units)\n", sMin, sMax);
 }
@@ -75,9 +75,8 @@ void printGaussianInfo(const std::string& spec) {
 void renderGaussianFile(const CLI::App& cmd, const RenderArgs& args, const std::string& spec,
                         const std::string& output) {
     GaussianRenderOptions o;
-    o.renderer = asUsage([&] {
-        return parseGaussianRenderer(given(cmd, "renderer") ? args.renderer : "3dgs");
-    });
+    o.renderer = asUsage(
+        [&] { return parseGaussianRenderer(given(cmd, "renderer") ? args.renderer : "3dgs"); });
     o.threads = args.threads;
     o.slab = given(cmd, "slab") ? args.slab : 0;
     o.tolerance = args.refTolerance;

@@ -2,7 +2,8 @@
 // Gaussian scenes (splat/gaussians.h) on the command line: a VOLUME argument ending in .ply
 // or starting with "gaussians:" is a 3DGS scene, for `splat info` and `splat render`
 // (--renderer 3dgs|3dgs-pixel|sheet|reference; the camera options apply, --slab is in world
-// units); `splat gaussians VOLUME -o scene.ply` (cmd_gaussians.cpp) writes a volume's splats as one.
+// units); `splat gaussians VOLUME -o scene.ply` (cmd_gaussians.cpp) writes a volume's splats as
+// one.
 #include <CLI/CLI.hpp>
 #include <string>
 

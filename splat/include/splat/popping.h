@@ -47,8 +47,8 @@ struct Sweep {
 struct PoppingOptions {
     std::vector<RendererKind> renderers{RendererKind::Axis, RendererKind::Sheet,
                                         RendererKind::Reference};
-    double madK = 5.0;            ///< event threshold: median + madK * MAD ...
-    double floorRatio = 2.0;      ///< ... and at least floorRatio * median
+    double madK = 5.0;        ///< event threshold: median + madK * MAD ...
+    double floorRatio = 2.0;  ///< ... and at least floorRatio * median
     /// ... and above precisionFloor times the sweep's peak pixel value: 1e-6 is about 8 float
     /// ulps (FLT_EPSILON = 1.2e-7) of the peak, above the rounding of a frame's float sums,
     /// and below the smallest visible change (one pixel moving one 8-bit step in a 1024 x

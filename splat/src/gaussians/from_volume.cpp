@@ -10,9 +10,9 @@
 
 #include "footprint/kernel.h"
 #include "splat/classify.h"
-#include "splat/settings.h"
 #include "splat/error.h"
 #include "splat/gaussians.h"
+#include "splat/settings.h"
 
 namespace splat {
 
@@ -26,7 +26,8 @@ GaussianScene gaussiansFromVolume(const Volume& volume, const RenderSettings& se
     }
     if (settings.kernel != "gaussian")
         throw Error("a volume becomes Gaussians only with the gaussian kernel (--kernel gaussian)");
-    const bool isotropic = volume.spacing.x == volume.spacing.y && volume.spacing.y == volume.spacing.z;
+    const bool isotropic =
+        volume.spacing.x == volume.spacing.y && volume.spacing.y == volume.spacing.z;
     if (volume.direction != glm::dmat3(1.0) && !isotropic)
         throw Error(
             "an oblique volume with anisotropic spacing cannot be written as Gaussians yet");
@@ -52,7 +53,8 @@ GaussianScene gaussiansFromVolume(const Volume& volume, const RenderSettings& se
         s.opacities[i] = float(-std::expm1(-rho * perRho));
         const glm::dvec3 e(splats.r[i], splats.g[i], splats.b[i]);
         const glm::dvec3 colour = rho > 0 ? e / rho : glm::dvec3(0.0);
-        for (int c = 0; c < 3; ++c) s.sh[i * 3 + std::size_t(c)] = float((colour[c] - 0.5) / 0.28209479177387814);
+        for (int c = 0; c < 3; ++c)
+            s.sh[i * 3 + std::size_t(c)] = float((colour[c] - 0.5) / 0.28209479177387814);
     }
     s.source = "Gaussians of " + (volume.source.empty() ? std::string("a volume") : volume.source);
     return s;

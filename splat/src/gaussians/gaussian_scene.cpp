@@ -33,7 +33,8 @@ void GaussianScene::validate() const {
             bad(i, "has a scale that is not a finite number > 0");
         if (!(std::abs(glm::length(q) - 1.0f) < 1e-3f))
             bad(i, "has a rotation that is not a unit quaternion");
-        if (!(opacities[i] >= 0.0f && opacities[i] <= 1.0f)) bad(i, "has an opacity outside [0, 1]");
+        if (!(opacities[i] >= 0.0f && opacities[i] <= 1.0f))
+            bad(i, "has an opacity outside [0, 1]");
     }
     for (float v : sh)
         if (!std::isfinite(v)) throw Error("Gaussian scene: an SH coefficient is not finite");

@@ -106,7 +106,8 @@ Header readHeader(std::istream& in, const std::string& path) {
             }
             words >> name;
             const int bytes = typeBytes(type);
-            if (bytes == 0) fail(path, "PLY property '" + name + "' has unknown type '" + type + "'");
+            if (bytes == 0)
+                fail(path, "PLY property '" + name + "' has unknown type '" + type + "'");
             if (inVertex) {
                 if (h.properties.count(name)) fail(path, "PLY property '" + name + "' repeats");
                 h.properties[name] = {h.stride, type == "float" || type == "float32"};
@@ -153,13 +154,14 @@ GaussianScene loadGaussians(const std::string& path) {
 
     auto find = [&](const std::string& name) -> std::size_t {
         const auto it = h.properties.find(name);
-        if (it == h.properties.end()) fail(path, "missing property '" + name + "' (not a 3DGS scene)");
+        if (it == h.properties.end())
+            fail(path, "missing property '" + name + "' (not a 3DGS scene)");
         if (!it->second.isFloat) fail(path, "property '" + name + "' is not float");
         return it->second.offset;
     };
-    const char* required[] = {"x",       "y",       "z",       "f_dc_0",  "f_dc_1", "f_dc_2",
-                              "opacity", "scale_0", "scale_1", "scale_2", "rot_0",  "rot_1",
-                              "rot_2",   "rot_3"};
+    const char* required[] = {"x",      "y",       "z",       "f_dc_0",  "f_dc_1",
+                              "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
+                              "rot_0",  "rot_1",   "rot_2",   "rot_3"};
     std::size_t off[14];
     for (int k = 0; k < 14; ++k) off[k] = find(required[k]);
     int rest = 0;
@@ -188,8 +190,8 @@ GaussianScene loadGaussians(const std::string& path) {
     for (std::size_t first = 0; first < n; first += chunk) {
         const std::size_t m = std::min(chunk, n - first);
         if (!in.read(buf.data(), std::streamsize(m * h.stride)))
-            fail(path, "truncated vertex block (read failed at Gaussian " +
-                           std::to_string(first) + ")");
+            fail(path,
+                 "truncated vertex block (read failed at Gaussian " + std::to_string(first) + ")");
         for (std::size_t j = 0; j < m; ++j) {
             const char* v = buf.data() + j * h.stride;
             auto f = [v](std::size_t o) {
@@ -226,10 +228,11 @@ GaussianScene loadGaussians(const std::string& path) {
 void writeGaussians(const GaussianScene& scene, const std::string& path) {
     scene.validate();
     const std::size_t n = scene.size(), k = std::size_t(scene.shCount());
-    std::vector<std::string> names = {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"};
+    std::vector<std::string> names = {"x",  "y",      "z",      "nx",    "ny",
+                                      "nz", "f_dc_0", "f_dc_1", "f_dc_2"};
     for (std::size_t j = 0; j < 3 * (k - 1); ++j) names.push_back("f_rest_" + std::to_string(j));
-    for (const char* p : {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2",
-                          "rot_3"})
+    for (const char* p :
+         {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"})
         names.push_back(p);
     std::string header = "ply\nformat binary_little_endian 1.0\ncomment written by splat\n";
     header += "element vertex " + std::to_string(n) + "\n";

@@ -70,7 +70,8 @@ Projected project(const GaussianScene& scene, const ViewFrame& f, Footprint foot
             const glm::dmat3 r = rotation(scene.rotations[i]);
             const glm::dvec3 s(scene.scales[i]);
             const glm::dmat3 rs(r[0] * s.x, r[1] * s.y, r[2] * s.z);
-            const glm::dmat3 sigmaView = toView * (rs * glm::transpose(rs)) * glm::transpose(toView);
+            const glm::dmat3 sigmaView =
+                toView * (rs * glm::transpose(rs)) * glm::transpose(toView);
             glm::dmat3 j(0.0);  // 2 x 3 Jacobian in the upper rows (glm: j[col][row])
             if (f.perspective) {
                 const double tx = std::clamp(v.x / v.z, -f.limitX, f.limitX) * v.z;

@@ -26,7 +26,7 @@ constexpr int kTile = 16;
 struct ViewFrame {
     glm::dvec3 eye, right, down, view;
     bool perspective = false;
-    double focalPixels = 1;  ///< perspective: focal / pixelSize; orthographic: 1 / pixelSize
+    double focalPixels = 1;         ///< perspective: focal / pixelSize; orthographic: 1 / pixelSize
     double limitX = 0, limitY = 0;  ///< perspective: 1.3 tan(half field of view) per axis
     int width = 0, height = 0;
 };
@@ -68,7 +68,6 @@ TileLists binToTiles(const Projected& projected, int width, int height);
 
 /// Calls fn(tileX, tileY) for every tile, in parallel (in the caller's task arena).
 void forEachTile(const TileLists& tiles, const std::function<void(int, int)>& fn);
-
 
 /// One Gaussian along a ray o + t d (|d| = 1): its density c exp(-m/2) exp(-a (t - t*)^2 / 2).
 struct RayGaussian {

@@ -12,10 +12,14 @@ namespace splat {
 
 const char* gaussianRendererName(GaussianRenderer renderer) {
     switch (renderer) {
-        case GaussianRenderer::Rasterizer: return "3dgs";
-        case GaussianRenderer::PixelSorted: return "3dgs-pixel";
-        case GaussianRenderer::Sheet: return "sheet";
-        case GaussianRenderer::Reference: return "reference";
+        case GaussianRenderer::Rasterizer:
+            return "3dgs";
+        case GaussianRenderer::PixelSorted:
+            return "3dgs-pixel";
+        case GaussianRenderer::Sheet:
+            return "sheet";
+        case GaussianRenderer::Reference:
+            return "reference";
     }
     return "?";
 }
@@ -42,8 +46,7 @@ Image renderGaussians(const GaussianScene& scene, const CameraParams& params,
         const bool volume = kind == GaussianRenderer::Sheet || kind == GaussianRenderer::Reference;
         // Gaussians whose optical depth along a ray stays below epsilon are left out of the
         // volume renderers: at most epsilon of opacity each.
-        const double epsilon =
-            kind == GaussianRenderer::Reference ? 0.1 * options.tolerance : 1e-6;
+        const double epsilon = kind == GaussianRenderer::Reference ? 0.1 * options.tolerance : 1e-6;
         const Projected p = project(scene, frame, volume ? Footprint::Volume : Footprint::Splat,
                                     epsilon, kind != GaussianRenderer::Rasterizer);
         const TileLists tiles = binToTiles(p, camera.width(), camera.height());

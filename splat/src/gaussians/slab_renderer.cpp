@@ -1,7 +1,7 @@
 // `sheet`: the image-aligned sheet-buffer splatter (Mueller & Crawfis 1998) on Gaussians. Slab
-// k holds view depths [k h, (k + 1) h) measured from the camera target's plane; along a pixel's ray o + t d it is
-// t in [k h / (d.view), (k + 1) h / (d.view)). Each Gaussian's optical depth in a slab is
-// exact: 2 amplitude (erf(s (t1 - t*)) - erf(s (t0 - t*))) / 2 (projection.h RayGaussian);
+// k holds view depths [k h, (k + 1) h) measured from the camera target's plane; along a pixel's ray
+// o + t d it is t in [k h / (d.view), (k + 1) h / (d.view)). Each Gaussian's optical depth in a
+// slab is exact: 2 amplitude (erf(s (t1 - t*)) - erf(s (t0 - t*))) / 2 (projection.h RayGaussian);
 // its emission is that times its colour. Each slab becomes one sample (alpha = 1 - exp(-tau),
 // C = E alpha / tau) composited front to back. Within one slab the colours of different
 // Gaussians are averaged by optical depth, which is the whole of its error against the
@@ -18,7 +18,7 @@
 namespace splat::gaussians {
 
 namespace {
-constexpr double kErfReach = 4.5;         // 1 - erf(4.5) = 2e-10: the Gaussian's whole extent
+constexpr double kErfReach = 4.5;            // 1 - erf(4.5) = 2e-10: the Gaussian's whole extent
 constexpr std::int64_t kMaxSlabs = 1 << 22;  // per pixel ray
 }  // namespace
 
@@ -41,7 +41,9 @@ Image renderSlabs(const GaussianScene& scene, const Projected& p, const TileList
                 // the same for every scene seen by one free camera): z = z_o + t cos.
                 const double cosine = glm::dot(ray.dir, camera.view);
                 const double zo = glm::dot(ray.origin - camera.target, camera.view);
-                auto slabOf = [&](double t) { return std::int64_t(std::floor((zo + t * cosine) / slab)); };
+                auto slabOf = [&](double t) {
+                    return std::int64_t(std::floor((zo + t * cosine) / slab));
+                };
                 std::int64_t first = INT64_MAX, last = INT64_MIN;
                 for (const RayGaussian& g : gs) {
                     first = std::min(first, slabOf(g.tStar - kErfReach / g.s));

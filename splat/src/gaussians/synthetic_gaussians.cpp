@@ -72,8 +72,10 @@ GaussianScene syntheticGaussians(const std::string& name) {
         const std::string count = rest.substr(0, colon);
         const std::string seed = colon == std::string::npos ? "1" : rest.substr(colon + 1);
         auto number = [&](const std::string& t) {
-            if (t.empty() || t.size() > 10 || t.find_first_not_of("0123456789") != std::string::npos)
-                throw Error("'" + name + "': expected gaussians:random:N[:SEED] with whole numbers");
+            if (t.empty() || t.size() > 10 ||
+                t.find_first_not_of("0123456789") != std::string::npos)
+                throw Error("'" + name +
+                            "': expected gaussians:random:N[:SEED] with whole numbers");
             return std::stoull(t);
         };
         const auto n = number(count);
