@@ -102,7 +102,9 @@ TEST_CASE("3dgs: a lone Gaussian is the dilated EWA 2D Gaussian", "[gaussians]")
           Approx(0.7 * std::exp(-0.5 * (0.25 * C + 0.25 * A - 0.5 * B) / det)).epsilon(1e-5));
 }
 
-TEST_CASE("3dgs: the perspective centre pixel has alpha min(0.99, o)", "[gaussians]") {
+TEST_CASE("every renderer: the perspective centre pixel has alpha min(0.99, o)", "[gaussians]") {
+    // The volume model's c makes the optical depth through the projected centre
+    // -ln(1 - min(0.99, o)).
     for (float o : {0.6f, 1.0f}) {
         const GaussianScene s =
             one({0.3f, 0.2f, -0.1f}, {0.2f, 0.4f, 0.3f}, {1, 0.2f, 0.1f, 0.3f}, o, {1, 1, 1});
@@ -111,10 +113,14 @@ TEST_CASE("3dgs: the perspective centre pixel has alpha min(0.99, o)", "[gaussia
         cam.projection = Projection::Perspective;
         cam.azimuthDeg = 25;
         cam.elevationDeg = 15;
-        const Image img = renderGaussians(s, cam, with(GaussianRenderer::Rasterizer));
-        CHECK(img.at(32, 32).a == Approx(std::min(0.99f, o)).epsilon(1e-6));
-        CHECK(img.at(32, 32).r == Approx(std::min(0.99f, o)).epsilon(1e-6));
-        CHECK(img.at(0, 0).a == 0.0f);
+        for (GaussianRenderer r : {GaussianRenderer::Rasterizer, GaussianRenderer::PixelSorted,
+                                   GaussianRenderer::Sheet, GaussianRenderer::Reference}) {
+            INFO(gaussianRendererName(r) << ", opacity " << o);
+            const Image img = renderGaussians(s, cam, with(r));
+            CHECK(img.at(32, 32).a == Approx(std::min(0.99f, o)).epsilon(1e-6));
+            CHECK(img.at(32, 32).r == Approx(std::min(0.99f, o)).epsilon(1e-6));
+            CHECK(img.at(0, 0).a == 0.0f);
+        }
     }
 }
 

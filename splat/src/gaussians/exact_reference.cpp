@@ -34,9 +34,11 @@ class RayIntegral {
             t0_ = std::min(t0_, g.tStar - kErfReach / g.s);
             t1_ = std::max(t1_, g.tStar + kErfReach / g.s);
         }
+        t0_ = std::max(t0_, 0.0);  // the ray starts at the eye (or in front of the scene)
         perLength_ = tolerance / (t1_ - t0_);
     }
     glm::vec4 run() {
+        if (!(t1_ > t0_)) return out_.pixel();
         segment(t0_, t1_, at(t0_), at(t1_), 0);
         return out_.pixel();
     }

@@ -44,11 +44,14 @@ Image renderSlabs(const GaussianScene& scene, const Projected& p, const TileList
                 auto slabOf = [&](double t) {
                     return std::int64_t(std::floor((zo + t * cosine) / slab));
                 };
+                // The ray starts at t = 0 (the eye, or the plane in front of the scene).
+                const std::int64_t start = slabOf(0.0);
                 std::int64_t first = INT64_MAX, last = INT64_MIN;
                 for (const RayGaussian& g : gs) {
-                    first = std::min(first, slabOf(g.tStar - kErfReach / g.s));
+                    first = std::min(first, std::max(start, slabOf(g.tStar - kErfReach / g.s)));
                     last = std::max(last, slabOf(g.tStar + kErfReach / g.s));
                 }
+                if (last < first) continue;
                 if (last - first + 1 > kMaxSlabs) {
                     tooThin = true;
                     return;
@@ -58,9 +61,9 @@ Image renderSlabs(const GaussianScene& scene, const Projected& p, const TileList
                 emission.assign(count, glm::dvec3(0.0));
                 auto tOf = [&](std::int64_t k) { return (double(k) * slab - zo) / cosine; };
                 for (const RayGaussian& g : gs) {
-                    const std::int64_t k0 = slabOf(g.tStar - kErfReach / g.s);
+                    const std::int64_t k0 = std::max(start, slabOf(g.tStar - kErfReach / g.s));
                     const std::int64_t k1 = slabOf(g.tStar + kErfReach / g.s);
-                    double before = std::erf(g.s * (tOf(k0) - g.tStar));
+                    double before = std::erf(g.s * (std::max(0.0, tOf(k0)) - g.tStar));
                     for (std::int64_t k = k0; k <= k1; ++k) {
                         const double after = std::erf(g.s * (tOf(k + 1) - g.tStar));
                         const double d = g.amplitude * (after - before);
