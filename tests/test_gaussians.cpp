@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -190,4 +191,36 @@ TEST_CASE("Gaussian scenes: generator, bounds, geometry and colour", "[gaussians
     CHECK(isGaussianScene("a/b/scene.PLY"));
     CHECK(isGaussianScene("gaussians:pop"));
     CHECK(!isGaussianScene("synthetic:blob"));
+}
+
+TEST_CASE("CLI: Gaussian scenes in info, render and splat gaussians", "[gaussians][cli]") {
+    using splat::test::runProgram;
+    auto r = runProgram(SPLAT_EXE, {"info", "gaussians:pop"});
+    CHECK(r.status == 0);
+    CHECK(r.out.find("Gaussians: 2, SH degree 0") != std::string::npos);
+    CHECK(r.out.find("opacity:   0.8 .. 0.8") != std::string::npos);
+
+    const std::string png = tmpFile("pop.png");
+    r = runProgram(SPLAT_EXE, {"render", "gaussians:pop", "--renderer", "sheet", "--slab", "0.1",
+                               "--size", "32x32", "-o", png});
+    CHECK(r.status == 0);
+    CHECK(std::filesystem::file_size(png) > 0);
+
+    r = runProgram(SPLAT_EXE, {"render", "gaussians:pop", "--renderer", "axis", "-o", png});
+    CHECK(r.status == 2);
+    REQUIRE(r.errLines().size() == 1);
+    CHECK(r.errLines()[0].find("splat: error: unknown Gaussian renderer") == 0);
+
+    writePly(tmpFile("cli_ascii.ply"), "ascii", gaussianHeader(1, 0), {});
+    r = runProgram(SPLAT_EXE, {"info", tmpFile("cli_ascii.ply")});
+    CHECK(r.status == 1);
+    REQUIRE(r.errLines().size() == 1);
+    CHECK(r.errLines()[0].find("ASCII PLY") != std::string::npos);
+
+    const std::string ply = tmpFile("blob.ply");
+    r = runProgram(SPLAT_EXE, {"gaussians", "synthetic:blob:8", "-o", ply});
+    CHECK(r.status == 0);
+    const GaussianScene s = loadGaussians(ply);
+    CHECK(s.size() > 10);
+    CHECK(s.scales[0].x == Approx(0.65f));
 }
