@@ -149,4 +149,5 @@ PYBIND11_MODULE(_splat, m) {
     bindRender(m);
     bindImage(m);
     bindAnalysis(m);
+    bindGaussians(m);
 }

@@ -132,6 +132,7 @@ void bindTransfer(py::module_& m);
 void bindRender(py::module_& m);
 void bindImage(py::module_& m);
 void bindAnalysis(py::module_& m);
+void bindGaussians(py::module_& m);  // py_gaussians.cpp
 
 /// An H x W x 4 float32 array (premultiplied RGBA, row 0 on top) owning a copy of `image`'s
 /// pixels... moved: no copy.

@@ -4,6 +4,8 @@
 
 #include "commands.h"
 #include "diagnostics.h"
+#include "gaussian_scenes.h"
+#include "splat/gaussians.h"
 #include "scene_file.h"
 #include "volume_options.h"
 
@@ -20,6 +22,10 @@ void registerInfo(CLI::App& app) {
         "  splat info scan.raw --dims 256x256x128 --type uint16 --big-endian --spacing 1,1,2");
     cmd->callback([args, cmd] {
         prepareCommand(*cmd, {"volume"});
+        if (isGaussianScene(args->spec)) {
+            printGaussianInfo(args->spec);
+            return;
+        }
         loadOptionsFromArgs(*args);
         // A folder of several DICOM series: list them (one is chosen with --series UID).
         if (args->series.empty()) {

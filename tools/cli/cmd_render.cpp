@@ -5,11 +5,13 @@
 #include "bricked_render.h"
 #include "commands.h"
 #include "diagnostics.h"
+#include "gaussian_scenes.h"
 #include "parallel.h"
 #include "render_options.h"
 #include "scene_file.h"
 #include "splat/atomic_file.h"
 #include "splat/error.h"
+#include "splat/gaussians.h"
 #include "splat/image_io.h"
 #include "volume_options.h"
 
@@ -63,6 +65,12 @@ void registerRender(CLI::App& app) {
     cmd->callback([args, cmd] {
         prepareCommand(*cmd, {"volume", "output"});
         checkImageOutput(args->output);
+        if (isGaussianScene(args->volume.spec)) {
+            beginRun(*cmd);
+            renderGaussianFile(*cmd, args->render, args->volume.spec, args->output);
+            finishRun(*cmd);
+            return;
+        }
         RenderUse use;
         use.imageExt = lowerExtension(args->output);
         RenderSettings settings = settingsFromArgs(args->render, use);

@@ -20,6 +20,7 @@ void registerMpr(CLI::App& app);         // cmd_mpr.cpp
 void registerCpr(CLI::App& app);         // cmd_cpr.cpp
 void registerIso(CLI::App& app);         // cmd_iso.cpp
 void registerCompletion(CLI::App& app);  // cmd_completion.cpp (hidden)
+void registerGaussians(CLI::App& app);   // cmd_gaussians.cpp
 
 /// The command line as typed (for reports that say how to reproduce them).
 const std::string& commandLine();

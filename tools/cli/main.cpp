@@ -66,6 +66,7 @@ int runCommand(int argc, char** argv) {
     registerIso(app);
     registerMpr(app);
     registerCpr(app);
+    registerGaussians(app);
     registerCompletion(app);
     setCommandLine(argc, argv);
     if (argc < 2) {

@@ -12,7 +12,10 @@
 // RMS is over all pixels and the RGB channels of the images composited over the background.
 // An event is an interval whose detection signal (J_X with a reference, else C for the
 // axis-aligned splatter and T_X otherwise) exceeds the sweep's robust threshold
-// max(median + k * MAD, floor * median), MAD scaled to a standard deviation (x 1.4826).
+// max(median + k * MAD, floor * median, precision * peak), MAD scaled to a standard deviation
+// (x 1.4826), peak the largest pixel value (RGB) of the sweep's frames: on a smooth scene the
+// median is itself at rounding level, and the precision floor keeps rounding from being
+// called an event.
 // Events are refined by bisection: a renderer pops at theta* when its change stays bounded
 // away from zero as the interval shrinks, while a continuous renderer's change falls about
 // linearly with it (fitted slope ~1 on log-log axes). Flicker is fast but continuous
@@ -44,8 +47,13 @@ struct Sweep {
 struct PoppingOptions {
     std::vector<RendererKind> renderers{RendererKind::Axis, RendererKind::Sheet,
                                         RendererKind::Reference};
-    double madK = 5.0;            ///< event threshold: median + madK * MAD ...
-    double floorRatio = 2.0;      ///< ... and at least floorRatio * median
+    double madK = 5.0;        ///< event threshold: median + madK * MAD ...
+    double floorRatio = 2.0;  ///< ... and at least floorRatio * median
+    /// ... and above precisionFloor times the sweep's peak pixel value: 1e-6 is about 8 float
+    /// ulps (FLT_EPSILON = 1.2e-7) of the peak, above the rounding of a frame's float sums,
+    /// and below the smallest visible change (one pixel moving one 8-bit step in a 1024 x
+    /// 1024 image is an RMS of 3.8e-6). 0 disables it.
+    double precisionFloor = 1e-6;
     int refine = 10;              ///< bisection levels around each event (0: none)
     double pixelsPerDegree = 67;  ///< LDR-FLIP viewing condition
     bool flip = true;             ///< compute the perceptual columns

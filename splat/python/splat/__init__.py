@@ -19,19 +19,20 @@ import warnings
 import numpy as np
 
 from . import _splat
-from ._splat import (Cancelled, Error, FileError, InputError, Mesh, PoppingResult,
+from ._splat import (Cancelled, Error, FileError, Gaussians, InputError, Mesh, PoppingResult,
                      StudyResult, TransferFunction, Volume, default_window, flip_map,
-                     iso_surface, list_dicom_series, read_image, study_knobs, synthetic_names,
-                     write_heatmap, write_image)
+                     iso_surface, list_dicom_series, load_gaussians, read_image,
+                     render_gaussians, study_knobs, synthetic_names, write_heatmap, write_image)
 
 __version__ = _splat.__version__
 
 __all__ = [
-    "Cancelled", "Error", "FileError", "InputError", "Mesh", "PoppingResult", "Scene",
-    "StudyResult", "TransferFunction", "Volume", "compare", "default_window", "flip_map",
-    "from_nibabel", "iso_surface", "list_dicom_series", "load", "load_options", "popping",
-    "read_image", "render", "render_options", "rotate", "study", "study_knobs", "synthetic",
-    "synthetic_names", "write_heatmap", "write_image",
+    "Cancelled", "Error", "FileError", "Gaussians", "InputError", "Mesh", "PoppingResult",
+    "Scene", "StudyResult", "TransferFunction", "Volume", "compare", "default_window",
+    "flip_map", "from_nibabel", "iso_surface", "list_dicom_series", "load", "load_gaussians",
+    "load_options", "popping", "read_image", "render", "render_gaussians", "render_options",
+    "rotate", "study", "study_knobs", "synthetic", "synthetic_names", "write_heatmap",
+    "write_image",
 ]
 
 # Options taking "WxH" / "XxYxZ" text; every other sequence is joined with commas.

@@ -532,6 +532,48 @@ class Mesh:
     def max_residual(self) -> float: ...
     def write(self, path: str) -> None: ...
 
+class Gaussians:
+    def __init__(
+        self,
+        means: NDArray[np.float32],
+        scales: NDArray[np.float32],
+        rotations: NDArray[np.float32],
+        opacities: NDArray[np.float32],
+        sh: NDArray[np.float32],
+    ) -> None: ...
+    @property
+    def sh_degree(self) -> int: ...
+    @property
+    def source(self) -> str: ...
+    @property
+    def means(self) -> NDArray[np.float32]: ...
+    @property
+    def scales(self) -> NDArray[np.float32]: ...
+    @property
+    def rotations(self) -> NDArray[np.float32]: ...
+    @property
+    def opacities(self) -> NDArray[np.float32]: ...
+    @property
+    def sh(self) -> NDArray[np.float32]: ...
+    def write(self, path: str) -> None: ...
+
+def load_gaussians(path: str) -> Gaussians: ...
+def render_gaussians(
+    scene: Gaussians,
+    *,
+    renderer: str = ...,
+    width: int = ...,
+    height: int = ...,
+    azimuth: float = ...,
+    elevation: float = ...,
+    projection: str = ...,
+    pixel_size: float = ...,
+    fov: float = ...,
+    slab: float = ...,
+    ref_tolerance: float = ...,
+    threads: int = ...,
+) -> NDArray[np.float32]: ...
+
 def iso_surface(
     volume: Volume,
     level: float,

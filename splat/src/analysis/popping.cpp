@@ -89,8 +89,8 @@ class Analyzer {
         ref_ = indexOf(RendererKind::Reference);
         axis_ = indexOf(RendererKind::Axis);
         sheet_ = indexOf(RendererKind::Sheet);
-        if (!(options.madK >= 0) || !(options.floorRatio >= 0))
-            throw Error("popping: the event threshold's k and floor must be >= 0");
+        if (!(options.madK >= 0) || !(options.floorRatio >= 0) || !(options.precisionFloor >= 0))
+            throw Error("popping: the event threshold's k and floors must be >= 0");
         if (options.refine < 0 || options.refine > 40)
             throw Error("popping: --refine must be between 0 and 40 levels");
         std::vector<CameraParams> views;
@@ -142,8 +142,13 @@ class Analyzer {
         so.skip = [&](std::size_t v) { return bool(journaled[v]); };
         View prev;
         std::size_t next = 0;
+        double peak = 0;  // the largest pixel value (RGB) of the sweep's frames
         auto consume = [&](std::size_t v, View cur) {
             if (v == 0) setWindow(cur);
+            for (const Image& im : cur.images)
+                for (const glm::vec4& p : im.pixels)
+                    peak = std::max({peak, double(std::abs(p.r)), double(std::abs(p.g)),
+                                     double(std::abs(p.b))});
             measureView(r, v, cur, prev, frameMs);
             prev = std::move(cur);
             next = v + 1;
@@ -172,7 +177,8 @@ class Analyzer {
             s.medianT = median(s.T);
             s.signal = signalOf(r, k);
             s.medianSignal = median(s.signal);
-            s.threshold = robustThreshold(s.signal, options_.madK, options_.floorRatio);
+            s.threshold = std::max(robustThreshold(s.signal, options_.madK, options_.floorRatio),
+                                   options_.precisionFloor * peak);
             const double mx = *std::max_element(s.signal.begin(), s.signal.end());
             s.spikeRatio = s.medianSignal > 0 ? mx / s.medianSignal : (mx > 0 ? INFINITY : 1.0);
         }

@@ -260,6 +260,7 @@ json optionsJson(const PoppingOptions& o) {
     json j;
     j["mad_k"] = o.madK;
     j["floor_ratio"] = o.floorRatio;
+    j["precision_floor"] = o.precisionFloor;
     j["refine"] = o.refine;
     j["pixels_per_degree"] = o.pixelsPerDegree;
     j["flip"] = o.flip;
