@@ -54,8 +54,9 @@ glm::dvec3 parseSpacing(const std::string& s) {
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
     const std::string g = "Volume";
     addOption(cmd, "VOLUME", args.spec,
-              "volume file (.nii .nii.gz .nrrd .nhdr .mhd .mha .raw), folder of slices or DICOM "
-              "files, or synthetic:NAME[:N] (phantom, ct-phantom, blob, cube, sphere, marschner-lobb)",
+              "volume file (.nii .nii.gz .nrrd .nhdr .mhd .mha .raw .vdb), folder of slices or "
+              "DICOM files, OME-Zarr folder, or synthetic:NAME[:N] (phantom, ct-phantom, blob, "
+              "cube, sphere, marschner-lobb)",
               g, PathKind::Input);
     addOption(cmd, "--dims", args.dims, "raw data: dimensions XxYxZ, e.g. 256x256x128", g);
     addOption(cmd, "--type", args.type,
@@ -76,6 +77,17 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
               "the field's value where nothing is (b; e.g. -1000 for CT in HU): a number, or "
               "'auto' for the median of the outer faces (default: from the file, else auto)",
               g);
+    addOption(cmd, "--grid", args.grid,
+              "OpenVDB: the grid to load (default: 'density', else the first float or double "
+              "grid; `splat info FILE.vdb` lists them)",
+              g);
+    addOption(cmd, "--zarr-level", args.level,
+              "OME-Zarr: the resolution level, 0 the finest (default 0; `splat info` lists them)",
+              g)
+        ->check(CLI::NonNegativeNumber);
+    addOption(cmd, "--channel", args.channel,
+              "OME-Zarr: the channel of a 4D or 5D image (default 0)", g)
+        ->check(CLI::NonNegativeNumber);
 }
 
 LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
@@ -88,6 +100,9 @@ LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
         options.raw.headerBytes = args.headerBytes;
         options.allowOutsideDataFiles = args.allowOutsideData;
         options.dicomSeries = args.series;
+        options.grid = args.grid;
+        if (args.level >= 0) options.level = args.level;
+        if (args.channel >= 0) options.channel = args.channel;
         if (args.nanPolicy == "error")
             options.nonFinite = NonFinitePolicy::Error;
         else if (args.nanPolicy == "zero")
