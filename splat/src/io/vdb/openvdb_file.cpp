@@ -239,6 +239,13 @@ Chosen choose(const VdbFile& f, const LoadOptions& options, openvdb::GridBase::P
         c.meta = whole;
     }
     c.geometry = geometry(f.name, *c.meta, c.box, active);
+    if (!grid) {
+        // The metadata hold no tree, and so no background: read the grid clipped to one
+        // voxel's world box (the root node, which holds the background, and a leaf at most).
+        const glm::dvec3 w = c.geometry.world(glm::dvec3(0.0));
+        const openvdb::BBoxd one(openvdb::Vec3d(w.x, w.y, w.z), openvdb::Vec3d(w.x, w.y, w.z));
+        c.meta = f.guard([&] { return f.file->readGrid(c.meta->getName(), one); });
+    }
     c.geometry.background = float(background(*c.meta));
     c.geometry.backgroundSource = "OpenVDB grid background";
     return c;
