@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <sstream>
 
@@ -49,6 +50,15 @@ glm::dvec3 parseSpacing(const std::string& s) {
     return {v[0], v[1], v[2]};
 }
 
+// A level or channel number: an integer 0 .. 2^31-1.
+int parseIndex(const std::string& s, const std::string& flag) {
+    char* end = nullptr;
+    const long long v = std::strtoll(s.c_str(), &end, 10);
+    if (s.empty() || *end || v < 0 || v > 2147483647LL)
+        throw Error(flag + " '" + s + "': expected an integer >= 0");
+    return int(v);
+}
+
 }  // namespace
 
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
@@ -83,11 +93,9 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
               g);
     addOption(cmd, "--zarr-level", args.level,
               "OME-Zarr: the resolution level, 0 the finest (default 0; `splat info` lists them)",
-              g)
-        ->check(CLI::NonNegativeNumber);
+              g);
     addOption(cmd, "--channel", args.channel,
-              "OME-Zarr: the channel of a 4D or 5D image (default 0)", g)
-        ->check(CLI::NonNegativeNumber);
+              "OME-Zarr: the channel of a 4D or 5D image (default 0)", g);
 }
 
 LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
@@ -101,8 +109,8 @@ LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
         options.allowOutsideDataFiles = args.allowOutsideData;
         options.dicomSeries = args.series;
         options.grid = args.grid;
-        if (args.level >= 0) options.level = args.level;
-        if (args.channel >= 0) options.channel = args.channel;
+        if (!args.level.empty()) options.level = parseIndex(args.level, "--zarr-level");
+        if (!args.channel.empty()) options.channel = parseIndex(args.channel, "--channel");
         if (args.nanPolicy == "error")
             options.nonFinite = NonFinitePolicy::Error;
         else if (args.nanPolicy == "zero")

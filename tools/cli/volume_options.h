@@ -17,7 +17,7 @@ struct VolumeArgs {
     std::string series;               // DICOM SeriesInstanceUID
     std::string backgroundValue;      // b: a number, "auto" (the faces rule) or "" (the loader's)
     std::string grid;                 // OpenVDB: the grid's name
-    int level = -1, channel = -1;     // OME-Zarr: resolution level and channel (-1: unset)
+    std::string level, channel;       // OME-Zarr: resolution level and channel ("": unset)
 };
 
 /// Adds VOLUME and --dims/--type/--spacing/--big-endian/--header-bytes/--nan-policy/
