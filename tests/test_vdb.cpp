@@ -2,7 +2,7 @@
 // (tests/sparse/make_sparse_data.py): a grid equals the NIfTI nibabel wrote of the same
 // samples (inactive voxels hold the background, which becomes b); grids are chosen by name
 // or by the default rule; active tiles fill their boxes; a turned transform, a vector grid,
-// a truncated or foreign file give one line; bricks read alone equal crops. Skipped with a
+// a truncated, damaged or foreign file give one line; bricks read alone equal crops. Skipped with a
 // message when splat is built without OpenVDB (SPLAT_OPENVDB), except for the line that
 // says so.
 #include <catch2/catch.hpp>
@@ -136,6 +136,23 @@ TEST_CASE("vdb: truncated and foreign files are one line", "[vdb][errors]") {
         std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(keep));
         const std::string e = loadError(p.string());
         CHECK(e.find("cut.vdb") != std::string::npos);
+        CHECK(e.find('\n') == std::string::npos);
+    }
+    // Bytes changed inside the tree: OpenVDB aborts on the first (a leaf's header, byte
+    // 9311 of this file), throws on the second; the child process that reads the file first
+    // turns the abort into one line (parse_in_child.h).
+    for (const auto& [at, value] : {std::pair<std::size_t, char>{9311, char(0x9b)},
+                                    std::pair<std::size_t, char>{15736, char(0x11)}}) {
+        INFO("byte " << at);
+        REQUIRE(at < bytes.size());
+        std::string changed = bytes;
+        changed[at] = value;
+        const fs::path p = tmp / "changed.vdb";
+        std::ofstream(p, std::ios::binary).write(changed.data(), std::streamsize(changed.size()));
+        const std::string e = loadError(p.string());
+        CHECK(e.find("changed.vdb: ") != std::string::npos);
+        CHECK((e.find("malformed OpenVDB file") != std::string::npos ||
+               e.find("not a readable OpenVDB file") != std::string::npos));
         CHECK(e.find('\n') == std::string::npos);
     }
     const fs::path foreign = tmp / "text.vdb";

@@ -19,12 +19,14 @@ import sys
 here = os.path.dirname(os.path.abspath(__file__))
 make = os.path.join(here, "..", "..", "tests", "sparse", "make_sparse_data.py")
 
+argv = sys.argv[1:]
+flags = argv[argv.index("--") + 1:] if "--" in argv else []
+argv = argv[:argv.index("--")] if "--" in argv else argv
 ap = argparse.ArgumentParser()
 ap.add_argument("splat")
 ap.add_argument("--sizes", default="128,256,512,1024")
 ap.add_argument("--dir", default="/tmp/splat_sparse_bench")
-ap.add_argument("flags", nargs="*")
-a = ap.parse_args()
+a = ap.parse_args(argv)
 os.makedirs(a.dir, exist_ok=True)
 
 print(f"{'N':>6} {'active':>10} {'box':>12} {'seconds':>8} {'peak MiB':>9}")
@@ -38,7 +40,7 @@ for n in [int(s) for s in a.sizes.split(",")]:
     active = int(m.group(1)) if m else -1
     out = os.path.join(a.dir, f"shell_{n}.png")
     r = subprocess.run(["nice", "-n", "10", "/usr/bin/time", "-v", a.splat, "render", shell,
-                        "--mode", "mip", "--size", "256x256", "-o", out] + a.flags,
+                        "--mode", "mip", "--size", "256x256", "-o", out] + flags,
                        capture_output=True, text=True)
     if r.returncode != 0:
         print(f"{n:>6} {active:>10} {n ** 3:>12}   failed: {r.stderr.strip().splitlines()[-1:]}")

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "../parse_in_child.h"
 #include "../volume_detail.h"
 #include "splat/error.h"
 #include "splat/sparse_files.h"
@@ -51,6 +52,10 @@ Volume loadVdbBrick(const fs::path& p, const LoadOptions&, const glm::ivec3&, co
 namespace splat {
 namespace {
 
+bool scalarGrid(const openvdb::GridBase& g) {
+    return g.isType<openvdb::FloatGrid>() || g.isType<openvdb::DoubleGrid>();
+}
+
 /// Runs `f`, turning OpenVDB's exceptions into one splat::Error line about `name`.
 template <typename F>
 auto guarded(const std::string& name, F&& f) {
@@ -72,6 +77,15 @@ struct VdbFile {
         static std::once_flag once;
         std::call_once(once, [] { openvdb::initialize(); });
         detail::regularFileSize(p);
+        // OpenVDB can corrupt the heap or abort on a damaged tree (a byte changed in a leaf's
+        // header): every float and double grid is read once in a child process first.
+        detail::parseInChild(name, "OpenVDB", "OpenVDB", [&] {
+            openvdb::io::File file(p.string());
+            file.open(false);
+            const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
+            for (const auto& g : *grids)
+                if (scalarGrid(*g)) file.readGrid(g->getName());
+        });
         guarded(name, [&] {
             file = std::make_unique<openvdb::io::File>(p.string());
             file->open(false);  // read grids whole when asked, no delayed loading
@@ -85,10 +99,6 @@ struct VdbFile {
         return guarded(name, std::forward<F>(f));
     }
 };
-
-bool scalarGrid(const openvdb::GridBase& g) {
-    return g.isType<openvdb::FloatGrid>() || g.isType<openvdb::DoubleGrid>();
-}
 
 /// The grid LoadOptions::grid names (metadata only), or the default.
 openvdb::GridBase::ConstPtr chooseGrid(const VdbFile& f, const std::string& wanted) {
