@@ -29,11 +29,12 @@ inline std::optional<std::filesystem::path> sparseData() {
 }  // namespace splat::test
 
 /// Skips the rest of a test case (with a message) when the data cannot be written.
-#define SPARSE_DATA_OR_SKIP(var)                                                           \
-    const auto var##_dir = splat::test::sparseData();                                      \
-    if (!var##_dir) {                                                                      \
-        WARN("python3-openvdb, python3-zarr or python3-nibabel missing (tools/setup.sh): " \
-             "skipped");                                                                   \
-        return;                                                                            \
-    }                                                                                      \
+#define SPARSE_DATA_OR_SKIP(var)                                                          \
+    const auto var##_dir = splat::test::sparseData();                                     \
+    if (!var##_dir) {                                                                     \
+        WARN(                                                                             \
+            "python3-openvdb, python3-zarr or python3-nibabel missing (tools/setup.sh): " \
+            "skipped");                                                                   \
+        return;                                                                           \
+    }                                                                                     \
     const std::filesystem::path var = *var##_dir

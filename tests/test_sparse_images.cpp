@@ -3,8 +3,8 @@
 // OME-Zarr image whose background chunks are not stored) — with the same geometry and a
 // background value of 3, render the same image in every renderer and mode: max abs
 // difference <= 1e-5 of the image's peak (tests/sparse/make_sparse_data.py).
-#include <catch2/catch.hpp>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 
 #include "sparse_util.h"

@@ -38,11 +38,12 @@ float small(int i, int j, int k) { return float((i * 30 + j * 6 + k) % 7 + 1); }
 
 }  // namespace
 
-#define OPENVDB_OR_SKIP()                                                               \
-    if (!openVdbAvailable()) {                                                          \
-        WARN("splat is built without OpenVDB (SPLAT_OPENVDB; Debian: libopenvdb-dev): " \
-             "skipped");                                                                \
-        return;                                                                         \
+#define OPENVDB_OR_SKIP()                                                              \
+    if (!openVdbAvailable()) {                                                         \
+        WARN(                                                                          \
+            "splat is built without OpenVDB (SPLAT_OPENVDB; Debian: libopenvdb-dev): " \
+            "skipped");                                                                \
+        return;                                                                        \
     }
 
 TEST_CASE("vdb: without OpenVDB a .vdb file is one line", "[vdb]") {

@@ -216,8 +216,7 @@ TEST_CASE("zarr: bad files give one line", "[zarr][errors]") {
         {"structured.zarr", "\"<u2\"", "[[\"a\", \"<u2\"]]", "structured dtype"},
         {"lz4.zarr", "\"compressor\": null", "\"compressor\": {\"id\": \"lz4\"}",
          "compressor 'lz4' is not supported"},
-        {"filters.zarr", "\"filters\": null", "\"filters\": [{\"id\": \"delta\"}]",
-         "filters"},
+        {"filters.zarr", "\"filters\": null", "\"filters\": [{\"id\": \"delta\"}]", "filters"},
         {"huge.zarr", "\"chunks\": [\n        3,", "\"chunks\": [\n        300000000,",
          "larger than splat reads"},
         {"v3.zarr", "\"zarr_format\": 2", "\"zarr_format\": 3", "zarr_format is not 2"},
@@ -287,15 +286,15 @@ TEST_CASE("zarr: splat info lists the levels; a bad image is one error line", "[
     CHECK(r.out.find("OME-Zarr:    axes zyx, 1 time point, 1 channel, 2 levels") !=
           std::string::npos);
     CHECK(r.out.find("level 1 '1': 10 x 9 x 7, spacing 1.5 x 2.25 x 2.5") != std::string::npos);
-    const RunResult l = runProgram(SPLAT_EXE, {"info", (data / "same.zarr").string(), "--zarr-level",
-                                               "1"});
+    const RunResult l =
+        runProgram(SPLAT_EXE, {"info", (data / "same.zarr").string(), "--zarr-level", "1"});
     CHECK(l.status == 0);
     CHECK(l.out.find("10 x 9 x 7") != std::string::npos);
     const fs::path tmp = testTmpDir("zarr_cli");
     const fs::path bad = copyFolder(data / "dtypes" / "u1_le_none.zarr", tmp / "bad.zarr");
     fs::resize_file(bad / "1.0.2", 3);
-    const RunResult e = runProgram(SPLAT_EXE, {"render", bad.string(), "-o",
-                                               (tmp / "x.png").string()});
+    const RunResult e =
+        runProgram(SPLAT_EXE, {"render", bad.string(), "-o", (tmp / "x.png").string()});
     CHECK(e.status == 1);
     REQUIRE(e.errLines().size() == 1);
     CHECK(e.errLines()[0].rfind("splat: error: ", 0) == 0);

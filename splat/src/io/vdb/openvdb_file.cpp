@@ -194,8 +194,7 @@ void fillActive(const GridT& grid, const openvdb::Coord& lo, Volume& v) {
     for (auto it = grid.cbeginValueOn(); it; ++it) {
         if (it.isVoxelValue()) {
             const openvdb::Coord c = it.getCoord();
-            if (box.isInside(c))
-                v.at(c.x() - lo.x(), c.y() - lo.y(), c.z() - lo.z()) = float(*it);
+            if (box.isInside(c)) v.at(c.x() - lo.x(), c.y() - lo.y(), c.z() - lo.z()) = float(*it);
             continue;
         }
         openvdb::CoordBBox tile;
@@ -238,8 +237,8 @@ Chosen choose(const VdbFile& f, const LoadOptions& options, openvdb::GridBase::P
     Chosen c;
     c.meta = chooseGrid(f, options.grid);
     std::uint64_t active = 0;
-    if (const auto n = c.meta->getMetadata<openvdb::Int64Metadata>(
-            openvdb::GridBase::META_FILE_VOXEL_COUNT))
+    if (const auto n =
+            c.meta->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
         active = std::uint64_t(n->value());
     if (grid || !fileBBox(*c.meta, c.box)) {
         openvdb::GridBase::Ptr whole = f.guard([&] { return f.file->readGrid(c.meta->getName()); });

@@ -29,7 +29,7 @@ struct Level {
 /// An image: its axes and levels, checked to agree.
 struct Image {
     std::string name;
-    std::string axes;         ///< one letter per array axis: t, c, z, y, x (or '?')
+    std::string axes;  ///< one letter per array axis: t, c, z, y, x (or '?')
     int time = -1, channel = -1;
     int space[3] = {-1, -1, -1};  ///< the array axes of x, y, z (z: -1 for a 2D image)
     std::vector<Level> levels;
@@ -91,8 +91,8 @@ void applyTransforms(const json& list, const std::string& what, std::vector<doub
                 translation[d] *= s[d];
             }
         } else if (type == "translation") {
-            const auto s = numbers(t.value("translation", json()), what + ": translation",
-                                   translation.size());
+            const auto s =
+                numbers(t.value("translation", json()), what + ": translation", translation.size());
             for (std::size_t d = 0; d < s.size(); ++d) translation[d] += s[d];
         } else {
             throw Error(what + ": coordinate transformation '" + type +
@@ -239,8 +239,7 @@ Image readImage(const fs::path& given) {
             if (ds["path"] == L.path)
                 applyTransforms(ds.value("coordinateTransformations", json()),
                                 name + ": level '" + L.path + "'", L.scale, L.translation);
-        applyTransforms(m.value("coordinateTransformations", json()), name, L.scale,
-                        L.translation);
+        applyTransforms(m.value("coordinateTransformations", json()), name, L.scale, L.translation);
         for (std::size_t d = 0; d < n; ++d)
             if (!(L.scale[d] > 0))
                 throw Error(name + ": level '" + L.path + "' has scale " +
@@ -267,8 +266,8 @@ int pick(const std::optional<int>& given, int count, const std::string& what,
         return *given;
     }
     if (count > 1 && notes)
-        notes->push_back("OME-Zarr image of " + std::to_string(count) + " " + knob +
-                         "s: loaded " + knob + " 0");
+        notes->push_back("OME-Zarr image of " + std::to_string(count) + " " + knob + "s: loaded " +
+                         knob + " 0");
     return 0;
 }
 

@@ -47,8 +47,7 @@ void parseDtype(Array& a, const json& dt) {
                     : a.kind == 'b'                  ? n == 1
                                                      : false;
     if (!ok)
-        throw bad(
-            "splat reads int8 to int64, uint8 to uint64, float32, float64 and bool samples");
+        throw bad("splat reads int8 to int64, uint8 to uint64, float32, float64 and bool samples");
     a.itemBytes = n;
 }
 
@@ -164,8 +163,8 @@ std::vector<unsigned char> readChunk(const Array& a, const fs::path& p, std::uin
             throw Error(what + ": corrupt blosc data (invalid header or truncated)");
         if (nbytes != bytes)
             throw Error(what + ": chunk decompresses to " + std::to_string(nbytes) +
-                        " bytes, expected " + std::to_string(bytes) + " (chunk shape x " +
-                        a.dtype + ")");
+                        " bytes, expected " + std::to_string(bytes) + " (chunk shape x " + a.dtype +
+                        ")");
         out.resize(std::size_t(bytes));
         const int got = blosc_decompress_ctx(packed.data(), out.data(), out.size(), 1);
         if (got < 0 || std::uint64_t(got) != bytes)
@@ -205,8 +204,7 @@ Array readArray(const fs::path& dir, const std::string& name) {
     {
         const std::vector<unsigned char> text = readFileBytes(meta);
         j = json::parse(text.begin(), text.end(), nullptr, false);
-        if (j.is_discarded() || !j.is_object())
-            throw Error(displayName(meta) + ": not valid JSON");
+        if (j.is_discarded() || !j.is_object()) throw Error(displayName(meta) + ": not valid JSON");
     }
     if (!j.contains("zarr_format") || j["zarr_format"] != 2)
         throw Error(displayName(meta) + ": zarr_format is not 2 (splat reads Zarr v2 arrays)");

@@ -18,9 +18,9 @@ struct Array {
     std::filesystem::path dir;  ///< the folder holding `.zarray` and the chunk files
     std::string name;           ///< its name in messages
     std::vector<std::int64_t> shape, chunks;
-    std::string dtype;     ///< as written, e.g. "<u2"
-    char kind = 'u';       ///< 'i', 'u', 'f' or 'b'
-    int itemBytes = 1;     ///< 1, 2, 4 or 8
+    std::string dtype;  ///< as written, e.g. "<u2"
+    char kind = 'u';    ///< 'i', 'u', 'f' or 'b'
+    int itemBytes = 1;  ///< 1, 2, 4 or 8
     bool bigEndian = false;
     bool fortran = false;  ///< "order": "F"
     char separator = '.';  ///< dimension_separator: '.' or '/'
