@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "sparse_util.h"
+#include "splat/bricks.h"
 #include "splat/render.h"
 #include "splat/sparse_files.h"
 #include "splat/volume_io.h"
@@ -72,4 +73,40 @@ TEST_CASE("sparse files: NIfTI, OpenVDB and OME-Zarr of the same data render the
                     CHECK(maxAbsDiff(render(*v, s), ref) <= 1e-5 * top);
                 }
             }
+}
+
+TEST_CASE("sparse files: bricks read alone from VDB and OME-Zarr render the NIfTI's bricked image",
+          "[vdb][zarr][images][bricks]") {
+    SPARSE_DATA_OR_SKIP(data);
+    std::vector<std::string> files = {"same.nii.gz", "same.zarr"};
+    if (openVdbAvailable()) files.push_back("same.vdb");
+    RenderSettings s;
+    s.renderer = RendererKind::Axis;
+    s.mode = RenderMode::Dvr;
+    s.camera.width = s.camera.height = 32;
+    s.camera.azimuthDeg = 35;
+    s.camera.elevationDeg = 20;
+    s.threads = 2;
+    std::vector<Image> images;
+    for (const std::string& name : files) {
+        const std::string spec = (data / name).string();
+        const Volume g = volumeGeometry(spec, LoadOptions{}, nullptr);
+        LocalBrickGroup group;
+        BrickStats stats;
+        images.push_back(renderBricked(
+            g,
+            [&](const Brick& b) {
+                Volume v = loadVolumeBrick(spec, LoadOptions{}, b.loadLo, b.loadHi);
+                v.background = g.background;
+                return v;
+            },
+            s, 3, group, &stats));
+        CHECK(stats.bricks == 3);
+    }
+    const double top = peak(images[0]);
+    REQUIRE(top > 0);
+    for (std::size_t n = 1; n < images.size(); ++n) {
+        INFO(files[n]);
+        CHECK(maxAbsDiff(images[n], images[0]) <= 1e-5 * top);
+    }
 }
