@@ -14,7 +14,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-targets_all=(nifti nifti_gz nrrd metaimage raw dicom transfer)
+targets_all=(nifti nifti_gz nrrd metaimage raw dicom transfer zarr vdb)
 smoke=0
 seconds=600
 if [[ "${1:-}" == "--smoke" ]]; then
@@ -26,6 +26,7 @@ elif [[ "${1:-}" =~ ^[0-9]+$ ]]; then
   shift
 fi
 targets=("$@")
+explicit=${#targets[@]}
 [[ ${#targets[@]} -eq 0 ]] && targets=("${targets_all[@]}")
 jobs="${SPLAT_FUZZ_JOBS:-2}"
 
@@ -80,6 +81,20 @@ for f in "$nib"/tests/data/*.nii.gz; do
   [[ -f $f ]] && gzip -dc "$f" >"$seeds/nifti_gz/third_$(basename "$f" .gz)" && third=$((third + 1))
 done
 [[ $third -gt 0 ]] && echo "fuzz.sh: $third third-party seed files (nibabel, pydicom)"
+# Zarr and OpenVDB seeds written by the formats' own Python libraries (the readers' test
+# data): each Zarr array as its .zarray, the data marker and its chunk 0.0.0 (fuzz_zarr.cpp).
+mkdir -p "$seeds/zarr" "$seeds/vdb"
+if /usr/bin/python3 tests/sparse/make_sparse_data.py "$build/sparse_data" >/dev/null 2>&1; then
+  for a in "$build"/sparse_data/dtypes/*.zarr; do
+    [[ -f $a/0.0.0 ]] || continue
+    { cat "$a/.zarray"; printf '\n@@DATA@@\n'; cat "$a/0.0.0"; } >"$seeds/zarr/$(basename "$a")"
+  done
+  cp "$build"/sparse_data/*.vdb "$seeds/vdb/"
+else
+  echo "fuzz.sh: python3-zarr or python3-openvdb missing: fuzz_zarr and fuzz_vdb start unseeded" >&2
+  printf '{"zarr_format": 2}' >"$seeds/zarr/empty"
+  printf 'x' >"$seeds/vdb/empty"
+fi
 mkdir -p "$build/corpus" "$build/findings" "$build/logs"
 
 # -malloc_limit_mb: no input may make a loader allocate more than 512 MB (every seed and
@@ -97,6 +112,10 @@ status=0
 pids=()
 names=()
 for t in "${targets[@]}"; do
+  if [[ ! -x "$build/tests/fuzz/fuzz_$t" && $t == vdb && $explicit == 0 ]]; then
+    echo "fuzz.sh: fuzz_vdb skipped: splat is built without OpenVDB (SPLAT_OPENVDB)" >&2
+    continue
+  fi
   if [[ ! -x "$build/tests/fuzz/fuzz_$t" ]]; then
     echo "fuzz.sh: no target fuzz_$t (known: ${targets_all[*]})" >&2
     exit 2

@@ -8,6 +8,8 @@ packages=(build-essential cmake pkg-config libglm-dev libopenimageio-dev openima
           xvfb xauth  # xvfb, xauth: tools/bench/vs_vtk.py runs VTK without a display
           python3 python3-nibabel python3-pydicom teem-apps libbz2-dev  # tests: faults, third-party files and oracles
           libopenmpi-dev openmpi-bin  # splat::mpi (docs/parallel.md)
+          libblosc-dev libopenvdb-dev  # OME-Zarr blosc chunks; OpenVDB files (optional: SPLAT_OPENVDB)
+          python3-openvdb python3-zarr python3-numcodecs  # tests: VDB and Zarr files written by their own libraries
           pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib)  # the Python module (docs/python.md)
 # SPLAT_WITH_ICET=1 also installs ParaView's IceT for splat::mpi's optional IceT compositor
 # (docs/building.md; Debian ships IceT only inside ParaView: paraview-dev, ~100 MB to

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <sstream>
 
@@ -49,13 +50,23 @@ glm::dvec3 parseSpacing(const std::string& s) {
     return {v[0], v[1], v[2]};
 }
 
+// A level or channel number: an integer 0 .. 2^31-1.
+int parseIndex(const std::string& s, const std::string& flag) {
+    char* end = nullptr;
+    const long long v = std::strtoll(s.c_str(), &end, 10);
+    if (s.empty() || *end || v < 0 || v > 2147483647LL)
+        throw Error(flag + " '" + s + "': expected an integer >= 0");
+    return int(v);
+}
+
 }  // namespace
 
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
     const std::string g = "Volume";
     addOption(cmd, "VOLUME", args.spec,
-              "volume file (.nii .nii.gz .nrrd .nhdr .mhd .mha .raw), folder of slices or DICOM "
-              "files, or synthetic:NAME[:N] (phantom, ct-phantom, blob, cube, sphere, marschner-lobb)",
+              "volume file (.nii .nii.gz .nrrd .nhdr .mhd .mha .raw .vdb), folder of slices or "
+              "DICOM files, OME-Zarr folder, or synthetic:NAME[:N] (phantom, ct-phantom, blob, "
+              "cube, sphere, marschner-lobb)",
               g, PathKind::Input);
     addOption(cmd, "--dims", args.dims, "raw data: dimensions XxYxZ, e.g. 256x256x128", g);
     addOption(cmd, "--type", args.type,
@@ -76,6 +87,15 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
               "the field's value where nothing is (b; e.g. -1000 for CT in HU): a number, or "
               "'auto' for the median of the outer faces (default: from the file, else auto)",
               g);
+    addOption(cmd, "--grid", args.grid,
+              "OpenVDB: the grid to load (default: 'density', else the first float or double "
+              "grid; `splat info FILE.vdb` lists them)",
+              g);
+    addOption(cmd, "--zarr-level", args.level,
+              "OME-Zarr: the resolution level, 0 the finest (default 0; `splat info` lists them)",
+              g);
+    addOption(cmd, "--channel", args.channel,
+              "OME-Zarr: the channel of a 4D or 5D image (default 0)", g);
 }
 
 LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
@@ -88,6 +108,9 @@ LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
         options.raw.headerBytes = args.headerBytes;
         options.allowOutsideDataFiles = args.allowOutsideData;
         options.dicomSeries = args.series;
+        options.grid = args.grid;
+        if (!args.level.empty()) options.level = parseIndex(args.level, "--zarr-level");
+        if (!args.channel.empty()) options.channel = parseIndex(args.channel, "--channel");
         if (args.nanPolicy == "error")
             options.nonFinite = NonFinitePolicy::Error;
         else if (args.nanPolicy == "zero")

@@ -16,10 +16,12 @@ struct VolumeArgs {
     bool allowOutsideData = false;    // NRRD/MetaImage data files outside the header's folder
     std::string series;               // DICOM SeriesInstanceUID
     std::string backgroundValue;      // b: a number, "auto" (the faces rule) or "" (the loader's)
+    std::string grid;                 // OpenVDB: the grid's name
+    std::string level, channel;       // OME-Zarr: resolution level and channel ("": unset)
 };
 
 /// Adds VOLUME and --dims/--type/--spacing/--big-endian/--header-bytes/--nan-policy/
-/// --allow-outside-data/--series/--background-value.
+/// --allow-outside-data/--series/--background-value/--grid/--zarr-level/--channel.
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args);
 
 /// Parses the options (UsageError on malformed ones).

@@ -36,11 +36,18 @@ struct LoadOptions {
     /// DICOM: the SeriesInstanceUID to load when a folder holds several series (CLI:
     /// --series UID). Empty: the folder must hold exactly one series.
     std::string dicomSeries;
+    /// OpenVDB: the grid to load. Empty: `density`, else the first float or double grid.
+    std::string grid;
+    /// OME-Zarr: the resolution level (0, the finest, when unset).
+    std::optional<int> level;
+    /// OME-Zarr: the time point and channel of a 4D or 5D image (0 when unset, with a note).
+    std::optional<int> time, channel;
 };
 
 /// Loads `spec`: a file (.nii, .nii.gz, .hdr/.img ANALYZE 7.5 or NIfTI pair, NIfTI-2,
-/// .nrrd, .nhdr, .mhd, .mha, .raw, .raw.gz, .dcm), a folder of 2D slices (PNG/TIFF,
-/// natural sort order) or of DICOM files, or `synthetic:NAME[:N]`.
+/// .nrrd, .nhdr, .mhd, .mha, .raw, .raw.gz, .dcm, .vdb with OpenVDB), a folder of 2D slices
+/// (PNG/TIFF, natural sort order) or of DICOM files, an OME-Zarr image (a folder, see
+/// splat/sparse_files.h), or `synthetic:NAME[:N]`.
 /// Throws splat::Error with one line naming the file and the problem. Anything accepted
 /// but worth a word (an assumption, an ignored field) is in Volume::note.
 Volume loadVolume(const std::string& spec, const LoadOptions& options = {});

@@ -105,6 +105,9 @@ def load(
     allow_outside_data: bool | None = ...,
     series: str | None = ...,
     background_value: float | str | None = ...,
+    grid: str | None = ...,
+    zarr_level: int | str | None = ...,
+    channel: int | str | None = ...,
 ) -> Volume: ...
 def load_options() -> list[str]: ...
 def synthetic(name: str, size: int | None = ...) -> Volume: ...

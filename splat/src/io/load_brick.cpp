@@ -1,14 +1,18 @@
 // Reading one brick of a volume (splat/bricks.h): synthetic volumes compute only the brick;
-// NIfTI, NRRD, MetaImage and .raw files are read by byte ranges when raw-stored and by one
-// pass over the decompressed stream when compressed (sample_layout.h); anything else (DICOM,
-// slice folders, NRRD text/hex, ANALYZE pairs) is loaded whole and cropped.
+// OME-Zarr images read the chunks the brick intersects (zarr/ome_zarr.h) and OpenVDB files
+// the part of the tree it intersects (vdb/openvdb_file.h); NIfTI, NRRD,
+// MetaImage and .raw files are read by byte ranges when raw-stored and by one pass over the
+// decompressed stream when compressed (sample_layout.h); anything else (DICOM, slice
+// folders, NRRD text/hex, ANALYZE pairs) is loaded whole and cropped.
 #include "sample_layout.h"
 #include "splat/atomic_file.h"
 #include "splat/bricks.h"
 #include "splat/error.h"
 #include "splat/synthetic.h"
 #include "splat/volume_io.h"
+#include "vdb/openvdb_file.h"
 #include "volume_detail.h"
+#include "zarr/ome_zarr.h"
 
 namespace fs = std::filesystem;
 
@@ -17,6 +21,11 @@ namespace splat {
 namespace {
 
 bool isSynthetic(const std::string& spec) { return spec.rfind("synthetic:", 0) == 0; }
+
+bool isZarr(const std::string& spec) {
+    std::error_code ec;
+    return !spec.empty() && fs::is_directory(spec, ec) && detail::isZarrFolder(spec);
+}
 
 Volume crop(const Volume& whole, const glm::ivec3& lo, const glm::ivec3& hi) {
     Volume v = makeVolume(hi - lo, whole.spacing, whole.source);
@@ -39,8 +48,14 @@ Volume volumeGeometry(const std::string& spec, const LoadOptions& options, bool*
                       bool background) {
     Volume g;
     detail::SampleLayout L;
-    const bool byLayout = detail::sampleLayoutOf(spec, options, &L);
-    if (isSynthetic(spec)) {
+    const bool zarr = !isSynthetic(spec) && isZarr(spec);
+    const bool vdb = !isSynthetic(spec) && detail::isVdbFile(spec);
+    const bool byLayout = !zarr && !vdb && detail::sampleLayoutOf(spec, options, &L);
+    if (zarr) {
+        g = detail::zarrGeometry(spec, options, background);
+    } else if (vdb) {
+        g = detail::vdbGeometry(spec, options);  // b is the grid's background
+    } else if (isSynthetic(spec)) {
         const auto [name, n] = detail::syntheticSpec(spec);
         g = makeSyntheticBrick(name, n, glm::ivec3(0), glm::ivec3(1));
         g.dims = glm::ivec3(n);
@@ -57,7 +72,7 @@ Volume volumeGeometry(const std::string& spec, const LoadOptions& options, bool*
     }
     g.data.clear();
     g.data.shrink_to_fit();
-    if (alone) *alone = isSynthetic(spec) || byLayout;
+    if (alone) *alone = isSynthetic(spec) || byLayout || zarr || vdb;
     return g;
 }
 
@@ -69,6 +84,13 @@ Volume loadVolumeBrick(const std::string& spec, const LoadOptions& options, cons
         v.backgroundSource = "synthetic volume";
         return v;
     }
+    if (isZarr(spec)) {
+        Volume v = detail::loadZarrBrick(spec, options, lo, hi);
+        detail::applyNonFinitePolicy(v, options.nonFinite, spec);
+        return v;
+    }
+    if (!isSynthetic(spec) && detail::isVdbFile(spec))
+        return detail::loadVdbBrick(spec, options, lo, hi);
     detail::SampleLayout L;
     if (detail::sampleLayoutOf(spec, options, &L))
         return detail::readLayoutBrick(L, detail::layoutGeometry(L), lo, hi, options.nonFinite);

@@ -8,7 +8,9 @@
 
 #include "splat/error.h"
 #include "splat/synthetic.h"
+#include "vdb/openvdb_file.h"
 #include "volume_detail.h"
+#include "zarr/ome_zarr.h"
 
 namespace fs = std::filesystem;
 
@@ -64,6 +66,7 @@ Volume loadByType(const fs::path& p, const std::string& ext, const LoadOptions& 
     if (ext == ".nrrd" || ext == ".nhdr") return detail::loadNrrd(p, options);
     if (ext == ".mhd" || ext == ".mha") return detail::loadMetaImage(p, options);
     if (ext == ".raw" || ext == ".raw.gz") return detail::loadRaw(p, options.raw);
+    if (ext == ".vdb") return detail::loadVdb(p, options);
     if (ext == ".dcm" || ext == ".dicom")
         return detail::loadDicomFiles(detail::displayName(p), {p}, options);
     if (ext == ".png" || ext == ".tif" || ext == ".tiff")
@@ -105,7 +108,8 @@ Volume loadVolume(const std::string& spec, const LoadOptions& options) {
         fs::file_status st = fs::status(p, ec);
         if (!fs::exists(st)) throw Error(spec + ": no such file or folder");
         if (fs::is_directory(st)) {
-            v = detail::loadSliceFolder(p, options);
+            v = detail::isZarrFolder(p) ? detail::loadZarr(p, options)
+                                        : detail::loadSliceFolder(p, options);
         } else {
             detail::regularFileSize(p);  // FIFOs and devices are refused before any open
             std::string ext = lowerExtension(p);
@@ -117,8 +121,8 @@ Volume loadVolume(const std::string& spec, const LoadOptions& options) {
                 if (guess.empty() || guess == ext)
                     throw Error(spec + ": unknown file type '" + p.extension().string() +
                                 "' (expected .nii, .nii.gz, .hdr/.img, .nrrd, .nhdr, .mhd, .mha, "
-                                ".raw, .raw.gz, .dcm, a folder of slices or DICOM files, or "
-                                "synthetic:NAME)");
+                                ".raw, .raw.gz, .dcm, .vdb, a folder of slices or DICOM files, "
+                                "an OME-Zarr folder, or synthetic:NAME)");
                 v = loadByType(p, guess, options);
             }
         }

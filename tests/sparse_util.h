@@ -1,0 +1,40 @@
+#pragma once
+// The test data of the OpenVDB and OME-Zarr readers, written once per test run by
+// tests/sparse/make_sparse_data.py with the formats' own Python libraries (python3-openvdb,
+// python3-zarr, nibabel). sparseData() is empty (and the caller skips with a message) when
+// one of them is missing.
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "cli_util.h"
+
+namespace splat::test {
+
+inline std::optional<std::filesystem::path> sparseData() {
+    static std::once_flag once;
+    static std::optional<std::filesystem::path> dir;
+    std::call_once(once, [] {
+        const std::filesystem::path out = testTmpDir("sparse_data");
+        const std::string cmd = std::string("/usr/bin/python3 ") + SPLAT_TEST_SOURCE_DIR +
+                                "/sparse/make_sparse_data.py " + out.string();
+        const int status = std::system(cmd.c_str());
+        if (status == 0) dir = out;
+    });
+    return dir;
+}
+
+}  // namespace splat::test
+
+/// Skips the rest of a test case (with a message) when the data cannot be written.
+#define SPARSE_DATA_OR_SKIP(var)                                                          \
+    const auto var##_dir = splat::test::sparseData();                                     \
+    if (!var##_dir) {                                                                     \
+        WARN(                                                                             \
+            "python3-openvdb, python3-zarr or python3-nibabel missing (tools/setup.sh): " \
+            "skipped");                                                                   \
+        return;                                                                           \
+    }                                                                                     \
+    const std::filesystem::path var = *var##_dir
