@@ -10,9 +10,9 @@
 #include "splat/error.h"
 #include "splat/synthetic.h"
 #include "splat/volume_io.h"
-#include "vdb/openvdb_file.h"
+#include "io/vdb/openvdb_file.h"
 #include "volume_detail.h"
-#include "zarr/ome_zarr.h"
+#include "io/zarr/ome_zarr.h"
 
 namespace fs = std::filesystem;
 

@@ -1,11 +1,11 @@
 // OpenVDB files as volumes (openvdb_file.h), and listVdbGrids for `splat info`.
-#include "openvdb_file.h"
+#include "io/vdb/openvdb_file.h"
 
 #include <string>
 #include <vector>
 
-#include "../parse_in_child.h"
-#include "../volume_detail.h"
+#include "io/parse_in_child.h"
+#include "io/volume_detail.h"
 #include "splat/error.h"
 #include "splat/sparse_files.h"
 

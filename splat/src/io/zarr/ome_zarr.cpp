@@ -1,7 +1,7 @@
 // OME-Zarr images as volumes (ome_zarr.h): the `multiscales` metadata of OME-NGFF 0.4
 // (https://ngff.openmicroscopy.org/0.4/#multiscale-md), the selection of one 3D block, and
 // its chunks read through zarr_array.h.
-#include "ome_zarr.h"
+#include "io/zarr/ome_zarr.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "../volume_detail.h"
+#include "io/volume_detail.h"
 #include "splat/error.h"
 #include "splat/sparse_files.h"
-#include "zarr_array.h"
+#include "io/zarr/zarr_array.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -1,5 +1,5 @@
 // Zarr v2 arrays: `.zarray` parsing and box reads chunk by chunk (zarr_array.h).
-#include "zarr_array.h"
+#include "io/zarr/zarr_array.h"
 
 #include <blosc.h>
 #include <tbb/parallel_for.h>
@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "../volume_detail.h"
+#include "io/volume_detail.h"
 #include "splat/error.h"
 
 namespace fs = std::filesystem;
