@@ -135,7 +135,7 @@ RawLayout rawLayout(const std::filesystem::path& p, const RawOptions& options);
 /// "synthetic:NAME[:N]" as its name and size (the default size when N is not given).
 std::pair<std::string, int> syntheticSpec(const std::string& spec);
 Volume loadSliceFolder(const std::filesystem::path& dir, const LoadOptions& options);
-/// DICOM files through GDCM (load_dicom.cpp): one series, sorted along the slice normal.
+/// DICOM files through GDCM (load_dicom.cpp, dicom_detail.h): one series, sorted along the slice normal.
 Volume loadDicomFiles(const std::string& name, const std::vector<std::filesystem::path>& files,
                       const LoadOptions& options);
 /// DICOM files: ".dcm"/".dicom" or the "DICM" magic after the 128-byte preamble.
