@@ -36,6 +36,11 @@ struct LoadOptions {
     /// DICOM: the SeriesInstanceUID to load when a folder holds several series (CLI:
     /// --series UID). Empty: the folder must hold exactly one series.
     std::string dicomSeries;
+    /// Time series (4D NIfTI, NRRD with a time axis, a folder of 3D files, a series of
+    /// Siemens mosaics, OME-Zarr `t`): the time step to load, from 0 (CLI: --time T). Unset:
+    /// the first, with a note when there are more. A step past the last throws OptionError;
+    /// a file without a time axis has the one step 0.
+    std::optional<int> time;
 };
 
 /// Loads `spec`: a file (.nii, .nii.gz, .hdr/.img ANALYZE 7.5 or NIfTI pair, NIfTI-2,

@@ -1,6 +1,7 @@
 // DICOM pixels into rescaled floats: native (uncompressed) Pixel Data decoded here from the
-// bytes the element walk located; compressed pixels through gdcm::ImageReader in a forked
-// child (dicom_isolation.cpp), which writes the floats into a shared mapping.
+// bytes the element walk located, RLE Lossless by dicom_rle.cpp; the other compressed
+// transfer syntaxes through gdcm::ImageReader in a forked child (dicom_isolation.cpp), which
+// writes the floats into a shared mapping.
 #include <gdcmImageReader.h>
 #include <sys/mman.h>
 
@@ -12,6 +13,33 @@
 
 namespace splat::detail {
 namespace {
+
+const char* const kRleLossless = "1.2.840.10008.1.2.5";
+
+std::uint32_t be32(const unsigned char* p) {
+    return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 |
+           std::uint32_t(p[3]);
+}
+
+/// A JPEG 2000 codestream (ISO/IEC 15444-1 A.5.1: SOC FF4F, then the SIZ marker FF51 with
+/// Lsiz, Rsiz, Xsiz, Ysiz, XOsiz, YOsiz) must declare the image the DICOM header does:
+/// Xsiz - XOsiz = Columns, Ysiz - YOsiz = Rows. A codestream that declares another (pydicom's
+/// JPEG2000-embedded-sequence-delimiter.dcm: four bytes of its SIZ overwritten, a 3722445056
+/// x 1024 image) is refused with that, before a decoder sees it.
+void checkJpeg2000Size(const SliceInfo& s) {
+    const DicomLayout& l = s.layout;
+    if (l.pixelLength < 4 + 38) return;
+    const std::vector<unsigned char> head = readFileRange(s.path, l.pixelOffset, 4 + 38);
+    const unsigned char* p = head.data();
+    if (!(p[0] == 0xFF && p[1] == 0x4F && p[2] == 0xFF && p[3] == 0x51)) return;  // a JP2 file
+    const std::uint64_t x = be32(p + 8), y = be32(p + 12), x0 = be32(p + 16), y0 = be32(p + 20);
+    if (x > x0 && y > y0 && x - x0 == std::uint64_t(s.columns) && y - y0 == std::uint64_t(s.rows))
+        return;
+    throw Error(displayName(s.path) + ": corrupt JPEG 2000 codestream: its SIZ marker declares a " +
+                std::to_string(x > x0 ? x - x0 : 0) + " x " + std::to_string(y > y0 ? y - y0 : 0) +
+                " image, the DICOM header Columns x Rows " + std::to_string(s.columns) + " x " +
+                std::to_string(s.rows));
+}
 
 /// Stored values (the low `bitsStored` bits of `size`-byte words, two's complement when
 /// signed) through the rescale into floats.
@@ -34,7 +62,7 @@ void storedToReal(const unsigned char* raw, std::size_t count, std::size_t size,
     }
 }
 
-/// Compressed pixels (JPEG baseline/extended/lossless, JPEG-LS, JPEG 2000, RLE: every codec
+/// Compressed pixels (JPEG baseline/extended/lossless, JPEG-LS, JPEG 2000: the codecs
 /// Debian's GDCM links) decoded by gdcm::ImageReader in a forked child, as the header is
 /// (survivesInChild): the child writes the rescaled floats into a shared mapping.
 void decodeCompressed(const SliceInfo& s, std::size_t count, float* out) {
@@ -101,7 +129,20 @@ void readPixelsUnguarded(const SliceInfo& s, float* out) {
     const std::uint64_t count = std::uint64_t(s.columns) * std::uint64_t(s.rows);
     const std::uint64_t size = std::uint64_t(s.bitsAllocated / 8);
     const std::uint64_t bytes = checkedMul(count, size, name);
+    if (l.syntax == kRleLossless && l.encapsulated) {
+        // One fragment per frame (PS3.5 A.4.2), the first after the offset table.
+        const std::vector<unsigned char> frame =
+            readFileRange(s.path, l.pixelOffset, l.pixelLength);
+        const std::vector<unsigned char> raw = decodeRleFrame(
+            frame.data(), frame.size(), std::size_t(count), int(size), name);
+        storedToReal(raw.data(), std::size_t(count), std::size_t(size), s.bitsStored,
+                     s.signedPixels, false, s.slope, s.intercept, out);
+        return;
+    }
     if (compressed) {
+        if (l.encapsulated && (l.syntax == "1.2.840.10008.1.2.4.90" ||
+                               l.syntax == "1.2.840.10008.1.2.4.91"))
+            checkJpeg2000Size(s);
         decodeCompressed(s, std::size_t(count), out);
         return;
     }

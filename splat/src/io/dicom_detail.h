@@ -4,6 +4,7 @@
 //                        pixel data into a SliceInfo, grouped by SeriesInstanceUID
 //   dicom_geometry.cpp   a series' slice order, spacing and orientation (and a mosaic's)
 //   dicom_decode.cpp     one slice's pixels into rescaled floats
+//   dicom_rle.cpp        the RLE Lossless codec
 //   dicom_isolation.cpp  GDCM kept from harming the process: every length checked before
 //                        GDCM reads a file, every GDCM parse tried in a forked child
 //   load_dicom.cpp       loadDicomFiles: one series chosen, checked and assembled
@@ -78,7 +79,8 @@ auto guarded(const std::filesystem::path& p, F f) {
 
 // ---- series discovery (dicom_series.cpp) -------------------------------------------
 
-/// Every file's header (element walk, then GDCM up to the Pixel Data), in `files` order.
+/// Every file's header (element walk, then GDCM up to the Pixel Data), in `files` order;
+/// files without Pixel Data are left out (all of them: refused, "no pixel data").
 std::vector<SliceInfo> readInfos(const std::vector<std::filesystem::path>& files);
 /// The series of `infos`, sorted by series number then UID.
 std::vector<DicomSeriesInfo> groupSeries(const std::vector<SliceInfo>& infos);
@@ -103,5 +105,12 @@ DicomGeometry mosaicGeometry(const SliceInfo& s, int tileRows, int tileCols);
 
 /// Reads the pixels of one single-frame slice into `out` (columns x rows floats, rescaled).
 void readPixels(const SliceInfo& s, float* out);
+
+/// One RLE Lossless frame (dicom_rle.cpp, PS3.5 Annex G) of `count` scalar samples of
+/// `bytesPerSample` bytes, as little-endian samples; throws "NAME: corrupt RLE Lossless pixel
+/// data (...)" when the frame does not decode to exactly that.
+std::vector<unsigned char> decodeRleFrame(const unsigned char* frame, std::size_t size,
+                                          std::size_t count, int bytesPerSample,
+                                          const std::string& name);
 
 }  // namespace splat::detail

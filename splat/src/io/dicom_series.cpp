@@ -185,6 +185,17 @@ std::vector<SliceInfo> readInfos(const std::vector<fs::path>& files) {
     std::vector<Checked> checked;
     checked.reserve(files.size());
     for (const fs::path& p : files) checked.push_back(checkFile(p));
+    // A file without Pixel Data (a DICOMDIR, a structured report, nibabel's
+    // csa_slice_norm.dcm) is no slice, and GDCM's header reader asserts on some of them: it
+    // is left out of a folder that holds images, and refused alone.
+    const auto image = [](const Checked& c) { return c.layout.pixelData; };
+    if (!checked.empty() && std::none_of(checked.begin(), checked.end(), image))
+        throw Error(displayName(checked.front().path) +
+                    ": DICOM file without pixel data (no Pixel Data element (7fe0,0010)): not "
+                    "an image");
+    checked.erase(std::remove_if(checked.begin(), checked.end(),
+                                 [&](const Checked& c) { return !image(c); }),
+                  checked.end());
     // Every header is first parsed in one child process for the whole series (one fork per
     // series, not per slice: README "Input files" has the measured cost); the child records
     // which file it is in, so a death names the file.
@@ -211,7 +222,7 @@ std::vector<SliceInfo> readInfos(const std::vector<fs::path>& files) {
         throw Error(displayName(checked[std::min(*at, checked.size() - 1)].path) + e.what());
     }
     std::vector<SliceInfo> infos;
-    infos.reserve(files.size());
+    infos.reserve(checked.size());
     for (const Checked& c : checked)
         infos.push_back(
             guarded(c.path, [&] { return readHeaderWithGdcm(c.path, c.layout, c.fileSize); }));

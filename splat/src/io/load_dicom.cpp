@@ -26,18 +26,21 @@ void setBackground(Volume& v, const SliceInfo& first) {
 
 /// A Siemens mosaic: one file holds a volume, its n = NumberOfImagesInMosaic slices tiled
 /// m x m (m = ceil(sqrt n)) in one image, row by row; read as nibabel's MosaicWrapper reads
-/// it (geometry: mosaicGeometry). A series of mosaic files is a time series: its first file
-/// is loaded, with a warning.
-Volume loadMosaic(const std::string& name, std::vector<SliceInfo> files) {
+/// it (geometry: mosaicGeometry). A series of mosaic files is a time series in
+/// InstanceNumber order: LoadOptions::time picks the file (the first by default, with a
+/// warning).
+Volume loadMosaic(const std::string& name, std::vector<SliceInfo> files,
+                  const LoadOptions& options) {
     std::vector<std::string> notes;
-    if (files.size() > 1) {
-        std::stable_sort(files.begin(), files.end(), [](const SliceInfo& a, const SliceInfo& b) {
-            return a.instance < b.instance;
-        });
+    std::stable_sort(files.begin(), files.end(), [](const SliceInfo& a, const SliceInfo& b) {
+        return a.instance < b.instance;
+    });
+    const std::uint64_t step = timeStep(name, options, files.size());
+    if (files.size() > 1 && !options.time)
         notes.push_back("Siemens mosaic series of " + std::to_string(files.size()) +
-                        " files (one volume each): only the first was loaded");
-    }
-    const SliceInfo& s = files.front();
+                        " files (one volume each): only the first was loaded (--time T loads "
+                        "another)");
+    const SliceInfo& s = files[step];
     const std::string sn = displayName(s.path);
     if (s.mosaicImages < 1)
         throw Error(sn +
@@ -70,6 +73,8 @@ Volume loadMosaic(const std::string& name, std::vector<SliceInfo> files) {
     std::string modality = s.modality.empty() ? "" : s.modality + " ";
     v.source = "DICOM " + modality + "Siemens mosaic, " + std::to_string(dims.z) + " slices (" +
                name + ")";
+    if (files.size() > 1 && options.time)
+        v.source += ", time step " + std::to_string(step) + " of " + std::to_string(files.size());
     applyOrientation(v, g.M, g.t, g.what);
     for (const std::string& n : notes) addNote(v, n);
     setBackground(v, s);
@@ -130,7 +135,8 @@ Volume loadDicomFiles(const std::string& name, const std::vector<fs::path>& file
                         std::to_string(s.rows) + ", the first slice is " +
                         std::to_string(first.columns) + " x " + std::to_string(first.rows));
     }
-    if (first.mosaic) return loadMosaic(name, std::move(slices));
+    if (first.mosaic) return loadMosaic(name, std::move(slices), options);
+    timeStep(name, options, 1);  // a series of single slices has no time axis
     if (slices.size() > std::size_t(INT32_MAX)) throw Error(name + ": too many slices");
     const glm::ivec3 dims(first.columns, first.rows, int(slices.size()));
     checkedVoxelCount(dims, name);
