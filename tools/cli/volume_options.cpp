@@ -1,8 +1,10 @@
 // VOLUME and the options that say how to read it, shared by every subcommand.
 #include "volume_options.h"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <sstream>
 
@@ -51,6 +53,15 @@ glm::dvec3 parseSpacing(const std::string& s) {
 
 }  // namespace
 
+int parseTimeStep(const std::string& text, const std::string& what) {
+    char* end = nullptr;
+    errno = 0;
+    const long long t = std::strtoll(text.c_str(), &end, 10);
+    if (text.empty() || *end || errno || t < 0 || t > 2147483647LL)
+        throw Error(what + " '" + text + "': expected a time step, an integer from 0");
+    return int(t);
+}
+
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
     const std::string g = "Volume";
     addOption(cmd, "VOLUME", args.spec,
@@ -72,6 +83,10 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
               "DICOM: the SeriesInstanceUID to load when a folder holds several (`splat info "
               "FOLDER` lists them)",
               g);
+    addOption(cmd, "--time", args.time,
+              "time series (4D NIfTI, NRRD with a time axis, a folder of 3D files, OME-Zarr t): "
+              "the time step to load, from 0 (default: the first)",
+              g);
     addOption(cmd, "--background-value", args.backgroundValue,
               "the field's value where nothing is (b; e.g. -1000 for CT in HU): a number, or "
               "'auto' for the median of the outer faces (default: from the file, else auto)",
@@ -88,6 +103,7 @@ LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
         options.raw.headerBytes = args.headerBytes;
         options.allowOutsideDataFiles = args.allowOutsideData;
         options.dicomSeries = args.series;
+        if (!args.time.empty()) options.time = parseTimeStep(args.time, "--time");
         if (args.nanPolicy == "error")
             options.nonFinite = NonFinitePolicy::Error;
         else if (args.nanPolicy == "zero")
@@ -110,7 +126,12 @@ Volume loadVolumeWith(const VolumeArgs& args) {
             return float(b[0]);
         });
     }
-    Volume v = loadVolume(args.spec, options);
+    Volume v;
+    try {
+        v = loadVolume(args.spec, options);
+    } catch (const OptionError& e) {  // --time past the last step: the option is wrong
+        throw UsageError(e.what());
+    }
     if (background) {
         v.background = *background;
         v.backgroundSource = "--background-value";

@@ -15,18 +15,22 @@ struct VolumeArgs {
     std::string nanPolicy = "error";  // error | zero
     bool allowOutsideData = false;    // NRRD/MetaImage data files outside the header's folder
     std::string series;               // DICOM SeriesInstanceUID
+    std::string time;                 // time step of a time series, from 0 ("": the first)
     std::string backgroundValue;      // b: a number, "auto" (the faces rule) or "" (the loader's)
 };
 
 /// Adds VOLUME and --dims/--type/--spacing/--big-endian/--header-bytes/--nan-policy/
-/// --allow-outside-data/--series/--background-value.
+/// --allow-outside-data/--series/--time/--background-value.
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args);
+
+/// "T" as a time step (an integer from 0); throws splat::Error naming `what` otherwise.
+int parseTimeStep(const std::string& text, const std::string& what);
 
 /// Parses the options (UsageError on malformed ones).
 LoadOptions loadOptionsFromArgs(const VolumeArgs& args);
 
 /// Parses the options and loads the volume with its background value (--background-value);
-/// throws splat::Error on bad input. Prints nothing and records nothing (the Python module's
+/// throws splat::Error on bad input, UsageError for a --time past the file's last step. Prints nothing and records nothing (the Python module's
 /// splat.load).
 Volume loadVolumeWith(const VolumeArgs& args);
 
