@@ -208,12 +208,14 @@ TEST_CASE("cli: the reference's mip in bricks equals one process within 1e-5 of 
           "[bricks][cli]") {
     const fs::path dir = testTmpDir("mip_bricks");
     auto args = [&](const std::string& out, const std::string& bricks) {
-        return std::vector<std::string>{"render",    "synthetic:phantom:96", "--renderer",
-                                        "reference", "--mode",               "mip",
-                                        "--size",    "128x128",              "--azimuth",
-                                        "33",        "--elevation",          "21",
-                                        "--bricks",  bricks,                 "-o",
-                                        (dir / out).string()};
+        return std::vector<std::string>{"render",      "synthetic:phantom:96",
+                                        "--renderer",  "reference",
+                                        "--mode",      "mip",
+                                        "--size",      "128x128",
+                                        "--azimuth",   "33",
+                                        "--elevation", "21",
+                                        "--bricks",    bricks,
+                                        "-o",          (dir / out).string()};
     };
     REQUIRE(runSplat(args("one.exr", "0")).status == 0);
     REQUIRE(runSplat(args("four.exr", "4")).status == 0);

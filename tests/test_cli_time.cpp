@@ -41,11 +41,21 @@ TEST_CASE("cli: --time and rotate --time-steps on a 4D NRRD", "[cli][time]") {
         REQUIRE(runSplat(with({"render", nrrd, "--time", std::to_string(t), "-o",
                                (dir / ("step" + std::to_string(t) + ".exr")).string()}))
                     .status == 0);
-    const RunResult out = runSplat(with({"render", nrrd, "--time", "3", "-o",
-                                         (dir / "x.exr").string()}));
+    const RunResult out =
+        runSplat(with({"render", nrrd, "--time", "3", "-o", (dir / "x.exr").string()}));
     CHECK(out.status == 2);
     CHECK_THAT(out.err, Catch::Contains("time step 3 is out of range: it holds time steps 0 to 2"));
-    CHECK(runSplat(with({"render", nrrd, "--time", "-1", "-o", (dir / "x.exr").string()}))
+    CHECK(runSplat(with({"render", nrrd, "--time", "-1", "-o", (dir / "x.exr").string()})).status ==
+          2);
+    // Bricks read the step by byte ranges (the sample layout): the same image, the same error.
+    REQUIRE(runSplat(with({"render", nrrd, "--time", "2", "--bricks", "2", "-o",
+                           (dir / "bricks2.exr").string()}))
+                .status == 0);
+    CHECK(maxDiff(readImage((dir / "step2.exr").string()),
+                  readImage((dir / "bricks2.exr").string())) <=
+          1e-5f * peakOf(readImage((dir / "step2.exr").string())));
+    CHECK(runSplat(with({"render", nrrd, "--time", "3", "--bricks", "2", "-o",
+                         (dir / "x.exr").string()}))
               .status == 2);
 
     // One frame per step, the camera fixed: frame f is step f's image.
@@ -55,15 +65,16 @@ TEST_CASE("cli: --time and rotate --time-steps on a 4D NRRD", "[cli][time]") {
     REQUIRE(r.status == 0);
     for (int f = 0; f < 3; ++f) {
         const Image step = readImage((dir / ("step" + std::to_string(f) + ".exr")).string());
-        const Image frame = readImage((dir / "frames" / ("frame_000" + std::to_string(f) + ".exr")).string());
+        const Image frame =
+            readImage((dir / "frames" / ("frame_000" + std::to_string(f) + ".exr")).string());
         CHECK(maxDiff(step, frame) == 0.0f);
     }
     // The steps differ (the ball grows), so the frames are not one image three times.
-    CHECK(maxDiff(readImage((dir / "step0.exr").string()), readImage((dir / "step2.exr").string())) >
-          1.0f);
+    CHECK(maxDiff(readImage((dir / "step0.exr").string()),
+                  readImage((dir / "step2.exr").string())) > 1.0f);
     // Past the last step: a usage error before any frame is written; --frames must agree.
-    const RunResult past = runSplat(with({"rotate", nrrd, "--time-steps", "1:3", "-q", "-o",
-                                          (dir / "past").string()}));
+    const RunResult past = runSplat(
+        with({"rotate", nrrd, "--time-steps", "1:3", "-q", "-o", (dir / "past").string()}));
     CHECK(past.status == 2);
     CHECK_FALSE(fs::exists(dir / "past" / "frame_0000.png"));
     CHECK(runSplat(with({"rotate", nrrd, "--time-steps", "0:2", "--frames", "4", "-o",

@@ -53,17 +53,22 @@ TEST_CASE("RLE Lossless: corrupt frames are one error line", "[dicom][rle]") {
     CHECK(errorOf([&] { decode(tiny, 4, 1); }) ==
           "f.dcm: corrupt RLE Lossless pixel data (a 10-byte frame, shorter than the 64-byte RLE "
           "header)");
-    CHECK(errorOf([&] { decode(frameOf({{0, 1}}), 1, 2); }) ==
-          "f.dcm: RLE Lossless pixel data with 1 segments; 2-byte scalar samples need 2");
+    CHECK(errorOf([&] {
+              decode(frameOf({{0, 1}}), 1, 2);
+          }) == "f.dcm: RLE Lossless pixel data with 1 segments; 2-byte scalar samples need 2");
     // A segment that ends early, one that decodes to more than Rows x Columns, a literal run
     // cut by the end of the frame, an offset inside the header.
-    CHECK(errorOf([&] { decode(frameOf({{0xFE, 5}}), 4, 1); }) ==
-          "f.dcm: corrupt RLE Lossless pixel data (segment 0 ends after 3 of its 4 bytes)");
-    CHECK(errorOf([&] { decode(frameOf({{0xFC, 5}}), 4, 1); }) ==
+    CHECK(errorOf([&] {
+              decode(frameOf({{0xFE, 5}}), 4, 1);
+          }) == "f.dcm: corrupt RLE Lossless pixel data (segment 0 ends after 3 of its 4 bytes)");
+    CHECK(errorOf([&] {
+              decode(frameOf({{0xFC, 5}}), 4, 1);
+          }) ==
           "f.dcm: corrupt RLE Lossless pixel data (segment 0 decodes to more than Rows x "
           "Columns bytes)");
-    CHECK(errorOf([&] { decode(frameOf({{3, 1, 2}}), 4, 1); }) ==
-          "f.dcm: corrupt RLE Lossless pixel data (segment 0 ends inside a literal run)");
+    CHECK(errorOf([&] {
+              decode(frameOf({{3, 1, 2}}), 4, 1);
+          }) == "f.dcm: corrupt RLE Lossless pixel data (segment 0 ends inside a literal run)");
     auto bad = frameOf({{0xFD, 5}});
     bad[4] = 8;
     CHECK(errorOf([&] { decode(bad, 4, 1); }) ==

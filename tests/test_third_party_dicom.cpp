@@ -103,14 +103,14 @@ TEST_CASE("DICOM: RLE Lossless decoded by splat as pydicom decodes it; files tha
     // test of its fragment parser): the element walk reads the fragment by its length, and
     // the codestream's SIZ marker now declares another image, named in the refusal.
     CHECK_THAT(
-        errorOf([&] {
-            loadVolume((kPydicom / "JPEG2000-embedded-sequence-delimiter.dcm").string());
-        }),
+        errorOf(
+            [&] { loadVolume((kPydicom / "JPEG2000-embedded-sequence-delimiter.dcm").string()); }),
         Catch::EndsWith("JPEG2000-embedded-sequence-delimiter.dcm: corrupt JPEG 2000 codestream: "
                         "its SIZ marker declares a 3722445056 x 1024 image, the DICOM header "
                         "Columns x Rows 256 x 1024"));
     // A well-formed file without Pixel Data (nibabel's CSA header sample): one line.
-    const fs::path csa = "/usr/lib/python3/dist-packages/nibabel/nicom/tests/data/csa_slice_norm.dcm";
+    const fs::path csa =
+        "/usr/lib/python3/dist-packages/nibabel/nicom/tests/data/csa_slice_norm.dcm";
     if (fs::exists(csa))
         CHECK_THAT(errorOf([&] { loadVolume(csa.string()); }),
                    Catch::EndsWith("csa_slice_norm.dcm: DICOM file without pixel data (no Pixel "
@@ -118,9 +118,10 @@ TEST_CASE("DICOM: RLE Lossless decoded by splat as pydicom decodes it; files tha
     // A CIFTI-2 matrix is not a volume (nibabel's row_major.dconn.nii, intent code 3001).
     const fs::path cifti = "/usr/lib/python3/dist-packages/nibabel/tests/data/row_major.dconn.nii";
     if (fs::exists(cifti))
-        CHECK_THAT(errorOf([&] { loadVolume(cifti.string()); }),
-                   Catch::EndsWith("row_major.dconn.nii: not a volume: a CIFTI-2 matrix (NIfTI "
-                                   "intent code 3001), whose axes are brain structures, not space"));
+        CHECK_THAT(
+            errorOf([&] { loadVolume(cifti.string()); }),
+            Catch::EndsWith("row_major.dconn.nii: not a volume: a CIFTI-2 matrix (NIfTI "
+                            "intent code 3001), whose axes are brain structures, not space"));
 }
 
 TEST_CASE("DICOM: Siemens mosaics are unpacked from the CSA header's image count",

@@ -99,11 +99,12 @@ TEST_CASE("time series: 4D NRRD along its last axis, raw and gzip", "[volume][ti
     writeBytes(dir / "raw.nrrd", head + "encoding: raw\n\n" + samples<float>(values));
     writeBytes(dir / "gz.nrrd",
                head + "encoding: gzip\n\n" + deflateBytes(samples<float>(values), true));
-    writeBytes(dir / "text.nrrd", head + "encoding: text\n\n" + [&] {
-        std::string s;
-        for (double v : values) s += std::to_string(int(v)) + " ";
-        return s;
-    }());
+    writeBytes(
+        dir / "text.nrrd", head + "encoding: text\n\n" + [&] {
+            std::string s;
+            for (double v : values) s += std::to_string(int(v)) + " ";
+            return s;
+        }());
     for (const char* file : {"raw.nrrd", "gz.nrrd", "text.nrrd"}) {
         INFO(file);
         const std::string path = (dir / file).string();

@@ -2,10 +2,11 @@
 // --path FILE.json] [--time-steps A:B] -o DIR [--name PATTERN] [--resume | --overwrite]
 // [--gif FILE] [--contact-sheet FILE] [--mp4 FILE]`: a rotation sequence through the sequence
 // engine (splat/sequence.h), or one frame per time step of a time series (--time-steps: the
-// camera fixed, or turning over the sequence as --from/--to or --path say). Frames are written atomically as they are finished, so an interrupted
-// run leaves only complete frames, and --resume renders only the missing ones. The folder
-// keeps a manifest (.splat-rotate.json) of what its frames show: resuming with other
-// settings, or writing into a folder with other frames, is refused unless --overwrite.
+// camera fixed, or turning over the sequence as --from/--to or --path say). Frames are written
+// atomically as they are finished, so an interrupted run leaves only complete frames, and --resume
+// renders only the missing ones. The folder keeps a manifest (.splat-rotate.json) of what its
+// frames show: resuming with other settings, or writing into a folder with other frames, is refused
+// unless --overwrite.
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -119,8 +120,7 @@ std::pair<int, int> parseTimeSteps(const std::string& text) {
         throw Error("--time-steps '" + text + "': expected A:B, the first and last time step");
     const int first = parseTimeStep(text.substr(0, colon), "--time-steps");
     const int last = parseTimeStep(text.substr(colon + 1), "--time-steps");
-    if (last < first)
-        throw Error("--time-steps '" + text + "': the last step is before the first");
+    if (last < first) throw Error("--time-steps '" + text + "': the last step is before the first");
     return {first, last};
 }
 
@@ -452,8 +452,8 @@ void registerRotate(CLI::App& app) {
         if (bricked && !a->timeSteps.empty())
             throw UsageError("--time-steps renders without bricks (no --bricks or --rank-memory)");
         // A time series' camera turns only when --from/--to (or --path) say so.
-        const bool fixedCamera = !a->timeSteps.empty() && a->path.empty() &&
-                                 !given(*cmd, "from") && !given(*cmd, "to");
+        const bool fixedCamera =
+            !a->timeSteps.empty() && a->path.empty() && !given(*cmd, "from") && !given(*cmd, "to");
         if (bricked && !alone && !workerProcess())
             warn(a->volume.spec +
                  ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, "
@@ -476,8 +476,8 @@ void registerRotate(CLI::App& app) {
         std::string ffmpeg;
         const bool keepImages = !a->gif.empty() || !a->contact.empty();
         const CameraPath path =
-            fixedCamera ? CameraPath{std::vector<CameraParams>(std::size_t(a->frames),
-                                                                settings.camera)}
+            fixedCamera
+                ? CameraPath{std::vector<CameraParams>(std::size_t(a->frames), settings.camera)}
             : a->path.empty()
                 ? CameraPath::turn(
                       settings.camera,

@@ -9,9 +9,9 @@
 #include <sstream>
 
 #include "diagnostics.h"
-#include "technique_options.h"
 #include "scene_file.h"
 #include "splat/error.h"
+#include "technique_options.h"
 
 namespace splat::cli {
 namespace {

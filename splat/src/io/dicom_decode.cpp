@@ -133,15 +133,15 @@ void readPixelsUnguarded(const SliceInfo& s, float* out) {
         // One fragment per frame (PS3.5 A.4.2), the first after the offset table.
         const std::vector<unsigned char> frame =
             readFileRange(s.path, l.pixelOffset, l.pixelLength);
-        const std::vector<unsigned char> raw = decodeRleFrame(
-            frame.data(), frame.size(), std::size_t(count), int(size), name);
+        const std::vector<unsigned char> raw =
+            decodeRleFrame(frame.data(), frame.size(), std::size_t(count), int(size), name);
         storedToReal(raw.data(), std::size_t(count), std::size_t(size), s.bitsStored,
                      s.signedPixels, false, s.slope, s.intercept, out);
         return;
     }
     if (compressed) {
-        if (l.encapsulated && (l.syntax == "1.2.840.10008.1.2.4.90" ||
-                               l.syntax == "1.2.840.10008.1.2.4.91"))
+        if (l.encapsulated &&
+            (l.syntax == "1.2.840.10008.1.2.4.90" || l.syntax == "1.2.840.10008.1.2.4.91"))
             checkJpeg2000Size(s);
         decodeCompressed(s, std::size_t(count), out);
         return;

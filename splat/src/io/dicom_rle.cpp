@@ -25,13 +25,12 @@ void unpackSegment(const unsigned char* in, const unsigned char* end, unsigned c
                    std::size_t count, const std::string& name, int segment) {
     std::size_t n = 0;
     auto fail = [&](const std::string& why) {
-        throw Error(name + ": corrupt RLE Lossless pixel data (segment " +
-                    std::to_string(segment) + " " + why + ")");
+        throw Error(name + ": corrupt RLE Lossless pixel data (segment " + std::to_string(segment) +
+                    " " + why + ")");
     };
     while (n < count) {
         if (in >= end)
-            fail("ends after " + std::to_string(n) + " of its " + std::to_string(count) +
-                 " bytes");
+            fail("ends after " + std::to_string(n) + " of its " + std::to_string(count) + " bytes");
         const int header = static_cast<signed char>(*in++);
         if (header >= 0) {
             const std::size_t run = std::size_t(header) + 1;

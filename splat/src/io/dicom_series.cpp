@@ -193,9 +193,9 @@ std::vector<SliceInfo> readInfos(const std::vector<fs::path>& files) {
         throw Error(displayName(checked.front().path) +
                     ": DICOM file without pixel data (no Pixel Data element (7fe0,0010)): not "
                     "an image");
-    checked.erase(std::remove_if(checked.begin(), checked.end(),
-                                 [&](const Checked& c) { return !image(c); }),
-                  checked.end());
+    checked.erase(
+        std::remove_if(checked.begin(), checked.end(), [&](const Checked& c) { return !image(c); }),
+        checked.end());
     // Every header is first parsed in one child process for the whole series (one fork per
     // series, not per slice: README "Input files" has the measured cost); the child records
     // which file it is in, so a death names the file.

@@ -321,8 +321,9 @@ NrrdParsed nrrdParse(const fs::path& p, const LoadOptions& options, const NrrdHe
             throw Error(name + ": 'space directions' has " + std::to_string(dirs.size()) +
                         " entries, dimension is " + std::to_string(dimension));
         if (dimension == 4 && dirs[3])
-            throw Error(name + ": NRRD 'space directions' gives the time axis (axis 3) a "
-                               "direction; a time axis has 'none'");
+            throw Error(name +
+                        ": NRRD 'space directions' gives the time axis (axis 3) a "
+                        "direction; a time axis has 'none'");
         for (int a = 0; a < spatialAxes; ++a) {
             if (!dirs[a]) throw Error(name + ": 'space directions' is 'none' for a spatial axis");
             for (double c : *dirs[a])
@@ -485,8 +486,7 @@ std::optional<SampleLayout> nrrdLayout(const fs::path& p, const LoadOptions& opt
         L.skip = std::uint64_t(std::max(0LL, P.byteSkip)) + before;
     } else if (P.byteSkip == -1) {
         // "-1": the data is the last `total` bytes of the file.
-        checkDataLength(P.total, std::size_t(size - std::min(size, dataStart)), L.fileName,
-                        false);
+        checkDataLength(P.total, std::size_t(size - std::min(size, dataStart)), L.fileName, false);
         L.start = size - P.total + before;
     } else {
         checkDataLength(std::size_t(P.byteSkip), std::size_t(size - std::min(size, dataStart)),

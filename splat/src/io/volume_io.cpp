@@ -61,8 +61,7 @@ std::uint64_t detail::timeStep(const std::string& name, const LoadOptions& optio
     if (!options.time) return 0;
     if (*options.time >= 0 && std::uint64_t(*options.time) < steps)
         return std::uint64_t(*options.time);
-    throw OptionError(name + ": time step " + std::to_string(*options.time) +
-                      " is out of range: " +
+    throw OptionError(name + ": time step " + std::to_string(*options.time) + " is out of range: " +
                       (steps == 1 ? std::string("it holds one volume (time step 0)")
                                   : "it holds time steps 0 to " + std::to_string(steps - 1)));
 }

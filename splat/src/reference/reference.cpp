@@ -40,8 +40,8 @@
 // the halved ones' eps taken to fall 16x (Simpson), is within the bound, and the test is
 // repeated (at most kMaxPanelLevels halvings a panel). The factor 1/16 is calibrated: with it
 // the images are no further from a tight truth than the whole-ray scheme's at its default
-// first step 0.25 (README "Accuracy": ch2 256^2 at 30 degrees, RMSE 2.8e-7 vs 3.0e-7), at ~60% of its
-// samples. Early termination as below, at panel granularity, re-checked after refinement.
+// first step 0.25 (README "Accuracy": ch2 256^2 at 30 degrees, RMSE 2.8e-7 vs 3.0e-7), at ~60% of
+// its samples. Early termination as below, at panel granularity, re-checked after refinement.
 //
 //  - dvr: optical depth tau(t) by Simpson/quadratic interpolation of rho at every sample,
 //    I = int e exp(-tau) by Simpson. Early termination: a ray stops once
@@ -654,13 +654,15 @@ class Caster {
                          double h, std::vector<MipPeak>& peaks) {
         const int n = int(f.size()) - 1;
         auto second = [&](int i) {  // |second difference| at i, 0 at the ends
-            return i < 1 || i >= n ? 0.0
-                                   : std::abs(double(f[std::size_t(i - 1)][0]) -
-                                              2.0 * f[std::size_t(i)][0] + f[std::size_t(i + 1)][0]);
+            return i < 1 || i >= n
+                       ? 0.0
+                       : std::abs(double(f[std::size_t(i - 1)][0]) - 2.0 * f[std::size_t(i)][0] +
+                                  f[std::size_t(i + 1)][0]);
         };
         for (int i = 0; i <= n; ++i) {
             const double fi = f[std::size_t(i)][0];
-            if ((i > 0 && f[std::size_t(i - 1)][0] > fi) || (i < n && f[std::size_t(i + 1)][0] > fi))
+            if ((i > 0 && f[std::size_t(i - 1)][0] > fi) ||
+                (i < n && f[std::size_t(i + 1)][0] > fi))
                 continue;
             const double rise = 0.25 * std::max({second(i - 1), second(i), second(i + 1)});
             if (fi + rise > 0) peaks.push_back({fi + rise, a + i * h, segment});
