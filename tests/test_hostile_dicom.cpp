@@ -207,11 +207,12 @@ TEST_CASE("DICOM: GDCM dying on a file is one error line, never the process",
     REQUIRE(dataSet != std::string::npos);
     // An implicit-VR sequence (0008,1140) of undefined length whose item of undefined length
     // never ends (no item delimiter): Debian's GDCM aborts in gdcm::DataSet::ReadNested
-    // (SIGABRT). Every length is within the file, so the element walk lets it through.
+    // (SIGABRT). Every length is within the file, so the element walk lets it through. The
+    // file ends with Pixel Data (a file without any is refused before GDCM reads it).
     const std::string nested = tagOf(0x0008, 0x1140, 0xFFFFFFFFu) +
                                tagOf(0xFFFE, 0xE000, 0xFFFFFFFFu) + tagOf(0x0010, 0x0010, 4) +
                                "ABCD" + tagOf(0xFFFE, 0xE0DD, 0) + tagOf(0x0010, 0x0020, 4) +
-                               "EFGH";
+                               "EFGH" + tagOf(0x7FE0, 0x0010, 24) + std::string(24, '\7');
     writeBytes(dir / "nested.dcm", bytes.substr(0, dataSet) + nested);
     CHECK_THAT(errorOf([&] { loadVolume((dir / "nested.dcm").string()); }),
                Catch::EndsWith("nested.dcm: malformed DICOM file (GDCM reading the header died "

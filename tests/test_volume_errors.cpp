@@ -100,7 +100,7 @@ TEST_CASE("load errors name the file and the problem", "[volume]") {
     CHECK_THAT(loadError(path("magic.nrrd")), Catch::Contains("not a NRRD file"));
     // An empty folder is not a volume.
     std::filesystem::create_directories(dir / "empty");
-    CHECK_THAT(loadError(path("empty")), Catch::Contains("no PNG/TIFF slices or DICOM files"));
+    CHECK_THAT(loadError(path("empty")), Catch::Contains("no PNG/TIFF slices, DICOM files or volume files"));
 }
 
 TEST_CASE("truncated NIfTI data reports expected and found bytes", "[volume]") {

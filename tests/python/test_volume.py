@@ -168,3 +168,16 @@ def test_flipped_and_permuted_affine_equals_splat_load(tmp):
     assert a.dims == b.dims == (6, 7, 5)
     assert a.spacing == b.spacing and a.origin == pytest.approx(b.origin, abs=1e-12)
     assert np.array_equal(a.array, b.array)
+
+
+def test_time_step_of_a_4d_nifti_equals_nibabels(tmp):
+    nib = pytest.importorskip("nibabel")
+    data = (100 + np.random.default_rng(3).integers(0, 1000, (6, 5, 4, 7))).astype(np.int16)
+    path = tmp / "series.nii.gz"
+    nib.save(nib.Nifti1Image(data, np.diag([0.5, 2.0, 1.5, 1.0])), str(path))
+    for t in (0, 3, 6):
+        v = splat.load(str(path), time=t)
+        # nibabel's [x, y, z] is splat's [z, y, x] transposed
+        assert np.array_equal(v.array, data[..., t].T.astype(np.float32))
+    with pytest.raises(splat.InputError, match="time step 7 is out of range"):
+        splat.load(str(path), time=7)

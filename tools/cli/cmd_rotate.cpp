@@ -1,10 +1,12 @@
 // `splat rotate VOLUME [options] --frames N [--from DEG --to DEG] [--sweep azimuth|elevation |
-// --path FILE.json] -o DIR [--name PATTERN] [--resume | --overwrite] [--gif FILE]
-// [--contact-sheet FILE] [--mp4 FILE]`: a rotation sequence through the sequence engine
-// (splat/sequence.h). Frames are written atomically as they are finished, so an interrupted
-// run leaves only complete frames, and --resume renders only the missing ones. The folder
-// keeps a manifest (.splat-rotate.json) of what its frames show: resuming with other
-// settings, or writing into a folder with other frames, is refused unless --overwrite.
+// --path FILE.json] [--time-steps A:B] -o DIR [--name PATTERN] [--resume | --overwrite]
+// [--gif FILE] [--contact-sheet FILE] [--mp4 FILE]`: a rotation sequence through the sequence
+// engine (splat/sequence.h), or one frame per time step of a time series (--time-steps: the
+// camera fixed, or turning over the sequence as --from/--to or --path say). Frames are written
+// atomically as they are finished, so an interrupted run leaves only complete frames, and --resume
+// renders only the missing ones. The folder keeps a manifest (.splat-rotate.json) of what its
+// frames show: resuming with other settings, or writing into a folder with other frames, is refused
+// unless --overwrite.
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -48,6 +50,8 @@ struct RotateCommand {
     RenderArgs render;
     std::string outDir, gif, contact, mp4, format = "png", name = "frame_%04d", sweep = "azimuth",
                                            path;
+    std::string timeSteps;  // "A:B": one frame per time step A..B (inclusive)
+    int firstStep = 0;      // A of --time-steps
     int frames = 36, fps = 12, parallelFrames = 0;
     double from = 0, to = 360;
     SequenceBrickArgs brick;
@@ -105,7 +109,47 @@ nlohmann::json manifestOf(const RotateCommand& a, const RenderSettings& s) {
             {"elevation", s.camera.elevationDeg},
             {"slab", s.quality.slab},
             {"projection", toString(s.camera.projection)},
-            {"shade", s.shading.enabled}};
+            {"shade", s.shading.enabled},
+            {"time_steps", a.timeSteps}};
+}
+
+/// "A:B" of --time-steps: the first and last time step, 0 <= A <= B.
+std::pair<int, int> parseTimeSteps(const std::string& text) {
+    const std::size_t colon = text.find(':');
+    if (colon == std::string::npos)
+        throw Error("--time-steps '" + text + "': expected A:B, the first and last time step");
+    const int first = parseTimeStep(text.substr(0, colon), "--time-steps");
+    const int last = parseTimeStep(text.substr(colon + 1), "--time-steps");
+    if (last < first) throw Error("--time-steps '" + text + "': the last step is before the first");
+    return {first, last};
+}
+
+/// The frames of a time series (--time-steps), in this process: frame f shows time step
+/// a.firstStep + f from path.views[f], its volume loaded and classified with `settings` (the
+/// first step's data defaults, so every frame has the same transfer function and window).
+void renderTimeSteps(const RotateCommand& a, const std::shared_ptr<const Volume>& first,
+                     const RenderSettings& settings, const CameraPath& path,
+                     const std::vector<bool>& keep, ProgressReporter& progress,
+                     const std::function<void(std::size_t, const Image&, double)>& emit) {
+    std::size_t pending = 0, done = 0;
+    for (bool k : keep) pending += k ? 0 : 1;
+    for (std::size_t f = 0; f < path.views.size(); ++f) {
+        if (keep[f]) continue;
+        const auto t = std::chrono::steady_clock::now();
+        std::shared_ptr<const Volume> volume = first;
+        if (f > 0) {
+            VolumeArgs step = a.volume;
+            step.time = std::to_string(a.firstStep + int(f));
+            volume = std::make_shared<const Volume>(loadVolumeWith(step));
+        }
+        const Scene scene(volume, settings);
+        const Image image = scene.render(settings.renderer, path.views[f]);
+        emit(f, image,
+             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t)
+                 .count());
+        if (!progress(++done, pending, "time step " + std::to_string(a.firstStep + int(f))))
+            throw Cancelled();
+    }
 }
 
 /// True when `file` decodes as a complete image of width x height pixels.
@@ -315,6 +359,10 @@ void registerRotate(CLI::App& app) {
               "camera path JSON {\"keys\": [{\"azimuth\", \"elevation\", \"distance\", "
               "\"pixel_size\"}, ...]}, interpolated over --frames (instead of --sweep)",
               seq, PathKind::Input);
+    addOption(*cmd, "--time-steps", a->timeSteps,
+              "time series: one frame per time step A..B (inclusive, e.g. 0:19; sets --frames); "
+              "the camera stays unless --from/--to or --path turn it over the sequence",
+              seq);
     addOption(*cmd, "--parallel-frames", a->parallelFrames,
               "frames rendered at once, one thread each (0: automatic)", seq);
     addSequenceBrickOptions(*cmd, a->brick, seq, "every frame");
@@ -365,6 +413,22 @@ void registerRotate(CLI::App& app) {
                 throw Error(a->mp4 + ": --mp4 needs a .mp4 file name");
             if (!a->mp4.empty() && a->format != "png")
                 throw Error("--mp4 is made from png frames (--format png)");
+            if (!a->timeSteps.empty()) {
+                if (!a->volume.time.empty())
+                    throw Error("--time-steps and --time exclude each other");
+                const auto [first, last] = parseTimeSteps(a->timeSteps);
+                const long long n = (long long)last - first + 1;
+                if (n > 100000) throw Error("--time-steps: at most 100000 frames");
+                if (given(*cmd, "frames") && a->frames != n)
+                    throw Error("--frames " + std::to_string(a->frames) + " and --time-steps " +
+                                a->timeSteps + " (" + std::to_string(n) +
+                                " frames) disagree; give one of them");
+                a->frames = int(n);
+                a->firstStep = first;
+                a->volume.time = std::to_string(first);  // the first frame's volume
+                if (processCount() > 1)
+                    throw Error("--time-steps renders in one process (without mpirun)");
+            }
         });
         if (!a->path.empty())
             for (const char* k : {"from", "to", "sweep"})
@@ -385,6 +449,11 @@ void registerRotate(CLI::App& app) {
         const std::optional<Volume>& geometry = choice.geometry;
         const bool alone = choice.alone;
         const bool bricked = bricks > 0;
+        if (bricked && !a->timeSteps.empty())
+            throw UsageError("--time-steps renders without bricks (no --bricks or --rank-memory)");
+        // A time series' camera turns only when --from/--to (or --path) say so.
+        const bool fixedCamera =
+            !a->timeSteps.empty() && a->path.empty() && !given(*cmd, "from") && !given(*cmd, "to");
         if (bricked && !alone && !workerProcess())
             warn(a->volume.spec +
                  ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, "
@@ -407,7 +476,9 @@ void registerRotate(CLI::App& app) {
         std::string ffmpeg;
         const bool keepImages = !a->gif.empty() || !a->contact.empty();
         const CameraPath path =
-            a->path.empty()
+            fixedCamera
+                ? CameraPath{std::vector<CameraParams>(std::size_t(a->frames), settings.camera)}
+            : a->path.empty()
                 ? CameraPath::turn(
                       settings.camera,
                       a->sweep == "azimuth" ? CameraPath::Angle::Azimuth
@@ -446,6 +517,13 @@ void registerRotate(CLI::App& app) {
                     volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
                     settings = withDataDefaults(a->render, settings, *volume);
                     scene.emplace(volume, settings);
+                }
+                if (!a->timeSteps.empty() && a->frames > 1) {
+                    // The last step is loaded once up front: a step past the file's last is a
+                    // usage error before any frame is rendered.
+                    VolumeArgs last = a->volume;
+                    last.time = std::to_string(a->firstStep + a->frames - 1);
+                    (void)loadVolumeWith(last);
                 }
                 std::error_code ec;
                 fs::create_directories(a->outDir, ec);
@@ -506,6 +584,8 @@ void registerRotate(CLI::App& app) {
             if (bricked)
                 renderBrickedFrames(*a, *geometry, settings, bricks, *group, path, keep, progress,
                                     emit);
+            else if (!a->timeSteps.empty())
+                renderTimeSteps(*a, volume, settings, path, keep, progress, emit);
             else
                 renderSequence(*scene, {settings.renderer}, path, so, [&](SequenceFrame&& f) {
                     emit(f.view, f.images[0], f.stats[0].milliseconds);

@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "diagnostics.h"
 #include "parallel.h"
+#include "splat/error.h"
 
 namespace {
 
@@ -101,6 +102,10 @@ int runCommand(int argc, char** argv) {
         printError(what + " (see '" + where + " --help')");
         return kExitUsage;
     } catch (const UsageError& e) {
+        printError(e.what());
+        return kExitUsage;
+    } catch (
+        const splat::OptionError& e) {  // an option the input cannot honour (--time past the end)
         printError(e.what());
         return kExitUsage;
     } catch (const std::exception& e) {

@@ -1,6 +1,7 @@
 // VOLUME and the options that say how to read it, shared by every subcommand.
 #include "volume_options.h"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -8,9 +9,9 @@
 #include <sstream>
 
 #include "diagnostics.h"
-#include "technique_options.h"
 #include "scene_file.h"
 #include "splat/error.h"
+#include "technique_options.h"
 
 namespace splat::cli {
 namespace {
@@ -61,6 +62,15 @@ int parseIndex(const std::string& s, const std::string& flag) {
 
 }  // namespace
 
+int parseTimeStep(const std::string& text, const std::string& what) {
+    char* end = nullptr;
+    errno = 0;
+    const long long t = std::strtoll(text.c_str(), &end, 10);
+    if (text.empty() || *end || errno || t < 0 || t > 2147483647LL)
+        throw Error(what + " '" + text + "': expected a time step, an integer from 0");
+    return int(t);
+}
+
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
     const std::string g = "Volume";
     addOption(cmd, "VOLUME", args.spec,
@@ -82,6 +92,10 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
     addOption(cmd, "--series", args.series,
               "DICOM: the SeriesInstanceUID to load when a folder holds several (`splat info "
               "FOLDER` lists them)",
+              g);
+    addOption(cmd, "--time", args.time,
+              "time series (4D NIfTI, NRRD with a time axis, a folder of 3D files, OME-Zarr t): "
+              "the time step to load, from 0 (default: the first)",
               g);
     addOption(cmd, "--background-value", args.backgroundValue,
               "the field's value where nothing is (b; e.g. -1000 for CT in HU): a number, or "
@@ -111,6 +125,7 @@ LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
         options.grid = args.grid;
         if (!args.level.empty()) options.level = parseIndex(args.level, "--zarr-level");
         if (!args.channel.empty()) options.channel = parseIndex(args.channel, "--channel");
+        if (!args.time.empty()) options.time = parseTimeStep(args.time, "--time");
         if (args.nanPolicy == "error")
             options.nonFinite = NonFinitePolicy::Error;
         else if (args.nanPolicy == "zero")
@@ -133,7 +148,12 @@ Volume loadVolumeWith(const VolumeArgs& args) {
             return float(b[0]);
         });
     }
-    Volume v = loadVolume(args.spec, options);
+    Volume v;
+    try {
+        v = loadVolume(args.spec, options);
+    } catch (const OptionError& e) {  // --time past the last step: the option is wrong
+        throw UsageError(e.what());
+    }
     if (background) {
         v.background = *background;
         v.backgroundSource = "--background-value";

@@ -15,20 +15,24 @@ struct VolumeArgs {
     std::string nanPolicy = "error";  // error | zero
     bool allowOutsideData = false;    // NRRD/MetaImage data files outside the header's folder
     std::string series;               // DICOM SeriesInstanceUID
+    std::string time;                 // time step of a time series, from 0 ("": the first)
     std::string backgroundValue;      // b: a number, "auto" (the faces rule) or "" (the loader's)
     std::string grid;                 // OpenVDB: the grid's name
     std::string level, channel;       // OME-Zarr: resolution level and channel ("": unset)
 };
 
 /// Adds VOLUME and --dims/--type/--spacing/--big-endian/--header-bytes/--nan-policy/
-/// --allow-outside-data/--series/--background-value/--grid/--zarr-level/--channel.
+/// --allow-outside-data/--series/--time/--background-value/--grid/--zarr-level/--channel.
 void addVolumeOptions(CLI::App& cmd, VolumeArgs& args);
+
+/// "T" as a time step (an integer from 0); throws splat::Error naming `what` otherwise.
+int parseTimeStep(const std::string& text, const std::string& what);
 
 /// Parses the options (UsageError on malformed ones).
 LoadOptions loadOptionsFromArgs(const VolumeArgs& args);
 
 /// Parses the options and loads the volume with its background value (--background-value);
-/// throws splat::Error on bad input. Prints nothing and records nothing (the Python module's
+/// throws splat::Error on bad input, UsageError for a --time past the file's last step. Prints nothing and records nothing (the Python module's
 /// splat.load).
 Volume loadVolumeWith(const VolumeArgs& args);
 

@@ -40,8 +40,13 @@ struct LoadOptions {
     std::string grid;
     /// OME-Zarr: the resolution level (0, the finest, when unset).
     std::optional<int> level;
-    /// OME-Zarr: the time point and channel of a 4D or 5D image (0 when unset, with a note).
-    std::optional<int> time, channel;
+    /// OME-Zarr: the channel of a 4D or 5D image (0 when unset, with a note).
+    std::optional<int> channel;
+    /// Time series (4D NIfTI, NRRD with a time axis, a folder of 3D files, a series of
+    /// Siemens mosaics, OME-Zarr `t`): the time step to load, from 0 (CLI: --time T). Unset:
+    /// the first, with a note when there are more. A step past the last throws OptionError;
+    /// a file without a time axis has the one step 0.
+    std::optional<int> time;
 };
 
 /// Loads `spec`: a file (.nii, .nii.gz, .hdr/.img ANALYZE 7.5 or NIfTI pair, NIfTI-2,

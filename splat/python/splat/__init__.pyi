@@ -104,6 +104,7 @@ def load(
     nan_policy: str | None = ...,
     allow_outside_data: bool | None = ...,
     series: str | None = ...,
+    time: int | None = ...,
     background_value: float | str | None = ...,
     grid: str | None = ...,
     zarr_level: int | str | None = ...,

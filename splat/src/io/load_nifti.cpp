@@ -6,9 +6,10 @@
 // 540-byte header of 64-bit fields; ANALYZE 7.5 is the 348-byte ancestor without
 // orientation. niftilib's header structures, byte swapping and quaternion maths are used;
 // the header values are checked here, in 64-bit arithmetic, before anything is
-// allocated, and only the first volume's bytes are read (a 4D series is not loaded to
-// keep one volume). Values go through the intensity scaling and the orientation (sform
-// preferred, then qform, else pixdim). docs/input-files.md lists what is
+// allocated, and only one volume's bytes are read: a 4D file is a time series (dim[4] the
+// time axis), and LoadOptions::time picks the volume (the first by default). Values go
+// through the intensity scaling and the orientation (sform preferred, then qform, else
+// pixdim). docs/input-files.md lists what is
 // refused and what is only warned about.
 #include <nifti2_io.h>
 #include <zlib.h>
@@ -56,6 +57,7 @@ struct Header {
     bool swapped = false;    ///< file byte order differs from the host's
     std::int64_t dim[8] = {};
     int datatype = 0, bitpix = 0;
+    int intentCode = 0;  ///< NIfTI-1/2 intent_code (0 for ANALYZE)
     double pixdim[8] = {};
     double voxOffset = 0;
     double sclSlope = 0, sclInter = 0;
@@ -100,6 +102,7 @@ template <typename H>
 void copyTransforms(const H& n, Header& h) {
     h.sclSlope = n.scl_slope;
     h.sclInter = n.scl_inter;
+    h.intentCode = n.intent_code;
     h.qformCode = n.qform_code;
     h.sformCode = n.sform_code;
     const double q[6] = {n.quatern_b, n.quatern_c, n.quatern_d,
@@ -248,7 +251,7 @@ namespace {
 
 /// The header of `given` parsed and checked: where the first volume's samples are and how
 /// they become the model's volume.
-SampleLayout niftiParse(const fs::path& given) {
+SampleLayout niftiParse(const fs::path& given, const LoadOptions& options) {
     std::string ext = toLower(given.extension().string());
     if (ext == ".gz") ext = toLower(given.stem().extension().string());
     // An .img names the pair's header; the header is where everything starts.
@@ -260,6 +263,11 @@ SampleLayout niftiParse(const fs::path& given) {
     std::vector<std::string> notes;
     if ((ext == ".nii") && !h.singleFile)
         throw Error(name + ": not a readable single-file NIfTI (magic is not n+1 or n+2)");
+    // CIFTI-2 (intent codes 3000-3099, NIFTI_INTENT_CONNECTIVITY_*): a matrix over brain
+    // structures stored along dim[5] and dim[6], dim[1..4] = 1 (nibabel's cifti2 module).
+    if (h.version > 0 && h.intentCode >= 3000 && h.intentCode <= 3099)
+        throw Error(name + ": not a volume: a CIFTI-2 matrix (NIfTI intent code " +
+                    std::to_string(h.intentCode) + "), whose axes are brain structures, not space");
 
     // Dimensions: dim[0] axes, each >= 1; the product in checked 64-bit arithmetic.
     if (h.dim[0] < 1 || h.dim[0] > 7)
@@ -287,17 +295,22 @@ SampleLayout niftiParse(const fs::path& given) {
                     " bits)");
     const std::size_t bytes = volumeBytes(dims, *type, name);
     checkedMul(bytes, volumes, name);  // the whole series must be addressable too
+    // The time axis is dim[4]; dims 5-7 (vector components and more) keep their first entry.
+    const std::uint64_t steps = h.dim[0] >= 4 ? std::uint64_t(h.dim[4]) : 1;
+    const std::uint64_t step = timeStep(name, options, steps);
 
     // Where the samples start.
     if (!std::isfinite(h.voxOffset) || h.voxOffset < 0 || h.voxOffset > 9.0e15 ||
         h.voxOffset != std::floor(h.voxOffset))
         throw Error(name + ": invalid vox_offset " + std::to_string(h.voxOffset));
     std::uint64_t offset = std::uint64_t(h.voxOffset);
+    const std::uint64_t first = offset;  // where the file's first volume starts
+    offset = checkedAdd(offset, checkedMul(step, bytes, name), name);
     fs::path dataPath = p;
     if (h.singleFile) {
         const std::uint64_t minimum = h.headerSize() + 4;
-        if (offset < minimum)
-            throw Error(name + ": vox_offset " + std::to_string(offset) +
+        if (first < minimum)
+            throw Error(name + ": vox_offset " + std::to_string(first) +
                         " lies inside the header (a single-file " + format +
                         " needs vox_offset >= " + std::to_string(minimum) + ")");
     } else {
@@ -393,19 +406,27 @@ SampleLayout niftiParse(const fs::path& given) {
     L.name = name;
     L.source =
         std::string(format) + " " + sampleTypeName(*type) + " (" + p.filename().string() + ")";
-    if (volumes > 1)
-        notes.insert(notes.begin(), "4D file: only the first of " + std::to_string(volumes) +
-                                        " volumes was loaded");
+    if (options.time && steps > 1)
+        L.source += ", time step " + std::to_string(step) + " of " + std::to_string(steps);
+    if (!options.time && steps > 1)
+        notes.insert(notes.begin(), "4D file: only the first of " + std::to_string(steps) +
+                                        " volumes was loaded (--time T loads another)");
+    else if (volumes > steps)
+        notes.insert(notes.begin(), "5D file: only the first of " +
+                                        std::to_string(volumes / steps) +
+                                        " components of each time step was loaded");
     L.notes = notes;
     return L;
 }
 
 }  // namespace
 
-std::optional<SampleLayout> niftiLayout(const fs::path& p) { return niftiParse(p); }
+std::optional<SampleLayout> niftiLayout(const fs::path& p, const LoadOptions& options) {
+    return niftiParse(p, options);
+}
 
-Volume loadNifti(const fs::path& given) {
-    const SampleLayout L = niftiParse(given);
+Volume loadNifti(const fs::path& given, const LoadOptions& options) {
+    const SampleLayout L = niftiParse(given, options);
     std::vector<unsigned char> data =
         readData(L.file, L.codec == SampleLayout::Codec::Gzip ? L.skip : L.start, L.sampleBytes());
     Volume v = makeVolume(L.dims, glm::dvec3(1.0), L.name);

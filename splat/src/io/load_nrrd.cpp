@@ -4,10 +4,13 @@
 // "field: value" lines ("#" starts a comment, "key:=value" is a key/value pair we
 // ignore). In a .nrrd the header ends at the first blank line and the data follows; a
 // .nhdr names its data with "data file:" (relative to the header's folder). Fields we
-// use: type, dimension (2 or 3), sizes, encoding (all five: raw, gzip/gz, bzip2/bz2,
-// text/txt/ascii, hex), endian, spacings or space (or space dimension) with space
-// directions and space origin, byte skip, line skip. Geometry in a named space is turned
+// use: type, dimension (2 or 3; 4 for a time series along the last axis, whose kind is time
+// or domain and which has no space direction), sizes, kinds, encoding (all five: raw,
+// gzip/gz, bzip2/bz2, text/txt/ascii, hex), endian, spacings or space (or space dimension)
+// with space directions and space origin, byte skip, line skip. LoadOptions::time picks the
+// time step (the first by default). Geometry in a named space is turned
 // into splat's world frame, RAS (docs/design.md "World frame").
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <initializer_list>
@@ -223,7 +226,9 @@ NrrdHeader parseNrrdHeader(const std::vector<unsigned char>& file, const std::st
 /// What the header says: the samples' type, size, orientation, encoding and where they are.
 struct NrrdParsed {
     SampleLayout layout;  ///< file, start and codec not set
-    std::size_t expected = 0;
+    std::size_t expected = 0;  ///< bytes of one time step
+    std::size_t total = 0;     ///< bytes of every time step
+    std::uint64_t step = 0;    ///< the time step to load
     bool gzip = false, bzip2 = false, text = false, hex = false;
     std::string encoding;
     long long byteSkip = 0, lineSkip = 0;
@@ -246,19 +251,39 @@ NrrdParsed nrrdParse(const fs::path& p, const LoadOptions& options, const NrrdHe
     auto type = parseSampleType(required("type"));
     if (!type) throw Error(name + ": unsupported NRRD type '" + field("type") + "'");
     int dimension = std::atoi(required("dimension").c_str());
-    if (dimension != 2 && dimension != 3)
+    if (dimension != 2 && dimension != 3 && dimension != 4)
         throw Error(name + ": NRRD dimension " + field("dimension") +
-                    " not supported (need a 2D or 3D scalar volume)");
+                    " not supported (need a 2D or 3D scalar volume, or a 3D time series)");
+    const int spatialAxes = std::min(dimension, 3);
     std::vector<double> sizes = parseNumbers(required("sizes"), name, "sizes");
     if (int(sizes.size()) != dimension)
         throw Error(name + ": 'sizes' has " + std::to_string(sizes.size()) + " entries, " +
                     "dimension is " + std::to_string(dimension));
     glm::ivec3 dims(1);
-    for (int a = 0; a < dimension; ++a)
+    for (int a = 0; a < spatialAxes; ++a)
         dims[a] = dimensionFrom(sizes[a], name, "NRRD sizes", field("sizes"));
     // Every size check before anything is allocated (64-bit, no wrap).
     const std::size_t expected = volumeBytes(dims, *type, name);
     std::vector<std::string> notes;
+    // A 4D NRRD is a time series along its last (slowest) axis: each step is a contiguous
+    // 3D volume. A vector or list axis (kind list, vector, RGB-color, ...) is not one.
+    std::uint64_t steps = 1;
+    if (dimension == 4) {
+        std::istringstream kinds(field("kinds"));
+        std::vector<std::string> kind;
+        for (std::string k; kinds >> k;) kind.push_back(toLower(k));
+        if (!kind.empty() && (kind.size() != 4 || (kind[3] != "time" && kind[3] != "domain" &&
+                                                   kind[3] != "none" && kind[3] != "???")))
+            throw Error(name + ": NRRD 4D data whose last axis is of kind '" +
+                        (kind.size() == 4 ? kind[3] : field("kinds")) +
+                        "': only a time series along the last axis (kind time) is read");
+        steps = std::uint64_t(dimensionFrom(sizes[3], name, "NRRD sizes", field("sizes")));
+    }
+    const std::size_t total = std::size_t(checkedMul(expected, steps, name));
+    const std::uint64_t step = timeStep(name, options, steps);
+    if (!options.time && steps > 1)
+        notes.push_back("4D NRRD: only the first of " + std::to_string(steps) +
+                        " time steps was loaded (--time T loads another)");
 
     // Geometry: space directions (with optional space origin) or per-axis spacings.
     glm::dmat3 M(1.0);
@@ -295,7 +320,11 @@ NrrdParsed nrrdParse(const fs::path& p, const LoadOptions& options, const NrrdHe
         if (int(dirs.size()) != dimension)
             throw Error(name + ": 'space directions' has " + std::to_string(dirs.size()) +
                         " entries, dimension is " + std::to_string(dimension));
-        for (int a = 0; a < dimension; ++a) {
+        if (dimension == 4 && dirs[3])
+            throw Error(name +
+                        ": NRRD 'space directions' gives the time axis (axis 3) a "
+                        "direction; a time axis has 'none'");
+        for (int a = 0; a < spatialAxes; ++a) {
             if (!dirs[a]) throw Error(name + ": 'space directions' is 'none' for a spatial axis");
             for (double c : *dirs[a])
                 if (!std::isfinite(c))
@@ -313,7 +342,7 @@ NrrdParsed nrrdParse(const fs::path& p, const LoadOptions& options, const NrrdHe
         if (int(sp.size()) != dimension)
             throw Error(name + ": 'spacings' has " + std::to_string(sp.size()) +
                         " entries, dimension is " + std::to_string(dimension));
-        for (int a = 0; a < dimension; ++a) {
+        for (int a = 0; a < spatialAxes; ++a) {
             if (std::isnan(sp[a])) {
                 // NRRD's own way to say "unknown spacing".
                 notes.push_back("NRRD spacing of axis " + std::to_string(a) +
@@ -383,6 +412,8 @@ NrrdParsed nrrdParse(const fs::path& p, const LoadOptions& options, const NrrdHe
         throw Error(name + ": NRRD header has no data (no blank line, no 'data file')");
     }
     P.expected = expected;
+    P.total = total;
+    P.step = step;
     P.gzip = gzip;
     P.bzip2 = bzip2;
     P.text = text;
@@ -394,13 +425,15 @@ NrrdParsed nrrdParse(const fs::path& p, const LoadOptions& options, const NrrdHe
     L.dims = dims;
     L.type = *type;
     L.bigEndian = bigEndian;
-    L.exact = true;
     L.M = M;
     L.t = t;
     L.orientation = oriented ? "space directions" : "spacings";
     L.name = name;
     L.source = std::string("NRRD ") + sampleTypeName(*type) + " " + encoding + " (" +
                p.filename().string() + ")";
+    if (steps > 1 && options.time)
+        L.source += ", time step " + std::to_string(step) + " of " + std::to_string(steps);
+    L.exact = steps == 1;  // a step before the last is followed by the others
     L.notes = notes;
     return P;
 }
@@ -446,19 +479,19 @@ std::optional<SampleLayout> nrrdLayout(const fs::path& p, const LoadOptions& opt
     L.fileName = displayName(L.file);
     const std::uint64_t dataStart = afterLines(L.file, P.dataFile ? 0 : header.pos, P.lineSkip);
     const std::uint64_t size = regularFileSize(L.file);
+    const std::uint64_t before = P.step * P.expected;  // the time steps before this one
     if (P.gzip || P.bzip2) {
         L.codec = P.gzip ? SampleLayout::Codec::Gzip : SampleLayout::Codec::Bzip2;
         L.start = dataStart;
-        L.skip = std::uint64_t(std::max(0LL, P.byteSkip));
+        L.skip = std::uint64_t(std::max(0LL, P.byteSkip)) + before;
     } else if (P.byteSkip == -1) {
-        // "-1": the data is the last `expected` bytes of the file.
-        checkDataLength(P.expected, std::size_t(size - std::min(size, dataStart)), L.fileName,
-                        false);
-        L.start = size - P.expected;
+        // "-1": the data is the last `total` bytes of the file.
+        checkDataLength(P.total, std::size_t(size - std::min(size, dataStart)), L.fileName, false);
+        L.start = size - P.total + before;
     } else {
         checkDataLength(std::size_t(P.byteSkip), std::size_t(size - std::min(size, dataStart)),
                         L.fileName, false);
-        L.start = dataStart + std::uint64_t(P.byteSkip);
+        L.start = dataStart + std::uint64_t(P.byteSkip) + before;
     }
     return L;
 }
@@ -468,7 +501,8 @@ Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
     std::vector<unsigned char> file = readFileBytes(p);
     const NrrdHeader header = parseNrrdHeader(file, name);
     const NrrdParsed P = nrrdParse(p, options, header);
-    const std::size_t expected = P.expected;
+    const std::size_t expected = P.total;  // every time step: the data must hold them all
+    const std::size_t before = std::size_t(P.step) * P.expected;
     const bool gzip = P.gzip, bzip2 = P.bzip2, text = P.text, hex = P.hex;
     const std::string& encoding = P.encoding;
     const long long byteSkip = P.byteSkip, lineSkip = P.lineSkip;
@@ -533,11 +567,16 @@ Volume loadNrrd(const fs::path& p, const LoadOptions& options) {
                         " characters of text, found " + std::to_string(dataSize));
     }
     Volume v = makeVolume(L.dims, glm::dvec3(1.0), name);
-    if (text) {
+    if (text && expected == P.expected) {
         decodeText(std::string(data, data + dataSize), v.voxelCount(), L.type, v.data.data(),
                    dataName);
+    } else if (text) {  // every step's numbers are checked, one step's kept
+        std::vector<float> all(expected / sampleSize(L.type));
+        decodeText(std::string(data, data + dataSize), all.size(), L.type, all.data(), dataName);
+        std::copy_n(all.begin() + std::ptrdiff_t(before / sampleSize(L.type)), v.voxelCount(),
+                    v.data.begin());
     } else {
-        decodeSamples(data, v.voxelCount(), L.type, L.bigEndian, v.data.data());
+        decodeSamples(data + before, v.voxelCount(), L.type, L.bigEndian, v.data.data());
     }
 
     v.source = L.source;

@@ -1,6 +1,7 @@
 // Folders of 2D slices: PNG/TIFF stacks read through OpenImageIO (one image per z,
 // natural sort order so that slice2 comes before slice10); folders of DICOM files go to
-// the GDCM reader (load_dicom.cpp).
+// the GDCM reader (load_dicom.cpp); a folder of 3D volume files (NIfTI, NRRD, MetaImage) is a
+// time series, one step per file in natural order (LoadOptions::time picks it).
 //
 // Slice pixel (column c, row r) of the n-th slice becomes voxel (c, r, n); values keep
 // their native range (0..255 for 8-bit, 0..65535 for 16-bit images); colour images
@@ -18,6 +19,14 @@ OIIO_NAMESPACE_USING
 
 namespace splat::detail {
 namespace {
+
+/// A 3D volume file of a time-series folder (the header of a pair: .hdr, .nhdr, .mhd).
+bool isVolumeFile(const fs::path& p) {
+    std::string e = toLower(p.extension().string());
+    if (e == ".gz") e = toLower(p.stem().extension().string()) + e;
+    return e == ".nii" || e == ".nii.gz" || e == ".hdr" || e == ".nrrd" || e == ".nhdr" ||
+           e == ".mha" || e == ".mhd";
+}
 
 bool isSliceImage(const fs::path& p) {
     std::string e = toLower(p.extension().string());
@@ -92,7 +101,7 @@ bool isDicomFile(const fs::path& p) {
 
 Volume loadSliceFolder(const fs::path& dir, const LoadOptions& options) {
     const std::string name = displayName(dir);
-    std::vector<fs::path> images, dicoms;
+    std::vector<fs::path> images, dicoms, volumes;
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(dir, ec)) {
         if (!entry.is_regular_file()) continue;
@@ -100,6 +109,8 @@ Volume loadSliceFolder(const fs::path& dir, const LoadOptions& options) {
         if (p.filename().string().starts_with(".")) continue;
         if (isSliceImage(p))
             images.push_back(p);
+        else if (isVolumeFile(p))
+            volumes.push_back(p);
         else if (isDicomFile(p))
             dicoms.push_back(p);
     }
@@ -111,7 +122,23 @@ Volume loadSliceFolder(const fs::path& dir, const LoadOptions& options) {
         std::sort(dicoms.begin(), dicoms.end(), byName);
         return loadDicomFiles(name, dicoms, options);
     }
-    if (images.empty()) throw Error(name + ": folder holds no PNG/TIFF slices or DICOM files");
+    if (images.empty() && !volumes.empty()) {
+        std::sort(volumes.begin(), volumes.end(), byName);
+        const std::uint64_t step = timeStep(name, options, volumes.size());
+        LoadOptions one = options;
+        one.time.reset();  // the step is the file; a 4D file in it gives its first volume
+        Volume v = loadVolume(volumes[step].string(), one);
+        v.source += ", time step " + std::to_string(step) + " of " +
+                    std::to_string(volumes.size()) + " (" + name + ")";
+        if (!options.time && volumes.size() > 1)
+            addNote(v, "folder of " + std::to_string(volumes.size()) +
+                           " volume files, a time series: only the first was loaded (--time T "
+                           "loads another)");
+        return v;
+    }
+    if (images.empty())
+        throw Error(name + ": folder holds no PNG/TIFF slices, DICOM files or volume files");
+    timeStep(name, options, 1);  // a stack of slices has no time axis
     std::sort(images.begin(), images.end(), byName);
 
     std::vector<float> slice;

@@ -398,14 +398,17 @@ bool sampleLayoutOf(const std::string& spec, const LoadOptions& options, SampleL
     if (!fs::is_regular_file(p, ec)) return false;
     std::string ext = lowerExtension(p);
     std::optional<SampleLayout> L;
-    if (ext == ".nii" || ext == ".nii.gz")
-        L = niftiLayout(p);
-    else if (ext == ".nrrd" || ext == ".nhdr")
+    if (ext == ".nii" || ext == ".nii.gz") {
+        L = niftiLayout(p, options);
+    } else if (ext == ".nrrd" || ext == ".nhdr") {
         L = nrrdLayout(p, options);
-    else if (ext == ".mhd" || ext == ".mha")
+    } else if (ext == ".mhd" || ext == ".mha") {
+        timeStep(displayName(p), options, 1);  // no time axis
         L = metaImageLayout(p, options);
-    else if (ext == ".raw" || ext == ".raw.gz")
+    } else if (ext == ".raw" || ext == ".raw.gz") {
+        timeStep(displayName(p), options, 1);
         L = rawSampleLayout(p, options.raw);
+    }
     if (!L) return false;
     *layout = std::move(*L);
     return true;

@@ -57,7 +57,8 @@ struct SampleLayout {
 /// the loader (same errors), reading only the header's bytes.
 bool sampleLayoutOf(const std::string& spec, const LoadOptions& options, SampleLayout* layout);
 
-std::optional<SampleLayout> niftiLayout(const std::filesystem::path& p);
+std::optional<SampleLayout> niftiLayout(const std::filesystem::path& p,
+                                        const LoadOptions& options);
 std::optional<SampleLayout> nrrdLayout(const std::filesystem::path& p, const LoadOptions& options);
 std::optional<SampleLayout> metaImageLayout(const std::filesystem::path& p,
                                             const LoadOptions& options);

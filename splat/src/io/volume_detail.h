@@ -115,12 +115,17 @@ struct AxisMap {
 };
 AxisMap axisMapOf(const glm::dmat3& M, const std::string& source, const std::string& what);
 
+/// The time step LoadOptions::time picks from an input of `steps` time steps (0 when unset);
+/// a step past the last throws OptionError "NAME: time step T is out of range: ...". Inputs
+/// without a time axis have the one step 0.
+std::uint64_t timeStep(const std::string& name, const LoadOptions& options, std::uint64_t steps);
+
 /// The NaN/Inf policy of loadVolume (an error naming the first such voxel, or 0 for each).
 void applyNonFinitePolicy(Volume& v, NonFinitePolicy policy, const std::string& what);
 
 // ---- the loaders (one per file) --------------------------------------------------
 
-Volume loadNifti(const std::filesystem::path& p);
+Volume loadNifti(const std::filesystem::path& p, const LoadOptions& options);
 Volume loadNrrd(const std::filesystem::path& p, const LoadOptions& options);
 Volume loadMetaImage(const std::filesystem::path& p, const LoadOptions& options);
 Volume loadRaw(const std::filesystem::path& p, const RawOptions& options);
@@ -135,7 +140,7 @@ RawLayout rawLayout(const std::filesystem::path& p, const RawOptions& options);
 /// "synthetic:NAME[:N]" as its name and size (the default size when N is not given).
 std::pair<std::string, int> syntheticSpec(const std::string& spec);
 Volume loadSliceFolder(const std::filesystem::path& dir, const LoadOptions& options);
-/// DICOM files through GDCM (load_dicom.cpp): one series, sorted along the slice normal.
+/// DICOM files through GDCM (load_dicom.cpp, dicom_detail.h): one series, sorted along the slice normal.
 Volume loadDicomFiles(const std::string& name, const std::vector<std::filesystem::path>& files,
                       const LoadOptions& options);
 /// DICOM files: ".dcm"/".dicom" or the "DICM" magic after the 128-byte preamble.

@@ -58,12 +58,24 @@ void detail::applyNonFinitePolicy(Volume& v, NonFinitePolicy policy, const std::
     v.note += std::to_string(count) + " NaN/Inf samples replaced by 0";
 }
 
+std::uint64_t detail::timeStep(const std::string& name, const LoadOptions& options,
+                               std::uint64_t steps) {
+    if (!options.time) return 0;
+    if (*options.time >= 0 && std::uint64_t(*options.time) < steps)
+        return std::uint64_t(*options.time);
+    throw OptionError(name + ": time step " + std::to_string(*options.time) + " is out of range: " +
+                      (steps == 1 ? std::string("it holds one volume (time step 0)")
+                                  : "it holds time steps 0 to " + std::to_string(steps - 1)));
+}
+
 namespace {
 
 Volume loadByType(const fs::path& p, const std::string& ext, const LoadOptions& options) {
     if (ext == ".nii" || ext == ".nii.gz" || ext == ".hdr" || ext == ".img")
-        return detail::loadNifti(p);
+        return detail::loadNifti(p, options);
     if (ext == ".nrrd" || ext == ".nhdr") return detail::loadNrrd(p, options);
+    if (ext == ".mhd" || ext == ".mha" || ext == ".raw" || ext == ".raw.gz")
+        detail::timeStep(detail::displayName(p), options, 1);  // no time axis
     if (ext == ".mhd" || ext == ".mha") return detail::loadMetaImage(p, options);
     if (ext == ".raw" || ext == ".raw.gz") return detail::loadRaw(p, options.raw);
     if (ext == ".vdb") return detail::loadVdb(p, options);
@@ -100,6 +112,7 @@ std::pair<std::string, int> detail::syntheticSpec(const std::string& spec) {
 Volume loadVolume(const std::string& spec, const LoadOptions& options) {
     Volume v;
     if (spec.rfind("synthetic:", 0) == 0) {
+        detail::timeStep(spec, options, 1);
         v = loadSynthetic(spec);
     } else {
         if (spec.empty()) throw Error("empty VOLUME argument");

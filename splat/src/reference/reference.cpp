@@ -40,8 +40,8 @@
 // the halved ones' eps taken to fall 16x (Simpson), is within the bound, and the test is
 // repeated (at most kMaxPanelLevels halvings a panel). The factor 1/16 is calibrated: with it
 // the images are no further from a tight truth than the whole-ray scheme's at its default
-// first step 0.25 (README "Accuracy": ch2 256^2 at 30 degrees, RMSE 2.8e-7 vs 3.0e-7), at ~60% of its
-// samples. Early termination as below, at panel granularity, re-checked after refinement.
+// first step 0.25 (README "Accuracy": ch2 256^2 at 30 degrees, RMSE 2.8e-7 vs 3.0e-7), at ~60% of
+// its samples. Early termination as below, at panel granularity, re-checked after refinement.
 //
 //  - dvr: optical depth tau(t) by Simpson/quadratic interpolation of rho at every sample,
 //    I = int e exp(-tau) by Simpson. Early termination: a ray stops once
@@ -56,7 +56,12 @@
 //    post-classified, emission without extinction) the ray stops at
 //    T < min(tolerance, 1e-3) * 1e-3 as before. Tested in tests/test_reference.cpp.
 //  - xray: int f dt (world units). mip: max of the samples, polished by a golden-section
-//    search around the largest one (0 when the ray meets nothing).
+//    search around the largest one and around every other local maximum of the samples
+//    whose hill could rise above the best value found: a hill peaking between two samples
+//    h apart exceeds the larger one by at most |f''| h^2 / 8, about a quarter of the second
+//    difference |f(i-1) - 2 f(i) + f(i+1)|, which is taken near the sample, doubled. Which
+//    hill holds the largest sample depends on where the samples fall (a brick's segments
+//    start at its own face), the peak does not (0 when the ray meets nothing).
 //  - iso: first sample pair bracketing f = level, refined by bisection to 1e-9 voxels,
 //    shaded with the normalised gradient of f (central differences) under a headlight.
 #include "splat/reference.h"
@@ -89,6 +94,13 @@ constexpr double kPanelShare = 1.0 / 16.0;  // panel adaptivity: sum of shares <
 
 thread_local std::size_t tlSamples = 0;  // field samples taken on this thread
 
+// mip: a local maximum of a pass's samples, at t in segment `segment`, and the most its hill
+// can rise to between the neighbouring samples.
+struct MipPeak {
+    double bound = 0, t = 0;
+    int segment = 0;
+};
+
 // Per-thread scratch of one ray.
 template <int C>
 struct RayScratch {
@@ -96,6 +108,7 @@ struct RayScratch {
     std::vector<int> baseN;                                   // subintervals of pass 0
     std::vector<std::vector<std::array<float, C>>> old, cur;  // samples per segment
     std::vector<std::array<float, C>> tmp;
+    std::vector<MipPeak> peaks;  // mip: local maxima of the samples of one pass
 };
 
 using Sample4 = std::array<float, 4>;
@@ -531,6 +544,7 @@ class Caster {
         depth = -1;
         double mipT = 0;
         int mipSeg = -1;
+        sc.peaks.clear();
         for (std::size_t s = 0; s < sc.segments.size() && !stop; ++s) {
             const Segment seg = sc.segments[s];
             const int n = sc.baseN[s] << level;
@@ -587,6 +601,7 @@ class Caster {
                         mipT = seg.a + idx * h;
                     }
                 }
+                mipPeaks<C>(cur, int(s), seg.a, h, sc.peaks);
             } else {  // iso
                 const double level0 = settings_.isoLevel - background_;  // samples: f - b
                 double fPrev = sample(0)[0];
@@ -610,17 +625,48 @@ class Caster {
         if (mode == RenderMode::Dvr) return glm::dvec4(emission, 1.0 - T);
         if (mode == RenderMode::Xray) return glm::dvec4(xray, xray, xray, 1.0);
         if (mode == RenderMode::Mip) {
-            if (mipSeg >= 0) {
-                const Segment seg = sc.segments[mipSeg];
-                const double h = (seg.b - seg.a) / (sc.baseN[mipSeg] << level);
-                const double lo = std::max(seg.a, mipT - h), hi = std::min(seg.b, mipT + h);
+            auto polish = [&](int segment, double t) {
+                const Segment seg = sc.segments[std::size_t(segment)];
+                const double h = (seg.b - seg.a) / (sc.baseN[std::size_t(segment)] << level);
+                const double lo = std::max(seg.a, t - h), hi = std::min(seg.b, t + h);
                 mip = std::max(mip, goldenMax(g, p0, v, lo, hi));
+            };
+            if (mipSeg >= 0) {
+                polish(mipSeg, mipT);
+                std::sort(sc.peaks.begin(), sc.peaks.end(),
+                          [](const MipPeak& a, const MipPeak& b) { return a.bound > b.bound; });
+                for (const MipPeak& p : sc.peaks) {
+                    if (p.bound <= mip) break;
+                    if (p.segment != mipSeg || p.t != mipT) polish(p.segment, p.t);
+                }
             }
             mip += background_;  // the samples hold f - b; outside the data a ray sees b
             return glm::dvec4(mip, mip, mip, 1.0);
         }
         if (depth < 0) return glm::dvec4(0.0);
         return glm::dvec4(shade(g, p0, v, depth), 1.0);
+    }
+
+    // mip: the local maxima of one segment's samples f(0..n) (spacing h from t = a) whose hill
+    // could rise above 0, each with the bound of its hill (see the head of this file).
+    template <int C>
+    static void mipPeaks(const std::vector<std::array<float, C>>& f, int segment, double a,
+                         double h, std::vector<MipPeak>& peaks) {
+        const int n = int(f.size()) - 1;
+        auto second = [&](int i) {  // |second difference| at i, 0 at the ends
+            return i < 1 || i >= n
+                       ? 0.0
+                       : std::abs(double(f[std::size_t(i - 1)][0]) - 2.0 * f[std::size_t(i)][0] +
+                                  f[std::size_t(i + 1)][0]);
+        };
+        for (int i = 0; i <= n; ++i) {
+            const double fi = f[std::size_t(i)][0];
+            if ((i > 0 && f[std::size_t(i - 1)][0] > fi) ||
+                (i < n && f[std::size_t(i + 1)][0] > fi))
+                continue;
+            const double rise = 0.25 * std::max({second(i - 1), second(i), second(i + 1)});
+            if (fi + rise > 0) peaks.push_back({fi + rise, a + i * h, segment});
+        }
     }
 
     template <int C>
