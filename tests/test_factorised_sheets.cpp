@@ -74,7 +74,9 @@ TEST_CASE("factorised sheets: reference error no worse than the per-splat frame'
         ref.renderer = RendererKind::Reference;
         const Image r = render(v, ref);
         const Image a = render(v, phantomSettings(64, view.azimuth, view.elevation, 0));
-        const Image f = render(v, phantomSettings(64, view.azimuth, view.elevation, 4));
+        // 8 samples per voxel: the phantom's opaque rim is sharp on a 64^2 image (a voxel is
+        // 0.8 pixels), where 4 samples per voxel still leave an interpolation error of 2e-3.
+        const Image f = render(v, phantomSettings(64, view.azimuth, view.elevation, 8));
         const double ea = rmse(a, r), ef = rmse(f, r);
         INFO("azimuth " << view.azimuth << ": axis " << ea << ", factorised " << ef);
         CHECK(ef < 1.1 * ea + 1e-4);
