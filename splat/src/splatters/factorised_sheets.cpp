@@ -100,10 +100,10 @@ Factorisation factorise(const Scene::Impl& scene, const Camera& camera, const Re
         vHi = std::max(vHi, p.y);
     }
     auto sample = [&](double x, double x0) { return (x - x0) * f.n; };
-    f.a0 = int(std::floor(std::max(0.0, sample(uLo, f.U0)))) - 1;
-    f.b0 = int(std::floor(std::max(0.0, sample(vLo, f.V0)))) - 1;
-    const int a1 = int(std::ceil(std::min(sample(U1, f.U0), sample(uHi, f.U0)))) + 2;
-    const int b1 = int(std::ceil(std::min(sample(V1, f.V0), sample(vHi, f.V0)))) + 2;
+    f.a0 = int(std::floor(std::max(0.0, sample(uLo, f.U0)))) - 2;
+    f.b0 = int(std::floor(std::max(0.0, sample(vLo, f.V0)))) - 2;
+    const int a1 = int(std::ceil(std::min(sample(U1, f.U0), sample(uHi, f.U0)))) + 3;
+    const int b1 = int(std::ceil(std::min(sample(V1, f.V0), sample(vHi, f.V0)))) + 3;
     f.width = std::max(0, a1 - f.a0);
     f.height = std::max(0, b1 - f.b0);
     return f;
@@ -293,7 +293,17 @@ std::size_t renderBand(const Factorisation& f, const SheetSplats& list,
     return weights;
 }
 
-/// The screen image: the composited window at each pixel centre, bilinearly.
+/// Catmull-Rom weights of the four samples around a point t in [0, 1) past the second.
+inline void catmullRom(float t, float (&w)[4]) {
+    w[0] = ((-t + 2.0f) * t - 1.0f) * t * 0.5f;
+    w[1] = ((3.0f * t - 5.0f) * t * t + 2.0f) * 0.5f;
+    w[2] = ((-3.0f * t + 4.0f) * t + 1.0f) * t * 0.5f;
+    w[3] = (t - 1.0f) * t * t * 0.5f;
+}
+
+/// The screen image: the composited window at each pixel centre, by the Catmull-Rom spline
+/// through its samples, opacity clamped to [0, 1] and colour to [0, opacity] (the spline's
+/// overshoot at opaque edges).
 Image warp(const Factorisation& f, const Composited& w, int width, int height) {
     Image image(width, height);
     tbb::parallel_for(0, height, [&](int y) {
@@ -301,16 +311,24 @@ Image warp(const Factorisation& f, const Composited& w, int width, int height) {
             const glm::dvec2 p = f.sheet({x + 0.5, y + 0.5});
             const double ga = (p.x - f.U0) * f.n - f.a0, gb = (p.y - f.V0) * f.n - f.b0;
             const double fa = std::floor(ga), fb = std::floor(gb);
-            if (!(fa >= 0 && fb >= 0 && fa + 1 < f.width && fb + 1 < f.height)) continue;
+            if (!(fa >= 1 && fb >= 1 && fa + 2 < f.width && fb + 2 < f.height)) continue;
             const float ta = float(ga - fa), tb = float(gb - fb);
-            const std::size_t o = std::size_t(fb) * std::size_t(f.width) + std::size_t(fa),
-                              o2 = o + std::size_t(f.width);
-            auto at = [&](const std::vector<float>& c) {
-                const float top = c[o] + ta * (c[o + 1] - c[o]);
-                const float bottom = c[o2] + ta * (c[o2 + 1] - c[o2]);
-                return top + tb * (bottom - top);
-            };
-            image.at(x, y) = glm::vec4(at(w.r), at(w.g), at(w.b), at(w.a));
+            float wa[4], wb[4];
+            catmullRom(ta, wa);
+            catmullRom(tb, wb);
+            const std::size_t o =
+                (std::size_t(fb) - 1) * std::size_t(f.width) + std::size_t(fa) - 1;
+            glm::vec4 sum(0.0f);
+            for (int j = 0; j < 4; ++j) {
+                const std::size_t r = o + std::size_t(j) * std::size_t(f.width);
+                glm::vec4 row(0.0f);
+                for (int i = 0; i < 4; ++i)
+                    row += wa[i] * glm::vec4(w.r[r + i], w.g[r + i], w.b[r + i], w.a[r + i]);
+                sum += wb[j] * row;
+            }
+            const float a = std::clamp(sum.a, 0.0f, 1.0f);
+            image.at(x, y) = glm::vec4(std::clamp(sum.r, 0.0f, a), std::clamp(sum.g, 0.0f, a),
+                                       std::clamp(sum.b, 0.0f, a), a);
         }
     });
     return image;
