@@ -155,7 +155,9 @@ struct Quality {
     /// merged levels: 0 splats every footprint into screen tiles (the default); n >= 1 uses
     /// factorised sheets instead (splatters/factorised_sheets.h: one footprint stamp per
     /// sheet on an intermediate image of n samples per voxel along the sheet, warped to the
-    /// screen once). Other frames ignore it.
+    /// screen once). -P (an experiment, any orthographic frame of the axis-aligned splatter):
+    /// per-frame footprint stamps at P x P sub-pixel phases instead of the footprint
+    /// polynomial per pixel. Other frames ignore it.
     int factorisedSheets = 0;
     /// The EWA low-pass when pixelFilter is 0, pixels (pbrt-v4's Gaussian pixel filter).
     static constexpr double kEwaDefaultSigma = 0.5;
