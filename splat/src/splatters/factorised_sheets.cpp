@@ -167,6 +167,43 @@ SheetSplats sheetSplats(const Scene::Impl& scene, int m, int u, int v, const flo
     return out;
 }
 
+/// The splats of row v of sheet q, list positions [first, second), by u, from one of two
+/// sources. Sheets along j or k (ListRows): a row (k, j) of the list is consecutive
+/// (Scene::Impl::cellStarts), read in place. Sheets along i (GatheredRows): the list
+/// gathered in sheet order (SheetSplats), rows found by bisection.
+struct ListRows {
+    const SplatList& s;
+    const std::vector<std::uint32_t>& cells;
+    std::size_t ny, cx;
+    int m, rows;  ///< sheet axis (1 or 2), rows per sheet
+    const float *er, *eg, *eb;
+    std::pair<std::size_t, std::size_t> range(int q, int v) const {
+        const std::size_t k = std::size_t(m == 2 ? q : v), j = std::size_t(m == 2 ? v : q);
+        const std::size_t c = (k * ny + j) * cx;
+        return {cells[c], cells[c + cx]};
+    }
+    int u(std::size_t p) const { return s.i[p]; }
+    glm::vec4 value(std::size_t p) const {
+        const glm::vec4 e = s.emission(p);
+        return er ? glm::vec4(e.x, er[p], eg[p], eb[p]) : e;
+    }
+};
+
+struct GatheredRows {
+    const SheetSplats& list;
+    int rows;
+    std::pair<std::size_t, std::size_t> range(int q, int v) const {
+        const std::vector<std::uint32_t>& start = *list.start;
+        const auto first = list.v.begin() + std::ptrdiff_t(start[std::size_t(q)]),
+                   last = list.v.begin() + std::ptrdiff_t(start[std::size_t(q) + 1]);
+        const auto lo = std::lower_bound(first, last, std::uint16_t(v));
+        const auto hi = std::upper_bound(lo, last, std::uint16_t(v));
+        return {std::size_t(lo - list.v.begin()), std::size_t(hi - list.v.begin())};
+    }
+    int u(std::size_t p) const { return list.u[p]; }
+    const glm::vec4& value(std::size_t p) const { return list.value[p]; }
+};
+
 /// The composited intermediate window: premultiplied colour and opacity, row-major.
 struct Composited {
     std::vector<float> r, g, b, a;
@@ -209,7 +246,8 @@ inline void addStampRow(float* p, std::size_t plane, const float* w, int width,
 /// stamp's width of margin either side), then composited into `out`. Front to back, a
 /// splat whose columns are opaque (every pixel of the band in each 8-column block) is
 /// skipped, and the band ends when all are. Returns the weights added.
-std::size_t renderBand(const Factorisation& f, const SheetSplats& list,
+template <class Rows>
+std::size_t renderBand(const Factorisation& f, const Rows& list, int sheets,
                        const std::vector<SheetStamp>& stamps, int row0, int rows,
                        CompositeOrder order, double earlyTermination, Composited& out) {
     const int margin = f.stampW, stride = f.width + 2 * f.stampW + 8;
@@ -221,8 +259,7 @@ std::size_t renderBand(const Factorisation& f, const SheetSplats& list,
     std::vector<std::uint8_t> opaque(std::size_t(blocks), 0);
     int opaqueCount = 0;
     std::size_t weights = 0;
-    const std::vector<std::uint32_t>& start = *list.start;
-    const int sheets = int(start.size()) - 1, n = f.n;
+    const int n = f.n;
     auto floorDiv = [](int x, int y) { return x >= 0 ? x / y : -((-x + y - 1) / y); };
     for (int k = 0; k < sheets && !(terminates && opaqueCount == blocks); ++k) {
         const int q = f.ascending ? k : sheets - 1 - k;
@@ -230,34 +267,32 @@ std::size_t renderBand(const Factorisation& f, const SheetSplats& list,
         // Voxel rows whose stamp rows n v + st.b + dB - b0 + [0, stampH) meet the band.
         const int top = st.b + f.dB - f.b0;
         const int vLo = std::max(0, -floorDiv(top + f.stampH - 1 - row0, n));
-        const int vHi = floorDiv(row0 + rows - 1 - top, n);
-        if (vHi < vLo) continue;
-        const auto first = list.v.begin() + std::ptrdiff_t(start[std::size_t(q)]),
-                   last = list.v.begin() + std::ptrdiff_t(start[std::size_t(q) + 1]);
-        const auto lo = std::lower_bound(first, last, std::uint16_t(std::min(vLo, 65535)));
-        const auto hi = std::upper_bound(lo, last, std::uint16_t(std::min(vHi, 65535)));
+        const int vHi = std::min(floorDiv(row0 + rows - 1 - top, n), list.rows - 1);
         int x0 = stride, x1 = -1, y0 = rows, y1 = -1;
-        for (std::size_t p = std::size_t(lo - list.v.begin()), e = std::size_t(hi - list.v.begin());
-             p < e; ++p) {
-            const int col = n * int(list.u[p]) + st.a + f.dA - f.a0;  // stamp column 0
-            if (col + f.stampW <= 0 || col >= f.width) continue;
-            if (terminates) {
-                const int c0 = std::max(col, 0) / kBlock,
-                          c1 = std::min(col + f.stampW - 1, f.width - 1) / kBlock;
-                bool hidden = true;
-                for (int c = c0; c <= c1 && hidden; ++c) hidden = opaque[std::size_t(c)] != 0;
-                if (hidden) continue;
-            }
-            const int row = n * int(list.v[p]) + top - row0;  // stamp row 0, band rows
+        for (int v = vLo; v <= vHi; ++v) {
+            const auto [pFirst, pEnd] = list.range(q, v);
+            const int row = n * v + top - row0;  // stamp row 0, band rows
             const int ys = std::max(0, -row), ye = std::min(f.stampH, rows - row);
-            for (int y = ys; y < ye; ++y)
-                addStampRow(&sheet[std::size_t(row + y) * stride + std::size_t(col + margin)],
-                            plane, &st.w[std::size_t(y) * f.stampW], f.stampW, list.value[p]);
-            weights += std::size_t(ye - ys) * std::size_t(f.stampW);
-            x0 = std::min(x0, col);
-            x1 = std::max(x1, col + f.stampW - 1);
-            y0 = std::min(y0, row + ys);
-            y1 = std::max(y1, row + ye - 1);
+            for (std::size_t p = pFirst; p < pEnd; ++p) {
+                const int col = n * list.u(p) + st.a + f.dA - f.a0;  // stamp column 0
+                if (col + f.stampW <= 0 || col >= f.width) continue;
+                if (terminates) {
+                    const int c0 = std::max(col, 0) / kBlock,
+                              c1 = std::min(col + f.stampW - 1, f.width - 1) / kBlock;
+                    bool hidden = true;
+                    for (int c = c0; c <= c1 && hidden; ++c) hidden = opaque[std::size_t(c)] != 0;
+                    if (hidden) continue;
+                }
+                const glm::vec4 value = list.value(p);
+                for (int y = ys; y < ye; ++y)
+                    addStampRow(&sheet[std::size_t(row + y) * stride + std::size_t(col + margin)],
+                                plane, &st.w[std::size_t(y) * f.stampW], f.stampW, value);
+                weights += std::size_t(ye - ys) * std::size_t(f.stampW);
+                x0 = std::min(x0, col);
+                x1 = std::max(x1, col + f.stampW - 1);
+                y0 = std::min(y0, row + ys);
+                y1 = std::max(y1, row + ye - 1);
+            }
         }
         if (x1 < x0) continue;
         // Composite the written rectangle (its part inside the window), then clear it.
@@ -349,8 +384,21 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
                              const float* eb, RenderStats& stats) {
     const auto start = Clock::now();
     const Factorisation f = factorise(scene, camera, s);
-    const SheetSplats list = sheetSplats(scene, f.m, f.u, f.v, er, eg, eb);
-    const int sheets = scene.volume->dims[f.m];
+    const glm::ivec3 dims = scene.volume->dims;
+    const int sheets = dims[f.m];
+    // Sheets along i cross the list's rows: gathered in sheet order; others read in place.
+    SheetSplats gathered;
+    if (f.m == 0) gathered = sheetSplats(scene, f.m, f.u, f.v, er, eg, eb);
+    const GatheredRows gatheredRows{gathered, dims[f.v]};
+    const ListRows listRows{scene.splats,
+                            scene.cellStarts(),
+                            std::size_t(dims.y),
+                            std::size_t(scene.cellsX()),
+                            f.m,
+                            dims[f.v],
+                            er,
+                            eg,
+                            eb};
     std::vector<SheetStamp> stamps(static_cast<std::size_t>(sheets));
     tbb::parallel_for(0, sheets,
                       [&](int q) { stamps[std::size_t(q)] = sheetStamp(f, q, scene.table); });
@@ -366,8 +414,10 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
     std::vector<std::size_t> weights(std::size_t(bands), 0);
     tbb::parallel_for(0, bands, [&](int k) {
         const int row0 = k * kBand, rows = std::min(kBand, f.height - row0);
-        weights[std::size_t(k)] =
-            renderBand(f, list, stamps, row0, rows, s.order, s.quality.earlyTermination, w);
+        weights[std::size_t(k)] = f.m == 0 ? renderBand(f, gatheredRows, sheets, stamps, row0, rows,
+                                                        s.order, s.quality.earlyTermination, w)
+                                           : renderBand(f, listRows, sheets, stamps, row0, rows,
+                                                        s.order, s.quality.earlyTermination, w);
     });
     Image image = warp(f, w, camera.width(), camera.height());
     stats.tilesMs = msSince(tiles);
