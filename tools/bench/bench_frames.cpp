@@ -12,6 +12,7 @@
 //       scene's build time, splat count and bytes per splat. RENDER OPTIONS are `splat
 //       render`'s own (tools/cli/render_options.h: --renderer, --mode, --slab, --lod, --ewa,
 //       --pixel-filter, --size WxH or N, --threads (default 2), --elevation (default 15), ...),
+//       and --factorised-sheets N (Quality::factorisedSheets, not a `splat render` option yet),
 //       parsed by the same code, so any value the command line accepts (e.g. a new `--lod`
 //       mode) works here too; TF is the --tf value (a preset or a JSON file). Frames listed in
 //       --save are written to DIR/frame_K.f32 (float RGBA, row 0 at the top); the reference
@@ -94,6 +95,9 @@ int renderRotation(const std::string& spec, const std::string& tf,
     app.add_option("--warmup", warmupFlag, "1: render two frames before timing");
     app.add_option("--save", saveList, "frames to write as DIR/frame_K.f32");
     app.add_option("--out", out, "folder of the saved frames");
+    int factorised = 0;
+    app.add_option("--factorised-sheets", factorised,
+                   "axis-aligned: factorised sheets with N samples per voxel (0: off)");
     // --size N means N x N.
     for (std::size_t i = 0; i + 1 < args.size(); ++i)
         if (args[i] == "--size" && args[i + 1].find_first_of("xX") == std::string::npos)
@@ -107,6 +111,7 @@ int renderRotation(const std::string& spec, const std::string& tf,
         return 2;
     }
     splat::RenderSettings s = splat::cli::settingsFromArgs(r, splat::cli::RenderUse{});
+    s.quality.factorisedSheets = factorised;
     frames = std::max(1, frames);
     const double elevation = s.camera.elevationDeg;
     const bool warmup = warmupFlag != 0;

@@ -151,6 +151,14 @@ struct Quality {
     /// leaves every other mode and image size bit-identical to off (README "Aliasing and
     /// EWA").
     Ewa ewa = Ewa::Auto;
+    /// Axis-aligned splatter, orthographic pre-classified dvr without clipping, labels, EWA or
+    /// merged levels: 0 splats every footprint into screen tiles (the default); n >= 1 uses
+    /// factorised sheets instead (splatters/factorised_sheets.h: one footprint stamp per
+    /// sheet on an intermediate image of n samples per voxel along the sheet, warped to the
+    /// screen once). -P (an experiment, any orthographic frame of the axis-aligned splatter):
+    /// per-frame footprint stamps at P x P sub-pixel phases instead of the footprint
+    /// polynomial per pixel. Other frames ignore it.
+    int factorisedSheets = 0;
     /// The EWA low-pass when pixelFilter is 0, pixels (pbrt-v4's Gaussian pixel filter).
     static constexpr double kEwaDefaultSigma = 0.5;
     /// Ewa::Auto turns EWA on while a voxel covers fewer pixels than this (measured, README).

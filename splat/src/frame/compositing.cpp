@@ -92,6 +92,33 @@ void TileAccumulator::compositeOpticalDepths(int p, int n, const float* tau, con
         composite(p + i, sampleFromOpticalDepth(tau[i], er[i], eg[i], eb[i]));
 }
 
+void compositeOpticalDepthRow(float* r, float* g, float* b, float* a, CompositeOrder order, int n,
+                              const float* tau, const float* er, const float* eg,
+                              const float* eb) {
+    const bool frontToBack = order == CompositeOrder::FrontToBack;
+#if defined(FOOTPRINT_HAVE_LANES)
+    if (footprint::cpuHasLanes()) {
+        compositeOpticalDepthsLanes(r, g, b, a, frontToBack, n, tau, er, eg, eb);
+        return;
+    }
+#endif
+    for (int i = 0; i < n; ++i) {
+        const Sample s = sampleFromOpticalDepth(tau[i], er[i], eg[i], eb[i]);
+        const float t = frontToBack ? 1.0f - a[i] : 1.0f - s.alpha;
+        if (frontToBack) {
+            r[i] += t * s.r;
+            g[i] += t * s.g;
+            b[i] += t * s.b;
+            a[i] += t * s.alpha;
+        } else {
+            r[i] = s.r + t * r[i];
+            g[i] = s.g + t * g[i];
+            b[i] = s.b + t * b[i];
+            a[i] = s.alpha + t * a[i];
+        }
+    }
+}
+
 TileAccumulator::TileAccumulator(int width, int height, CompositeOrder order,
                                  double earlyTermination, bool surface)
     : w_(width),

@@ -28,6 +28,14 @@ inline Sample sampleFromOpticalDepth(float tau, float er, float eg, float eb) {
     return {alpha, er * k, eg * k, eb * k};
 }
 
+/// Composites n pixels of a row held in plain arrays (premultiplied r, g, b and opacity a) with
+/// the samples of optical depths tau and emissions er, eg, eb in `order`: the lanes of
+/// TileAccumulator::compositeOpticalDepths for accumulators that are not tiles (the
+/// factorised sheets' intermediate image).
+void compositeOpticalDepthRow(float* r, float* g, float* b, float* a, CompositeOrder order, int n,
+                              const float* tau, const float* er, const float* eg,
+                              const float* eb);
+
 /// Compositing state of one tile: premultiplied colour and opacity (b in splat/DESIGN.md) for
 /// dvr; for mip the running maximum and for xray the running sum, both in r.
 class TileAccumulator {

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <memory>
 #include <mutex>
+#include <optional>
 
 #include "footprint/lanes.h"
 #include "splatters/splatter.h"
@@ -120,6 +121,72 @@ int splatFootprintVector(SheetBuffer<NCh>& sheet, const float (&values)[NCh], fl
     return splatFootprintLanes(sheet, values, sx, sy, e, rect, table,
                                footprint::FootprintLanes(table, poly));
 }
+/// Per-frame footprint stamps (orthographic views, one ellipse for every splat): the
+/// footprint rasterised once per frame at `phases` x `phases` sub-pixel phases, so that a
+/// splat adds a stamp, the one of its phase rounded to the nearest 1 / phases pixel (its
+/// position moved by at most 1 / (2 phases) pixels along each axis), with no polynomial per
+/// pixel.
+class PhaseStamps {
+  public:
+    PhaseStamps(const footprint::EllipticalFootprint& e, const footprint::FootprintTable& table,
+                int phases)
+        : phases_(phases),
+          k0_(int(std::floor(-e.halfWidth)) - 1),
+          l0_(int(std::floor(-e.halfHeight)) - 1),
+          width_(int(std::ceil(e.halfWidth)) + 2 - k0_),
+          height_(int(std::ceil(e.halfHeight)) + 2 - l0_),
+          stride_((width_ + 7) / 8 * 8 + 8) {
+        w_.assign(std::size_t(phases + 1) * (phases + 1) * height_ * stride_, 0.0f);
+        for (int py = 0; py <= phases; ++py)
+            for (int px = 0; px <= phases; ++px)
+                for (int l = 0; l < height_; ++l)
+                    for (int k = 0; k < width_; ++k) {
+                        const float dx = float(k0_ + k) - float(px) / float(phases),
+                                    dy = float(l0_ + l) - float(py) / float(phases);
+                        const float r2 = e.r2(dx, dy);
+                        if (r2 < table.r2Max())
+                            w_[index(px, py, l) + std::size_t(k)] = table.lookup(r2) * e.scale;
+                    }
+    }
+    /// Adds values * stamp for a splat at (sx, sy) to the pixels of `rect`.
+    template <int NCh>
+    int add(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx, float sy,
+            const PixelRect& rect) const {
+        // Pixel x's centre x + 0.5 lies k - phase from the splat, k = x - base.
+        const float fx = sx - 0.5f, fy = sy - 0.5f;
+        const int bx = int(std::floor(fx)), by = int(std::floor(fy));
+        const int px = int(std::lround((fx - float(bx)) * float(phases_)));
+        const int py = int(std::lround((fy - float(by)) * float(phases_)));
+        const int ox = sheet.originX(), oy = sheet.originY();
+        const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
+        sheet.markDirty(x0, x1, y0, y1);
+        const std::ptrdiff_t plane = NCh > 1 ? sheet.row(1, 0) - sheet.row(0, 0) : 0;
+        __m256 vv[NCh];
+        for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+        const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        const int k = rect.x0 - bx - k0_, n = x1 - x0 + 1;
+        for (int y = y0; y <= y1; ++y) {
+            const float* w = &w_[index(px, py, y + oy - by - l0_)] + k;
+            float* const base = sheet.row(0, y) + x0;
+            for (int i = 0; i < n; i += 8) {
+                const __m256i mask = _mm256_cmpgt_epi32(_mm256_set1_epi32(n - i), lane);
+                const __m256 wv = _mm256_maskload_ps(w + i, mask);
+                float* p = base + i;
+                for (int c = 0; c < NCh; ++c, p += plane)
+                    _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], wv, _mm256_loadu_ps(p)));
+            }
+        }
+        return n * (y1 - y0 + 1);
+    }
+
+  private:
+    std::size_t index(int px, int py, int l) const {
+        return ((std::size_t(py) * (phases_ + 1) + std::size_t(px)) * height_ + std::size_t(l)) *
+               stride_;
+    }
+    int phases_, k0_, l0_, width_, height_, stride_;
+    std::vector<float> w_;
+};
 FOOTPRINT_LANES_END
 #endif
 
@@ -157,6 +224,9 @@ struct WholeFootprints {
     std::uint32_t slices;
     const footprint::FootprintTable& table;
     const footprint::FootprintPoly* poly;
+#if defined(FOOTPRINT_HAVE_LANES)
+    const PhaseStamps* stamps = nullptr;  ///< per-frame footprint stamps, when asked for
+#endif
 
     template <class Record>  // SplatRecord or RunRecord
     std::uint32_t key(const Record& s) const {
@@ -168,6 +238,10 @@ struct WholeFootprints {
     template <int NCh>
     int cut(SheetBuffer<NCh>* const* sheets, const SplatRecord& s, const float (&v)[NCh],
             const footprint::EllipticalFootprint& e, const PixelRect& r) const {
+#if defined(FOOTPRINT_HAVE_LANES)
+        if constexpr (NCh != kLabelChannels)
+            if (stamps) return stamps->add(*sheets[0], v, s.sx, s.sy, r);
+#endif
         return splatFootprint(*sheets[0], v, s.sx, s.sy, e, r, table, poly);
     }
 };
@@ -438,9 +512,23 @@ class AxisAligned final : public Splatter {
     Image rasterize(const TileInputs& in, FrameWorkspace& work, RenderStats* stats) const override {
         const SplatList& s = in.scene.splats;
         const int m = in.plan.axis;
-        const WholeFootprints cutter{m == 0 ? s.i : (m == 1 ? s.j : s.k), in.plan.ascending,
-                                     in.plan.sheets, in.scene.table,
-                                     in.scene.poly ? &*in.scene.poly : nullptr};
+        WholeFootprints cutter{m == 0 ? s.i : (m == 1 ? s.j : s.k), in.plan.ascending,
+                               in.plan.sheets, in.scene.table,
+                               in.scene.poly ? &*in.scene.poly : nullptr};
+#if defined(FOOTPRINT_HAVE_LANES)
+        // Quality::factorisedSheets < 0 (an experiment beside factorised sheets): per-frame
+        // footprint stamps at -factorisedSheets phases per pixel, orthographic views only.
+        std::optional<PhaseStamps> stamps;
+        const int phases = -in.settings.quality.factorisedSheets;
+        if (phases > 0 && !in.camera.perspective() && footprint::cpuHasLanes()) {
+            const SplatProjector projector(
+                s, in.camera, in.scene.volume->spacing, in.scene.kernel.radius(),
+                footprintFilter(in.scene.kernel, in.settings.quality, in.settings.mode, in.camera,
+                                *in.scene.volume, in.scene.level));
+            stamps.emplace(projector.shared(), in.scene.table, phases);
+            cutter.stamps = &*stamps;
+        }
+#endif
         return rasterizeChunksWithPolicy(in, cutter, work.chunks, work.chunkBins, stats);
     }
 };

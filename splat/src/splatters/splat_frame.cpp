@@ -13,6 +13,7 @@
 #include "frame/stopwatch.h"
 #include "frame/tile_binning.h"
 #include "frame/workspace.h"
+#include "splatters/factorised_sheets.h"
 #include "splatters/splatter.h"
 
 namespace splat {
@@ -100,6 +101,12 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
         footprintFilter(scene.kernel, s.quality, s.mode, camera, *scene.volume, scene.level)
             .lowPass;
     const Emission e = shade(scene, camera, *work, stats);
+    if (!depth && factorisedSheetsApply(camera, s, scene.settings.labels.enabled,
+                                        s.clipping.enabled(), stats.ewaSigma, scene.level)) {
+        Image image = renderFactorisedSheets(scene, camera, s, e.r, e.g, e.b, stats);
+        applyBackground(image, s.mode, s.background, scene.splats.background);
+        return image;
+    }
     if (!splatter.streams()) project(scene, camera, s.quality, s.mode, *work, stats);
     const SheetPlan plan = order(splatter, scene, camera, s, *work, stats);
     if (!splatter.streams()) bin(camera, s, *work, stats);

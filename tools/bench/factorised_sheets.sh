@@ -1,0 +1,49 @@
+#!/bin/bash
+# The axis-aligned splatter's per-splat footprints against factorised sheets (n samples per
+# voxel, Quality::factorisedSheets) and per-frame footprint stamps (-P phases) on ch2, the
+# shared transfer function of vs_vtk.py: each setting's median CPU time per frame over a
+# 6-frame rotation (elevation 15), settings interleaved in rounds, its ratio to the per-splat
+# frame, and each setting's RMSE against the reference ray caster on frames 0 and 1.
+# Usage: bash tools/bench/factorised_sheets.sh [BUILD] (default build; needs bench_frames).
+# Environment: SIZES (default "256 512"), SETTINGS (default "0 1 2 -16"), ROUNDS (default 2).
+set -euo pipefail
+BIN=${1:-build}/bin/bench_frames
+CH2=/usr/share/mricron/templates/ch2.nii.gz
+[ -x "$BIN" ] || { echo "factorised_sheets: $BIN is missing" >&2; exit 1; }
+[ -f "$CH2" ] || { echo "factorised_sheets: $CH2 is missing (Debian package mricron-data)" >&2; exit 77; }
+OUT=$(mktemp -d /tmp/factorised_sheets.XXXXXX)
+TF=$OUT/tf.json
+cat > "$TF" <<'JSON'
+{"domain": "normalized", "unit_distance": 1.0, "points": [[0.0, 0.0, 0.0, 0.0, 0.0], [0.25, 0.45, 0.3, 0.25, 0.0], [0.5, 0.9, 0.6, 0.5, 0.3], [1.0, 1.0, 1.0, 1.0, 0.8]]}
+JSON
+SIZES=${SIZES:-"256 512"}
+SETTINGS=${SETTINGS:-"0 1 2 -16"}
+ROUNDS=${ROUNDS:-2}
+for S in $SIZES; do
+    mkdir -p "$OUT/${S}_ref"
+    nice "$BIN" render "$CH2" "$TF" --renderer reference --size "$S" --frames 6 --save 0,1 \
+        --out "$OUT/${S}_ref" > /dev/null
+    for r in $(seq 1 "$ROUNDS"); do
+        for N in $SETTINGS; do
+            mkdir -p "$OUT/${S}_$N"
+            nice "$BIN" render "$CH2" "$TF" --renderer axis --size "$S" --frames 6 \
+                --factorised-sheets="$N" --save 0,1 --out "$OUT/${S}_$N" > "$OUT/${S}_${N}_r$r.json"
+        done
+    done
+done
+/usr/bin/python3 - "$OUT" "$BIN" "$SIZES" "$SETTINGS" <<'PY'
+import glob, json, statistics, subprocess, sys
+out, binary, sizes, settings = sys.argv[1], sys.argv[2], sys.argv[3].split(), sys.argv[4].split()
+for s in sizes:
+    base = None
+    for n in settings:
+        cpu = [f["cpu_ms"] for p in glob.glob(f"{out}/{s}_{n}_r*.json")
+               for f in json.load(open(p))["frames"]]
+        med = statistics.median(cpu)
+        base = base or med
+        errs = [json.loads(subprocess.check_output(
+            [binary, "compare", f"{out}/{s}_{n}/frame_{k}.f32", f"{out}/{s}_ref/frame_{k}.f32",
+             s, s]))["rmse"] for k in (0, 1)]
+        print(f"{s}^2 setting {n:>4}: CPU {med:6.1f} ms per frame, {med / base:.2f}x per-splat; "
+              f"RMSE vs reference {errs[0]:.2e} {errs[1]:.2e}")
+PY
