@@ -99,8 +99,8 @@ nlohmann::json manifestOf(const RotateCommand& a, const RenderSettings& s) {
             {"renderer", toString(s.renderer)},
             {"mode", toString(s.mode)},
             {"classify", toString(s.classification)},
-            {"tf", a.render.tfInline.is_null() ? nlohmann::json(a.render.tf) : a.render.tfInline},
-            {"size", a.render.size},
+            {"tf", a.render.values.tfInline.empty() ? nlohmann::json(a.render.values.text("tf")) : nlohmann::json::parse(a.render.values.tfInline)},
+            {"size", a.render.size()},
             {"azimuth", s.camera.azimuthDeg},
             {"elevation", s.camera.elevationDeg},
             {"slab", s.quality.slab},
@@ -438,7 +438,7 @@ void registerRotate(CLI::App& app) {
                     double(a->frames) * settings.camera.width * settings.camera.height >
                         double(1 << 28))
                     throw Error("--gif/--contact-sheet with " + std::to_string(a->frames) +
-                                " frames of " + a->render.size +
+                                " frames of " + a->render.size() +
                                 " would not fit in memory; use fewer frames or a smaller --size");
                 keep = prepareFolder(*a, manifest, settings.camera.width, settings.camera.height);
                 beginRun(*cmd);

@@ -17,6 +17,7 @@
 #include "splat/frame_farm.h"
 #include "splat/image_io.h"
 #include "splat/metrics.h"
+#include "splat/options.h"
 #include "splat/render.h"
 #include "splat/scene.h"
 
@@ -34,24 +35,6 @@ double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     const std::size_t n = v.size();
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double parseNumber(const std::string& knob, const std::string& text) {
-    try {
-        std::size_t used = 0;
-        const double v = std::stod(text, &used);
-        if (used != text.size()) throw std::invalid_argument(text);
-        return v;
-    } catch (const std::exception&) {
-        throw Error("--sweep " + knob + ": '" + text + "' is not a number");
-    }
-}
-
-int parseInt(const std::string& knob, const std::string& text) {
-    const double v = parseNumber(knob, text);
-    if (v != std::floor(v) || std::abs(v) > 1e9)
-        throw Error("--sweep " + knob + ": '" + text + "' is not an integer");
-    return int(v);
 }
 
 /// Peak resident set size since the last reset (Linux /proc; 0 elsewhere), MiB.
@@ -171,81 +154,24 @@ class Progress {
 }  // namespace
 
 std::vector<std::string> studyKnobNames() {
-    return {"renderer",
-            "slab",
-            "early-termination",
-            "size",
-            "order",
-            "classify",
-            "kernel",
-            "sigma",
-            "radius",
-            "footprint-res",
-            "slab-radial-res",
-            "slab-depth-res",
-            "poly-tol",
-            "lod",
-            "ewa",
-            "pixel-filter"};
+    return {studyKnobs().begin(), studyKnobs().end()};
 }
 
 bool isSceneKnob(const std::string& n) {
-    return n == "classify" || n == "kernel" || n == "sigma" || n == "radius" ||
-           n == "footprint-res" || n == "slab-radial-res" || n == "slab-depth-res" ||
-           n == "poly-tol";
+    const OptionSpec* o = findOption(n);
+    return o && o->scope == OptionScope::Scene;
 }
 
 void applyKnob(RenderSettings& s, const std::string& n, const std::string& v) {
-    Quality& q = s.quality;
-    if (n == "renderer")
-        s.renderer = parseRenderer(v);
-    else if (n == "slab")
-        q.slab = parseNumber(n, v);
-    else if (n == "early-termination")
-        q.earlyTermination = parseNumber(n, v);
-    else if (n == "size") {
-        int w = 0, h = 0;
-        char x = 0;
-        std::istringstream in(v);
-        if (v.find_first_of("xX") == std::string::npos)
-            w = h = parseInt(n, v);
-        else if (!(in >> w >> x >> h))
-            throw Error("--sweep size: '" + v + "' must be N or WxH");
-        if (w < 1 || h < 1) throw Error("--sweep size: '" + v + "' must be positive");
-        s.camera.width = w;
-        s.camera.height = h;
-    } else if (n == "order")
-        s.order = parseOrder(v);
-    else if (n == "classify")
-        s.classification = parseClassification(v);
-    else if (n == "kernel")
-        s.kernel = v;
-    else if (n == "sigma")
-        s.kernelSigma = parseNumber(n, v);
-    else if (n == "radius")
-        s.kernelRadius = parseNumber(n, v);
-    else if (n == "footprint-res")
-        q.footprintResolution = parseInt(n, v);
-    else if (n == "slab-radial-res")
-        q.slabRadialResolution = parseInt(n, v);
-    else if (n == "slab-depth-res")
-        q.slabDepthResolution = parseInt(n, v);
-    else if (n == "poly-tol")
-        q.polynomialTolerance = parseNumber(n, v);
-    else if (n == "lod") {
-        q.lodAuto = v == "auto";
-        q.lodBrick = v == "brick";
-        q.lod = q.lodAuto || q.lodBrick ? 0 : parseNumber(n, v);
-    }
-    else if (n == "ewa")
-        q.ewa = parseEwa(v);
-    else if (n == "pixel-filter")
-        q.pixelFilter = parseNumber(n, v);
-    else {
+    const auto& knobs = studyKnobs();
+    if (std::find(knobs.begin(), knobs.end(), n) == knobs.end()) {
         std::string all;
-        for (const auto& k : studyKnobNames()) all += (all.empty() ? "" : ", ") + k;
+        for (const auto& k : knobs) all += (all.empty() ? "" : ", ") + std::string(k);
         throw Error("unknown study knob '" + n + "' (knobs: " + all + ")");
     }
+    // A study's size may be one number N: N x N pixels.
+    const bool square = n == "size" && v.find_first_of("xX") == std::string::npos;
+    applyOption(s, n, square ? v + "x" + v : v);
 }
 
 StudyKnob parseKnob(const std::string& text) {
