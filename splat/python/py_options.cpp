@@ -20,7 +20,9 @@ std::string keywordOf(std::string_view longName) {
 }
 
 /// Warnings as the command line prints them, one line each on stderr.
-void warnLine(const std::string& line) { std::fprintf(stderr, "splat: warning: %s\n", line.c_str()); }
+void warnLine(const std::string& line) {
+    std::fprintf(stderr, "splat: warning: %s\n", line.c_str());
+}
 
 OptionValues valuesOf(unsigned sets, const Keywords& keywords) {
     OptionValues values(sets);

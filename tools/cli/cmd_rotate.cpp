@@ -298,41 +298,134 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
 }
 }  // namespace
 
+namespace {
+
+/// The options of `splat rotate` besides the volume and rendering options.
+void addRotateOptions(CLI::App& cmd, RotateCommand& a) {
+    const std::string seq = "Sequence", out = "Output";
+    addOption(cmd, "--frames", a.frames, "number of frames", seq);
+    addOption(cmd, "--from", a.from, "first angle, degrees", seq);
+    addOption(cmd, "--to", a.to,
+              "last angle, degrees (inclusive: the last frame is at --to). Default: a full "
+              "turn that loops without repeating a view, from + 360 (frames - 1) / frames",
+              seq);
+    addOption(cmd, "--sweep", a.sweep, "the angle turned: azimuth or elevation", seq);
+    addOption(cmd, "--path", a.path,
+              "camera path JSON {\"keys\": [{\"azimuth\", \"elevation\", \"distance\", "
+              "\"pixel_size\"}, ...]}, interpolated over --frames (instead of --sweep)",
+              seq, PathKind::Input);
+    addOption(cmd, "--parallel-frames", a.parallelFrames,
+              "frames rendered at once, one thread each (0: automatic)", seq);
+    addSequenceBrickOptions(cmd, a.brick, seq, "every frame");
+    addOption(cmd, "-o,--output", a.outDir, "output folder for the frames (created)", out,
+              PathKind::Output);
+    addOption(cmd, "--name", a.name, "frame file name pattern (printf %d of the frame index)",
+              out);
+    addOption(cmd, "--format", a.format, "frame format: png, exr or tif", out);
+    addFlag(cmd, "--resume", a.resume, "render only the frames missing from the folder", out);
+    addFlag(cmd, "--overwrite", a.overwrite, "replace the frames the folder holds", out);
+    addOption(cmd, "--gif", a.gif, "also write an animated GIF", out, PathKind::Output);
+    addOption(cmd, "--contact-sheet", a.contact, "also write a contact sheet (all frames, tiled)",
+              out, PathKind::Output);
+    addOption(cmd, "--mp4", a.mp4,
+              "also write an MP4 video (needs the ffmpeg program; png frames)", out,
+              PathKind::Output);
+    addOption(cmd, "--fps", a.fps, "GIF and MP4 frames per second (1..100)", out);
+    addFlag(cmd, "-q,--quiet", a.quiet, "no progress output", out);
+}
+
+/// Refuses what cannot run before anything is rendered or created, and warns about the
+/// options the run ignores.
+void checkRotateArgs(const CLI::App& cmd, const RotateCommand& a) {
+    asUsage([&] {
+        if (a.frames < 1 || a.frames > 100000)
+            throw Error("--frames must be between 1 and 100000");
+        if (a.fps < 1 || a.fps > 100) throw Error("--fps must be between 1 and 100");
+        if (a.parallelFrames < 0 || a.parallelFrames > 1024)
+            throw Error("--parallel-frames must be between 0 and 1024");
+        if (!std::isfinite(a.from) || !std::isfinite(a.to) || std::abs(a.from) > 1e6 ||
+            std::abs(a.to) > 1e6)
+            throw Error("--from and --to must be finite angles (degrees)");
+        if (a.format != "png" && a.format != "exr" && a.format != "tif")
+            throw Error("--format must be png, exr or tif");
+        if (a.sweep != "azimuth" && a.sweep != "elevation")
+            throw Error("--sweep must be azimuth or elevation");
+        if (a.resume && a.overwrite)
+            throw Error("--resume and --overwrite exclude each other");
+        checkPattern(a.name);
+        if (!a.gif.empty() && lowerExtension(a.gif) != ".gif")
+            throw Error(a.gif + ": --gif needs a .gif file name");
+        if (!a.contact.empty()) checkImageExtension(a.contact);
+        if (!a.mp4.empty() && lowerExtension(a.mp4) != ".mp4")
+            throw Error(a.mp4 + ": --mp4 needs a .mp4 file name");
+        if (!a.mp4.empty() && a.format != "png")
+            throw Error("--mp4 is made from png frames (--format png)");
+    });
+    if (!a.path.empty())
+        for (const char* k : {"from", "to", "sweep"})
+            if (given(cmd, k) && !fromScene(cmd, k))
+                warn(std::string("--") + k + " does not apply with --path (the path's keys " +
+                     "set the views); ignored");
+    if (a.gif.empty() && a.mp4.empty() && given(cmd, "fps") && !fromScene(cmd, "fps"))
+        warn("--fps applies to --gif and --mp4 only; ignored");
+}
+
+/// The views: a turn of the swept angle, or the camera path of --path.
+CameraPath rotatePath(const CLI::App& cmd, const RotateCommand& a, const RenderSettings& settings) {
+    if (!a.path.empty()) return CameraPath::fromJson(a.path, settings.camera, a.frames);
+    const double to = given(cmd, "to") ? a.to : a.from + 360.0 * (a.frames - 1) / a.frames;
+    return CameraPath::turn(settings.camera,
+                            a.sweep == "azimuth" ? CameraPath::Angle::Azimuth
+                                                 : CameraPath::Angle::Elevation,
+                            a.from, to, a.frames);
+}
+
+/// The display window (mip, xray) is fixed by the first frame a folder gets, and kept in the
+/// manifest so that resumed frames match: the window of a resumed folder, if it has one.
+std::optional<WriteOptions> resumedWindow(const RotateCommand& a) {
+    if (!a.resume) return std::nullopt;
+    std::ifstream in(fs::path(a.outDir) / kManifest);
+    if (!in) return std::nullopt;
+    try {
+        const nlohmann::json old = nlohmann::json::parse(in);
+        if (!old.contains("window")) return std::nullopt;
+        WriteOptions w;
+        w.mapping = DisplayMapping::Window;
+        w.windowLow = old["window"][0].get<float>();
+        w.windowHigh = old["window"][1].get<float>();
+        return withMetadata(w);
+    } catch (const std::exception&) {
+        return std::nullopt;
+    }
+}
+
+/// The GIF and contact sheet of the frames (those kept from an earlier run read back).
+void writeGifAndContactSheet(const RotateCommand& a, std::vector<Image>& shown,
+                             const std::vector<bool>& keep,
+                             const std::optional<WriteOptions>& display) {
+    for (std::size_t f = 0; f < shown.size(); ++f)
+        if (keep[f]) {
+            const Image im = readImage(frameFile(a, f));
+            shown[f] = a.format == "png" || !display ? im : toDisplay(im, *display);
+        }
+    WriteOptions asIs;
+    asIs.mapping = DisplayMapping::Display;
+    if (!a.gif.empty()) writeAnimatedGif(a.gif, shown, asIs, a.fps);
+    if (!a.contact.empty()) {
+        std::vector<Image> small;
+        for (const Image& im : shown) small.push_back(downscale(im, 160));
+        writeImage(a.contact, contactSheet(small), withMetadata(asIs));
+    }
+}
+
+}  // namespace
+
 void registerRotate(CLI::App& app) {
     auto a = std::make_shared<RotateCommand>();
     CLI::App* cmd = app.add_subcommand("rotate", "render a rotation sequence or a camera path");
     addVolumeOptions(*cmd, a->volume);
     addRenderOptions(*cmd, a->render, true);
-    const std::string seq = "Sequence", out = "Output";
-    addOption(*cmd, "--frames", a->frames, "number of frames", seq);
-    addOption(*cmd, "--from", a->from, "first angle, degrees", seq);
-    addOption(*cmd, "--to", a->to,
-              "last angle, degrees (inclusive: the last frame is at --to). Default: a full "
-              "turn that loops without repeating a view, from + 360 (frames - 1) / frames",
-              seq);
-    addOption(*cmd, "--sweep", a->sweep, "the angle turned: azimuth or elevation", seq);
-    addOption(*cmd, "--path", a->path,
-              "camera path JSON {\"keys\": [{\"azimuth\", \"elevation\", \"distance\", "
-              "\"pixel_size\"}, ...]}, interpolated over --frames (instead of --sweep)",
-              seq, PathKind::Input);
-    addOption(*cmd, "--parallel-frames", a->parallelFrames,
-              "frames rendered at once, one thread each (0: automatic)", seq);
-    addSequenceBrickOptions(*cmd, a->brick, seq, "every frame");
-    addOption(*cmd, "-o,--output", a->outDir, "output folder for the frames (created)", out,
-              PathKind::Output);
-    addOption(*cmd, "--name", a->name, "frame file name pattern (printf %d of the frame index)",
-              out);
-    addOption(*cmd, "--format", a->format, "frame format: png, exr or tif", out);
-    addFlag(*cmd, "--resume", a->resume, "render only the frames missing from the folder", out);
-    addFlag(*cmd, "--overwrite", a->overwrite, "replace the frames the folder holds", out);
-    addOption(*cmd, "--gif", a->gif, "also write an animated GIF", out, PathKind::Output);
-    addOption(*cmd, "--contact-sheet", a->contact, "also write a contact sheet (all frames, tiled)",
-              out, PathKind::Output);
-    addOption(*cmd, "--mp4", a->mp4,
-              "also write an MP4 video (needs the ffmpeg program; png frames)", out,
-              PathKind::Output);
-    addOption(*cmd, "--fps", a->fps, "GIF and MP4 frames per second (1..100)", out);
-    addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
+    addRotateOptions(*cmd, *a);
     cmd->footer(
         "Examples:\n"
         "  splat rotate ch2.nii.gz --tf mri-head --frames 36 -o turn --gif turn.gif\n"
@@ -342,37 +435,7 @@ void registerRotate(CLI::App& app) {
     cmd->callback([a, cmd] {
         // Everything that can be refused is refused before anything is rendered or created.
         prepareCommand(*cmd, {"volume", "output"});
-        asUsage([&] {
-            if (a->frames < 1 || a->frames > 100000)
-                throw Error("--frames must be between 1 and 100000");
-            if (a->fps < 1 || a->fps > 100) throw Error("--fps must be between 1 and 100");
-            if (a->parallelFrames < 0 || a->parallelFrames > 1024)
-                throw Error("--parallel-frames must be between 0 and 1024");
-            if (!std::isfinite(a->from) || !std::isfinite(a->to) || std::abs(a->from) > 1e6 ||
-                std::abs(a->to) > 1e6)
-                throw Error("--from and --to must be finite angles (degrees)");
-            if (a->format != "png" && a->format != "exr" && a->format != "tif")
-                throw Error("--format must be png, exr or tif");
-            if (a->sweep != "azimuth" && a->sweep != "elevation")
-                throw Error("--sweep must be azimuth or elevation");
-            if (a->resume && a->overwrite)
-                throw Error("--resume and --overwrite exclude each other");
-            checkPattern(a->name);
-            if (!a->gif.empty() && lowerExtension(a->gif) != ".gif")
-                throw Error(a->gif + ": --gif needs a .gif file name");
-            if (!a->contact.empty()) checkImageExtension(a->contact);
-            if (!a->mp4.empty() && lowerExtension(a->mp4) != ".mp4")
-                throw Error(a->mp4 + ": --mp4 needs a .mp4 file name");
-            if (!a->mp4.empty() && a->format != "png")
-                throw Error("--mp4 is made from png frames (--format png)");
-        });
-        if (!a->path.empty())
-            for (const char* k : {"from", "to", "sweep"})
-                if (given(*cmd, k) && !fromScene(*cmd, k))
-                    warn(std::string("--") + k + " does not apply with --path (the path's keys " +
-                         "set the views); ignored");
-        if (a->gif.empty() && a->mp4.empty() && given(*cmd, "fps") && !fromScene(*cmd, "fps"))
-            warn("--fps applies to --gif and --mp4 only; ignored");
+        checkRotateArgs(*cmd, *a);
         checkSequenceBrickOptions(*cmd, a->brick);
         RenderUse use;
         use.imageExt = "." + a->format;
@@ -406,16 +469,7 @@ void registerRotate(CLI::App& app) {
             bricked ? brickGroup(a->brick.compositor) : nullptr;
         std::string ffmpeg;
         const bool keepImages = !a->gif.empty() || !a->contact.empty();
-        const CameraPath path =
-            a->path.empty()
-                ? CameraPath::turn(
-                      settings.camera,
-                      a->sweep == "azimuth" ? CameraPath::Angle::Azimuth
-                                            : CameraPath::Angle::Elevation,
-                      a->from,
-                      given(*cmd, "to") ? a->to : a->from + 360.0 * (a->frames - 1) / a->frames,
-                      a->frames)
-                : CameraPath::fromJson(a->path, settings.camera, a->frames);
+        const CameraPath path = rotatePath(*cmd, *a, settings);
         nlohmann::json manifest = manifestOf(*a, settings);
         std::vector<bool> keep(std::size_t(a->frames), false);
         std::shared_ptr<const Volume> volume;
@@ -452,21 +506,7 @@ void registerRotate(CLI::App& app) {
                 if (!fs::is_directory(a->outDir))
                     throw Error(a->outDir + ": cannot create output folder");
 
-                // The display window (mip, xray) is fixed by the first frame a folder gets, and
-                // kept in the manifest so that resumed frames match.
-                if (std::ifstream in(fs::path(a->outDir) / kManifest); in && a->resume) {
-                    try {
-                        const nlohmann::json old = nlohmann::json::parse(in);
-                        if (old.contains("window")) {
-                            WriteOptions w;
-                            w.mapping = DisplayMapping::Window;
-                            w.windowLow = old["window"][0].get<float>();
-                            w.windowHigh = old["window"][1].get<float>();
-                            display = withMetadata(w);
-                        }
-                    } catch (const std::exception&) {
-                    }
-                }
+                display = resumedWindow(*a);
             }
         } catch (const std::exception& e) {
             if (!bricked) throw;
@@ -519,22 +559,7 @@ void registerRotate(CLI::App& app) {
         progress.finish();
         if (rendered == 0 && !fs::exists(fs::path(a->outDir) / kManifest))
             writeTextAtomic(fs::path(a->outDir) / kManifest, manifest.dump(2) + "\n");
-        if (keepImages) {
-            // Frames kept from an earlier run are read back.
-            for (std::size_t f = 0; f < shown.size(); ++f)
-                if (keep[f]) {
-                    const Image im = readImage(frameFile(*a, f));
-                    shown[f] = a->format == "png" || !display ? im : toDisplay(im, *display);
-                }
-            WriteOptions asIs;
-            asIs.mapping = DisplayMapping::Display;
-            if (!a->gif.empty()) writeAnimatedGif(a->gif, shown, asIs, a->fps);
-            if (!a->contact.empty()) {
-                std::vector<Image> small;
-                for (const Image& im : shown) small.push_back(downscale(im, 160));
-                writeImage(a->contact, contactSheet(small), withMetadata(asIs));
-            }
-        }
+        if (keepImages) writeGifAndContactSheet(*a, shown, keep, display);
         if (!a->mp4.empty()) writeMp4(*a, ffmpeg);
         std::printf("wrote %zu frames to %s (%zu kept)%s%s%s%s%s%s (%.1f ms per frame)\n", rendered,
                     a->outDir.c_str(), std::size_t(a->frames) - rendered,

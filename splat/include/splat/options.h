@@ -59,11 +59,11 @@ using IgnoredRule = std::string (*)(const RenderSettings& settings, const Render
                                     const OptionValues& values);
 
 struct OptionSpec {
-    std::string_view name;         ///< long name: flag --NAME, keyword NAME ('-' -> '_'), key
+    std::string_view name;  ///< long name: flag --NAME, keyword NAME ('-' -> '_'), key
     OptionType type;
     std::string_view defaultText;  ///< as --help shows it ("" for none)
     std::string_view help;
-    std::string_view group;        ///< --help group
+    std::string_view group;  ///< --help group
     OptionScope scope;
     OptionSet set;
     OptionPath path = OptionPath::None;

@@ -134,7 +134,7 @@ constexpr OptionScope kVolume = OptionScope::Volume, kScene = OptionScope::Scene
                       kFrame = OptionScope::Frame, kOutput = OptionScope::Output,
                       kSweep = OptionScope::Sweep;
 constexpr const char *kCls = "Classification", *kCam = "Camera", *kRen = "Renderer",
-                 *kQ = "Quality", *kOut = "Output", *kVol = "Volume", *kSw = "Sweep";
+                     *kQ = "Quality", *kOut = "Output", *kVol = "Volume", *kSw = "Sweep";
 constexpr OptionSet R = kRenderOptions, I = kImageOptions, W = kSweepOptions, L = kVolumeOptions,
                     K = kStudyOnlyOptions;
 
@@ -153,8 +153,8 @@ std::vector<OptionSpec> makeTable() {
          "NaN/Inf samples: 'error' refuses the volume, 'zero' replaces them by 0", kVol, kVolume,
          L},
         {"allow-outside-data", T::Flag, "",
-         "NRRD/MetaImage: allow data files outside the header's folder (absolute paths, ..)",
-         kVol, kVolume, L},
+         "NRRD/MetaImage: allow data files outside the header's folder (absolute paths, ..)", kVol,
+         kVolume, L},
         {"series", T::Text, "",
          "DICOM: the SeriesInstanceUID to load when a folder holds several (`splat info "
          "FOLDER` lists them)",
@@ -180,13 +180,12 @@ std::vector<OptionSpec> makeTable() {
         {"azimuth", T::Real, "0", "camera azimuth, degrees", kCam, kFrame, R},
         {"elevation", T::Real, "0", "camera elevation, degrees", kCam, kFrame, R},
         {"projection", T::Text, "ortho", "ortho | perspective", kCam, kFrame, R},
-        {"pixel-size", T::Real, "0", "world units per pixel (0 = fit the volume)", kCam, kFrame,
-         R},
+        {"pixel-size", T::Real, "0", "world units per pixel (0 = fit the volume)", kCam, kFrame, R},
         {"fov", T::Real, "30", "perspective: vertical field of view, degrees", kCam, kFrame, R,
          P::None, ignoredFov},
         {"distance", T::Real, "0",
-         "perspective: eye distance from the volume centre, world units (0 = fit)", kCam, kFrame,
-         R, P::None, ignoredDistance},
+         "perspective: eye distance from the volume centre, world units (0 = fit)", kCam, kFrame, R,
+         P::None, ignoredDistance},
         {"eye", T::Text, "",
          "free camera: eye position X,Y,Z (world; with --look-at, replaces the orbit)", kCam,
          kFrame, R},
@@ -197,22 +196,22 @@ std::vector<OptionSpec> makeTable() {
         {"renderer", T::Text, "axis",
          "axis (axis-aligned sheets) | sheet (image-aligned slabs) | reference (ray caster)", kRen,
          kFrame, R},
-        {"order", T::Text, "ftb", "dvr: ftb (front-to-back) | btf (back-to-front)", kRen, kFrame,
-         R, P::None, ignoredOrder},
+        {"order", T::Text, "ftb", "dvr: ftb (front-to-back) | btf (back-to-front)", kRen, kFrame, R,
+         P::None, ignoredOrder},
         {"kernel", T::Text, "gaussian", "reconstruction kernel: gaussian | bspline", kRen, kScene,
          R},
-        {"sigma", T::Real, "0", "Gaussian sigma in voxels (0 = the kernel's default)", kRen,
-         kScene, R},
-        {"radius", T::Real, "0", "kernel radius in voxels (0 = the kernel's default)", kRen,
-         kScene, R},
+        {"sigma", T::Real, "0", "Gaussian sigma in voxels (0 = the kernel's default)", kRen, kScene,
+         R},
+        {"radius", T::Real, "0", "kernel radius in voxels (0 = the kernel's default)", kRen, kScene,
+         R},
         {"background", T::Text, "0,0,0,0", "background R,G,B[,A] in [0, 1]", kRen, kFrame, R},
         {"shade", T::Flag, "", "Blinn-Phong shading from the density gradient (dvr, iso)", kRen,
          kScene, R, P::None, ignoredShade},
         {"slab", T::Real, "1", "sheet renderer: slab thickness, voxels", kQ, kFrame, R, P::None,
          ignoredSlab},
         {"early-termination", T::Real, "0.00390625",
-         "splatters, front-to-back: stop when opacity >= 1 - EPS (0 = off)", kQ, kFrame, R,
-         P::None, ignoredEarlyTermination},
+         "splatters, front-to-back: stop when opacity >= 1 - EPS (0 = off)", kQ, kFrame, R, P::None,
+         ignoredEarlyTermination},
         {"ref-step", T::Real, "0",
          "reference renderer: first step, voxels (0: automatic, dvr 1 for the default kernel, "
          "else 0.25)",
@@ -220,8 +219,8 @@ std::vector<OptionSpec> makeTable() {
         {"ref-tolerance", T::Real, "0.0001", "reference renderer: step refinement tolerance", kQ,
          kFrame, R, P::None, ignoredRefTolerance},
         {"threads", T::Integer, "0", "worker threads (0 = all cores)", kQ, kFrame, R},
-        {"tile-size", T::Integer, "32", "splatters: screen tile edge in pixels (8..64)", kQ,
-         kFrame, R, P::None, ignoredTileSize},
+        {"tile-size", T::Integer, "32", "splatters: screen tile edge in pixels (8..64)", kQ, kFrame,
+         R, P::None, ignoredTileSize},
         {"lod", T::Text, "0",
          "splatters: level of detail, pixels per voxel below which 2x2x2 voxels are "
          "merged into one splat of twice the size, repeatedly (0..64; 0 = off), or auto: "
@@ -257,8 +256,8 @@ std::vector<OptionSpec> makeTable() {
          "label colours: FILE.lut (256 x RGB, mricron) or FILE.json; without "
          "--label-volume, VOLUME itself holds the labels",
          kCls, kScene, R, P::Input},
-        {"label-names", T::Text, "", "label names: FILE.txt (index name per line)", kCls, kScene,
-         R, P::Input},
+        {"label-names", T::Text, "", "label names: FILE.txt (index name per line)", kCls, kScene, R,
+         P::Input},
         {"labels", T::Text, "", "show only these labels, e.g. 37,38", kCls, kScene, R},
         {"label-opacity", T::Real, "1",
          "opacity of the labels per unit distance (tables without their own)", kCls, kScene, R},
@@ -280,10 +279,10 @@ std::vector<OptionSpec> makeTable() {
         // ---- the kernel tables' resolutions, swept by a study only
         {"footprint-res", T::Integer, "4096", "footprint table entries over r^2 (16..1048576)", kQ,
          kScene, K},
-        {"slab-radial-res", T::Integer, "128",
-         "slab-section table: intervals in r^2 (4..65536)", kQ, kScene, K},
-        {"slab-depth-res", T::Integer, "1024",
-         "slab-section table: intervals in depth (4..65536)", kQ, kScene, K},
+        {"slab-radial-res", T::Integer, "128", "slab-section table: intervals in r^2 (4..65536)",
+         kQ, kScene, K},
+        {"slab-depth-res", T::Integer, "1024", "slab-section table: intervals in depth (4..65536)",
+         kQ, kScene, K},
         {"poly-tol", T::Real, "1e-06",
          "footprint as a piecewise polynomial when it matches the table to this fraction of "
          "the peak (0: always the table)",
@@ -291,8 +290,8 @@ std::vector<OptionSpec> makeTable() {
         // ---- the written image
         {"bit-depth", T::Integer, "8", "PNG bits per channel: 8 or 16", kOut, kOutput, I, P::None,
          ignoredBitDepth},
-        {"alpha", T::Flag, "", "PNG with alpha (transparent background)", kOut, kOutput, I,
-         P::None, ignoredAlpha},
+        {"alpha", T::Flag, "", "PNG with alpha (transparent background)", kOut, kOutput, I, P::None,
+         ignoredAlpha},
         {"window", T::Text, "",
          "mip/xray 8-bit output: display window LOW,HIGH (default: the data range, 0 included)",
          kOut, kOutput, I, P::None, ignoredWindow},
@@ -345,11 +344,22 @@ const OptionSpec* findOption(std::string_view name) {
 }
 
 const std::vector<std::string_view>& studyKnobs() {
-    static const std::vector<std::string_view> knobs = {
-        "renderer",      "slab",          "early-termination", "size",
-        "order",         "classify",      "kernel",            "sigma",
-        "radius",        "footprint-res", "slab-radial-res",   "slab-depth-res",
-        "poly-tol",      "lod",           "ewa",               "pixel-filter"};
+    static const std::vector<std::string_view> knobs = {"renderer",
+                                                        "slab",
+                                                        "early-termination",
+                                                        "size",
+                                                        "order",
+                                                        "classify",
+                                                        "kernel",
+                                                        "sigma",
+                                                        "radius",
+                                                        "footprint-res",
+                                                        "slab-radial-res",
+                                                        "slab-depth-res",
+                                                        "poly-tol",
+                                                        "lod",
+                                                        "ewa",
+                                                        "pixel-filter"};
     return knobs;
 }
 

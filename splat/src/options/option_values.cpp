@@ -38,11 +38,9 @@ std::string checkOptionText(const OptionSpec& spec, const std::string& text) {
         case OptionType::Integer:
             return parseInteger(text, i) ? "" : "'" + text + "' is not an integer";
         case OptionType::Unsigned:
-            return parseInteger(text, i) && i >= 0 ? ""
-                                                   : "'" + text + "' is not an integer >= 0";
+            return parseInteger(text, i) && i >= 0 ? "" : "'" + text + "' is not an integer >= 0";
         case OptionType::Flag:
-            return text == "true" || text == "false" ? ""
-                                                     : "'" + text + "' is not true or false";
+            return text == "true" || text == "false" ? "" : "'" + text + "' is not true or false";
         case OptionType::Text:
         case OptionType::TextList:
             return "";
@@ -132,7 +130,8 @@ bool OptionValues::flag(std::string_view name) const { return slot(name).flag; }
 double OptionValues::real(std::string_view name) const {
     const Slot& s = slot(name);
     double d = 0;
-    if (!parseReal(s.text, d)) throw OptionError(flagOf(name) + ": " + checkOptionText(*s.spec, s.text));
+    if (!parseReal(s.text, d))
+        throw OptionError(flagOf(name) + ": " + checkOptionText(*s.spec, s.text));
     return d;
 }
 

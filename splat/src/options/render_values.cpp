@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "footprint/kernel.h"
 #include "splat/options.h"
 #include "splat/volume_io.h"
 
@@ -79,6 +80,11 @@ void parseKernelAndColours(const OptionValues& v, RenderSettings& s) {
     requireIn(radius, 0, 1e3, "--radius");
     s.kernelSigma = sigma;
     s.kernelRadius = radius;
+    try {
+        (void)footprint::Kernel::fromName(s.kernel, sigma, radius);  // names the kernels
+    } catch (const std::exception& e) {
+        throw OptionError(e.what());
+    }
     const std::vector<double> bg = parseNumbers(v.text("background"), "--background");
     if (bg.size() != 3 && bg.size() != 4) throw OptionError("--background needs R,G,B or R,G,B,A");
     for (double c : bg) requireIn(c, 0, 1, "--background: every component");
@@ -390,32 +396,51 @@ void applyOption(RenderSettings& s, std::string_view name, const std::string& te
     const RenderSettings p = parseRenderOptions(v);
     Quality& q = s.quality;
     const Quality& pq = p.quality;
-    if (name == "renderer") s.renderer = p.renderer;
-    else if (name == "mode") s.mode = p.mode;
-    else if (name == "order") s.order = p.order;
-    else if (name == "classify") s.classification = p.classification;
+    if (name == "renderer")
+        s.renderer = p.renderer;
+    else if (name == "mode")
+        s.mode = p.mode;
+    else if (name == "order")
+        s.order = p.order;
+    else if (name == "classify")
+        s.classification = p.classification;
     else if (name == "size") {
         s.camera.width = p.camera.width;
         s.camera.height = p.camera.height;
-    } else if (name == "kernel") s.kernel = p.kernel;
-    else if (name == "sigma") s.kernelSigma = p.kernelSigma;
-    else if (name == "radius") s.kernelRadius = p.kernelRadius;
-    else if (name == "slab") q.slab = pq.slab;
-    else if (name == "early-termination") q.earlyTermination = pq.earlyTermination;
-    else if (name == "tile-size") q.tileSize = pq.tileSize;
+    } else if (name == "kernel")
+        s.kernel = p.kernel;
+    else if (name == "sigma")
+        s.kernelSigma = p.kernelSigma;
+    else if (name == "radius")
+        s.kernelRadius = p.kernelRadius;
+    else if (name == "slab")
+        q.slab = pq.slab;
+    else if (name == "early-termination")
+        q.earlyTermination = pq.earlyTermination;
+    else if (name == "tile-size")
+        q.tileSize = pq.tileSize;
     else if (name == "lod") {
         q.lod = pq.lod;
         q.lodAuto = pq.lodAuto;
         q.lodBrick = pq.lodBrick;
-    } else if (name == "ewa") q.ewa = pq.ewa;
-    else if (name == "pixel-filter") q.pixelFilter = pq.pixelFilter;
-    else if (name == "ref-step") q.referenceStep = pq.referenceStep;
-    else if (name == "ref-tolerance") q.referenceTolerance = pq.referenceTolerance;
-    else if (name == "footprint-res") q.footprintResolution = pq.footprintResolution;
-    else if (name == "slab-radial-res") q.slabRadialResolution = pq.slabRadialResolution;
-    else if (name == "slab-depth-res") q.slabDepthResolution = pq.slabDepthResolution;
-    else if (name == "poly-tol") q.polynomialTolerance = pq.polynomialTolerance;
-    else throw OptionError("--" + std::string(name) + " cannot be set on its own");
+    } else if (name == "ewa")
+        q.ewa = pq.ewa;
+    else if (name == "pixel-filter")
+        q.pixelFilter = pq.pixelFilter;
+    else if (name == "ref-step")
+        q.referenceStep = pq.referenceStep;
+    else if (name == "ref-tolerance")
+        q.referenceTolerance = pq.referenceTolerance;
+    else if (name == "footprint-res")
+        q.footprintResolution = pq.footprintResolution;
+    else if (name == "slab-radial-res")
+        q.slabRadialResolution = pq.slabRadialResolution;
+    else if (name == "slab-depth-res")
+        q.slabDepthResolution = pq.slabDepthResolution;
+    else if (name == "poly-tol")
+        q.polynomialTolerance = pq.polynomialTolerance;
+    else
+        throw OptionError("--" + std::string(name) + " cannot be set on its own");
 }
 
 void dropIgnoredOptions(OptionValues& v, const RenderSettings& s, const RenderUse& use,
@@ -424,7 +449,8 @@ void dropIgnoredOptions(OptionValues& v, const RenderSettings& s, const RenderUs
         if (!spec->ignored) continue;
         std::istringstream reasons(spec->ignored(s, use, v));
         for (std::string why; std::getline(reasons, why);) {
-            if (!v.given(spec->name) || (v.fromScene(spec->name) && !v.differsFromDefault(spec->name)))
+            if (!v.given(spec->name) ||
+                (v.fromScene(spec->name) && !v.differsFromDefault(spec->name)))
                 break;
             warn(why + "; ignored");
             v.reset(spec->name);

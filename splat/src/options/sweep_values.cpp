@@ -18,7 +18,8 @@ std::vector<RendererKind> parseRenderers(const std::string& text) {
 
 std::vector<CameraParams> poppingViews(const OptionValues& v, const Sweep& sweep) {
     const std::string& path = v.text("path");
-    if (!path.empty()) return CameraPath::fromJson(path, sweep.base, int(v.integer("frames"))).views;
+    if (!path.empty())
+        return CameraPath::fromJson(path, sweep.base, int(v.integer("frames"))).views;
     std::vector<CameraParams> views;
     for (double angle : sweep.angles()) views.push_back(sweep.camera(angle));
     return views;
