@@ -1,6 +1,7 @@
 // The option table (splat/options.h): its defaults are the library's defaults, and for every
 // option the command-line flag, the scene-file key and the library's reading of the value
-// (what a Python keyword calls) accept and refuse the same values with the same line.
+// (what a Python keyword calls) accept and refuse the same values with the same line (a scene
+// value of the wrong type also names the file and the key).
 #include <catch2/catch.hpp>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -170,7 +171,13 @@ TEST_CASE("flag, scene key and library accept and refuse the same values alike",
             CHECK(a.status == b.status);
             CHECK(a.status != 0);
             CHECK(lastErrorLine(a) == "splat: error: " + verdict);
-            CHECK(lastErrorLine(b) == "splat: error: " + verdict);
+            // A scene file's value of the wrong type also names the file and the key.
+            const std::string sceneLine = lastErrorLine(b);
+            CHECK(sceneLine.find(verdict) != std::string::npos);
+            if (sceneLine != "splat: error: " + verdict) {
+                CHECK(sceneLine.find(scene) != std::string::npos);
+                CHECK(sceneLine.find("\"" + name + "\"") != std::string::npos);
+            }
         }
     }
     CHECK(refused > 40);

@@ -31,6 +31,8 @@ struct Entry {
     json initial;  ///< the value at registration: the default
     std::function<void(const json&)> setObject;
     std::function<json()> getObject;
+    /// An option of the library's table: why a value's text is not of its type ("" if it is).
+    std::function<std::string(const std::string&)> check;
 };
 
 struct CommandTable {
@@ -185,6 +187,11 @@ void applyKey(const CLI::App& cmd, CommandTable& t, Entry& e, const json& v,
         results.push_back(textOf(e, v, where, dir));
     }
     if (results.empty()) return;
+    if (e.check)
+        for (const std::string& r : results)
+            if (const std::string why = e.check(r); !why.empty())
+                throw UsageError(where + ": " + v.dump() + " is not a valid " + kindWord(e.kind) +
+                                 " (--" + e.key + ": " + why + ")");
     e.opt->add_result(results);
     try {
         e.opt->run_callback();
@@ -369,6 +376,9 @@ void addTableOptions(CLI::App& cmd, OptionValues& values, unsigned sets) {
         }
         o->group(std::string(spec->group));
         detail::recordOption(cmd, o, kindOf(spec->type), pathOf(spec->path), std::move(get));
+        tableOf(cmd).entries.back().check = [spec](const std::string& text) {
+            return checkOptionText(*spec, text);
+        };
     }
 }
 

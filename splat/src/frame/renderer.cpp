@@ -372,7 +372,7 @@ Image renderFrame(const Scene::Impl& scene, const RenderSettings& given, RenderS
     const auto start = Clock::now();
     validateFrame(given);
     RenderSettings s = given;
-    // Iso in the splatters is the first hit front to back (inapplicableSettings warns).
+    // Iso in the splatters is the first hit front to back (the option table warns of --order).
     if (s.mode == RenderMode::Iso) s.order = CompositeOrder::FrontToBack;
     RenderStats local;
     local.splats = scene.splats.size();

@@ -36,7 +36,10 @@ std::string checkOptionText(const OptionSpec& spec, const std::string& text) {
         case OptionType::Real:
             return parseReal(text, d) ? "" : "'" + text + "' is not a number";
         case OptionType::Integer:
-            return parseInteger(text, i) ? "" : "'" + text + "' is not an integer";
+            if (!parseInteger(text, i)) return "'" + text + "' is not an integer";
+            return i >= -2147483647 - 1 && i <= 2147483647
+                       ? ""
+                       : "'" + text + "' is not an integer in range (32 bits)";
         case OptionType::Unsigned:
             return parseInteger(text, i) && i >= 0 ? "" : "'" + text + "' is not an integer >= 0";
         case OptionType::Flag:
