@@ -3,7 +3,6 @@
 // type as in OpenImageIO's bindings.
 #include <filesystem>
 
-#include "diagnostics.h"
 #include "py_common.h"
 #include "splat/version.h"
 

@@ -1,10 +1,8 @@
 // Analyses (splat/popping.h, splat/study.h) and surfaces (splat/surface.h): result objects
 // whose series are NumPy arrays and whose events are plain Python data; write_report writes
 // the CLI's report. Sweeps run with the GIL released and stop on Ctrl-C between tiles.
-#include <CLI/CLI.hpp>
 #include <cstring>
 
-#include "popping_options.h"
 #include "py_common.h"
 #include "splat/popping.h"
 #include "splat/study.h"
@@ -164,44 +162,42 @@ void bindAnalysis(py::module_& m) {
 
     m.def(
         "_popping",
-        [](const PyVolume& v, const std::vector<std::string>& argv, const std::string& tfJson,
+        [](const PyVolume& v, const Keywords& options, const std::string& tfJson,
            const py::object& progress) {
-            cli::PoppingArgs pa;
+            OptionValues sweepValues(kSweepOptions);
             Sweep sweep;
             PoppingOptions o;
             RenderSettings settings = parseRenderSettings(
-                argv, tfJson, v.volume.get(), false,
-                [&pa](CLI::App& app) { cli::addPoppingOptions(app, pa); },
-                [&](const CLI::App& app, const RenderSettings& s) {
-                    cli::poppingFromArgs(app, pa, s, sweep, o);
+                options, tfJson, v.volume.get(), false, kSweepOptions,
+                [&](const OptionValues& values, const RenderSettings& s) {
+                    sweepValues = values;
+                    poppingFrom(values, s, sweep, o);
                 });
             settings.renderer = o.renderers.front();
             Sweep views = sweep;
             views.base = settings.camera;
-            settings = poppingSettings(settings, *v.volume, cli::poppingViews(pa, views), o.truth);
+            settings = poppingSettings(settings, *v.volume, poppingViews(sweepValues, views), o.truth);
             PyScene scene = makeSceneFrom(v.volume, settings);
             Interrupt in(progress);
             o.progress = in.progress();
             return interruptible(
                 in,
                 [&] {
-                    if (pa.path.empty()) return analyzePopping(*scene.scene, sweep, o);
+                    const std::string& path = sweepValues.text("path");
+                    if (path.empty()) return analyzePopping(*scene.scene, sweep, o);
                     return analyzePopping(
                         *scene.scene,
-                        CameraPath::fromJson(pa.path, scene.scene->settings().camera, pa.frames),
+                        CameraPath::fromJson(path, scene.scene->settings().camera,
+                                             int(sweepValues.integer("frames"))),
                         o);
                 },
                 scene.cancel.get());
         },
-        py::arg("volume"), py::arg("argv"), py::arg("tf_json"), py::arg("progress"));
+        py::arg("volume"), py::arg("options"), py::arg("tf_json"), py::arg("progress"));
     m.def("_popping_options", [] {
-        CLI::App app;
-        cli::PoppingArgs pa;
-        cli::addPoppingOptions(app, pa);
         std::vector<std::pair<std::string, std::string>> out;
-        for (const CLI::Option* o : app.get_options())
-            if (!o->get_lnames().empty() && o->get_lnames().front() != "help")
-                out.emplace_back(o->get_lnames().front(), o->get_description());
+        for (const auto& [keyword, flag, help, def] : poppingOptionTable())
+            out.emplace_back(flag.substr(2), help);
         return out;
     });
 
@@ -244,12 +240,12 @@ void bindAnalysis(py::module_& m) {
 
     m.def(
         "_study",
-        [](const PyVolume& v, const std::vector<std::string>& argv, const std::string& tfJson,
+        [](const PyVolume& v, const Keywords& options, const std::string& tfJson,
            const std::vector<std::string>& sweeps,
            const std::vector<std::pair<double, double>>& views, int repeats, int warmup,
            double truthStep, double truthTolerance, double ppd, bool convergence,
            const std::string& cacheDir, const std::string& truth, const py::object& progress) {
-            RenderSettings settings = parseRenderSettings(argv, tfJson, v.volume.get(), false);
+            RenderSettings settings = parseRenderSettings(options, tfJson, v.volume.get(), false);
             StudyOptions o;
             for (const std::string& s : sweeps) o.sweeps.push_back(parseKnob(s));
             for (const auto& [az, el] : views) o.views.emplace_back(az, el);
@@ -281,7 +277,7 @@ void bindAnalysis(py::module_& m) {
                 return r;
             });
         },
-        py::arg("volume"), py::arg("argv"), py::arg("tf_json"), py::arg("sweeps"), py::arg("views"),
+        py::arg("volume"), py::arg("options"), py::arg("tf_json"), py::arg("sweeps"), py::arg("views"),
         py::arg("repeats"), py::arg("warmup"), py::arg("truth_step"), py::arg("truth_tolerance"),
         py::arg("ppd"), py::arg("convergence"), py::arg("cache_dir"), py::arg("truth"),
         py::arg("progress"));

@@ -15,20 +15,19 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "splat/error.h"
 #include "splat/image.h"
+#include "splat/options.h"
 #include "splat/scene.h"
 #include "splat/settings.h"
 #include "splat/volume.h"
 
 namespace py = pybind11;
-
-namespace CLI {
-class App;
-}
 
 namespace splat::python {
 
@@ -87,26 +86,29 @@ auto interruptible(Interrupt& in, F&& work, SceneCancel* scene = nullptr) -> dec
 
 // ---- keyword arguments (py_options.cpp) ---------------------------------------------
 
-/// Render settings from the command line's render options: `argv` holds flags built by
-/// splat/__init__.py from keyword arguments ("--tf", "ct-bone", "--size", "512x512", ...);
+/// Keyword arguments as (long option name, text) pairs, built by splat/__init__.py from
+/// keyword arguments (("tf", "ct-bone"), ("size", "512x512"), ("shade", "true"), ...).
+using Keywords = std::vector<std::pair<std::string, std::string>>;
+/// (keyword, flag, help, default) per option, for docstrings and the stub test.
+using OptionTableRows = std::vector<std::tuple<std::string, std::string, std::string, std::string>>;
+
+/// Render settings from the rendering options of the option table (splat/options.h);
 /// `tfJson` a transfer function given as an object (the project's JSON; empty: none), read
-/// like a scene file's inline "tf". With `volume`, the data-dependent defaults of the CLI
-/// (ct-hu for CT in Hounsfield units, the free camera's target). Errors: splat::Error with
-/// the CLI's message.
-/// `addExtra` adds a command's own options to the same app before parsing (splat.popping's
-/// sweep options); `readExtra` reads them once the render settings are parsed.
+/// like a scene file's inline "tf". With `volume`, the data-dependent defaults (ct-hu for CT
+/// in Hounsfield units, the free camera's target). Errors: splat::OptionError with the
+/// command line's message. `extraSets`: a command's own options taken with them
+/// (splat.popping's sweep, kSweepOptions); `readExtra` reads them once the render settings
+/// are parsed.
 RenderSettings parseRenderSettings(
-    const std::vector<std::string>& argv, const std::string& tfJson, const Volume* volume,
-    bool oneRenderer, const std::function<void(CLI::App&)>& addExtra = {},
-    const std::function<void(const CLI::App&, const RenderSettings&)>& readExtra = {});
+    const Keywords& keywords, const std::string& tfJson, const Volume* volume, bool oneRenderer,
+    unsigned extraSets = 0,
+    const std::function<void(const OptionValues&, const RenderSettings&)>& readExtra = {});
 
-/// The render options the CLI knows: (keyword, flag, help, default) for docstrings and the
-/// stub test.
-std::vector<std::tuple<std::string, std::string, std::string, std::string>> renderOptionTable();
-
-/// Loads `spec` with the CLI's volume options (argv as above).
-Volume loadWithOptions(const std::string& spec, const std::vector<std::string>& argv);
-std::vector<std::tuple<std::string, std::string, std::string, std::string>> loadOptionTable();
+OptionTableRows renderOptionTable();
+/// Loads `spec` with the volume options.
+Volume loadWithOptions(const std::string& spec, const Keywords& keywords);
+OptionTableRows loadOptionTable();
+OptionTableRows poppingOptionTable();
 
 /// The project's JSON text of a transfer function (py_transfer.cpp).
 std::string transferJson(const TransferFunction& tf);

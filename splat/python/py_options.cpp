@@ -1,132 +1,85 @@
-// Keyword arguments read by the command line's own option definitions (tools/cli): a
-// keyword is a long option with '-' written '_' (`--pixel-size` -> pixel_size=), so a keyword
-// accepts, refuses and means exactly what its flag does, with the same one-line messages.
-// splat/__init__.py turns keyword values into flag text (size=(512, 512) -> "512x512").
-// The CLI11 app is short-lived and built with the GIL held (the option tables are global).
-#include <CLI/CLI.hpp>
+// Keyword arguments read by the library's option table (splat/options.h): a keyword is a long
+// option with '-' written '_' (`--pixel-size` -> pixel_size=), so a keyword accepts, refuses
+// and means exactly what its flag does, with the same one-line messages. splat/__init__.py
+// turns keyword values into the options' text (size=(512, 512) -> "512x512").
+#include <cstdio>
 
-#include "diagnostics.h"
 #include "py_common.h"
-#include "render_options.h"
-#include "scene_file.h"
-#include "volume_options.h"
 
 namespace splat::python {
 
 namespace {
 
-/// Forgets the app's recorded options when the parse is over (scene_file.h).
-struct CommandScope {
-    CLI::App app{"splat"};
-    ~CommandScope() { cli::forgetCommand(app); }
-};
-
-/// "--pixel-size" -> "pixel_size"; "from" -> "from_" (a Python keyword).
-std::string keywordOf(const std::string& longName) {
-    std::string k = longName;
+/// "pixel-size" -> "pixel_size"; "from" -> "from_" (a Python keyword).
+std::string keywordOf(std::string_view longName) {
+    std::string k(longName);
     for (char& c : k)
         if (c == '-') c = '_';
     if (k == "from") k += "_";
     return k;
 }
 
-/// CLI11's wording ("The following argument was not expected: --foo") in keyword terms.
-std::string keywordMessage(const CLI::ParseError& e) {
-    std::string m = e.what();
-    for (std::size_t at = 0; (at = m.find("--", at)) != std::string::npos;) {
-        std::size_t end = at + 2;
-        while (end < m.size() &&
-               (std::isalnum(static_cast<unsigned char>(m[end])) || m[end] == '-'))
-            ++end;
-        const std::string k = keywordOf(m.substr(at + 2, end - at - 2));
-        m.replace(at, end - at, k + "=");
-        at += k.size() + 1;
-    }
-    return "unknown or malformed keyword: " + m;
+/// Warnings as the command line prints them, one line each on stderr.
+void warnLine(const std::string& line) {
+    std::fprintf(stderr, "splat: warning: %s\n", line.c_str());
 }
 
-void parse(CLI::App& app, const std::vector<std::string>& argv) {
-    for (const std::string& a : argv) {
-        if (a == "--") break;
-        if (a.rfind("--", 0) == 0 && !app.get_option_no_throw(a))
-            throw cli::UsageError("unknown keyword '" + keywordOf(a.substr(2)) +
-                                  "' (the keywords are the command line's long options: "
-                                  "splat.render_options(), splat.load_options())");
+OptionValues valuesOf(unsigned sets, const Keywords& keywords) {
+    OptionValues values(sets);
+    for (const auto& [name, text] : keywords) {
+        if (!values.has(name))
+            throw OptionError("unknown keyword '" + keywordOf(name) +
+                              "' (the keywords are the command line's long options: "
+                              "splat.render_options(), splat.load_options())");
+        values.set(name, text);
     }
-    std::vector<std::string> reversed(argv.rbegin(), argv.rend());
-    try {
-        app.parse(reversed);
-    } catch (const CLI::ParseError& e) {
-        throw cli::UsageError(keywordMessage(e));
-    }
+    return values;
 }
 
-std::vector<std::tuple<std::string, std::string, std::string, std::string>> tableOf(
-    const CLI::App& app) {
-    std::vector<std::tuple<std::string, std::string, std::string, std::string>> out;
-    for (const CLI::Option* o : app.get_options()) {
-        if (o->get_lnames().empty()) continue;
-        const std::string name = o->get_lnames().front();
-        if (name == "help" || name == "write-scene") continue;
-        out.emplace_back(keywordOf(name), "--" + name, o->get_description(), o->get_default_str());
-    }
+OptionTableRows tableOf(unsigned sets) {
+    OptionTableRows out;
+    for (const OptionSpec* o : optionsOf(sets))
+        out.emplace_back(keywordOf(o->name), "--" + std::string(o->name), std::string(o->help),
+                         std::string(o->defaultText));
     return out;
 }
 
 }  // namespace
 
 RenderSettings parseRenderSettings(
-    const std::vector<std::string>& argv, const std::string& tfJson, const Volume* volume,
-    bool oneRenderer, const std::function<void(CLI::App&)>& addExtra,
-    const std::function<void(const CLI::App&, const RenderSettings&)>& readExtra) {
-    CommandScope scope;
-    cli::RenderArgs args;
-    cli::addRenderOptions(scope.app, args, false);
-    if (addExtra) addExtra(scope.app);
-    if (!tfJson.empty()) args.tfInline = nlohmann::json::parse(tfJson);
-    parse(scope.app, argv);
-    cli::prepareCommand(scope.app, {});
-    cli::RenderUse use;
+    const Keywords& keywords, const std::string& tfJson, const Volume* volume, bool oneRenderer,
+    unsigned extraSets,
+    const std::function<void(const OptionValues&, const RenderSettings&)>& readExtra) {
+    OptionValues values = valuesOf(kRenderOptions | extraSets, keywords);
+    values.tfInline = tfJson;
+    RenderUse use;
     use.oneRenderer = oneRenderer;
-    RenderSettings s = cli::settingsFromArgs(args, use);
-    if (readExtra) readExtra(scope.app, s);
-    if (volume) s = cli::withDataDefaults(args, s, *volume);
+    RenderSettings s = renderSettingsFrom(values, use, warnLine);
+    if (readExtra) readExtra(values, s);
+    if (volume)
+        s = withDataDefaults(values, s, *volume, [](const std::string& line) {
+            std::fprintf(stderr, "splat: %s\n", line.c_str());
+        });
     return s;
 }
 
-std::vector<std::tuple<std::string, std::string, std::string, std::string>> renderOptionTable() {
-    CommandScope scope;
-    cli::RenderArgs args;
-    cli::addRenderOptions(scope.app, args, false);
-    return tableOf(scope.app);
-}
+OptionTableRows renderOptionTable() { return tableOf(kRenderOptions); }
 
-Volume loadWithOptions(const std::string& spec, const std::vector<std::string>& argv) {
-    cli::VolumeArgs args;
-    {
-        CommandScope scope;
-        cli::addVolumeOptions(scope.app, args);
-        std::vector<std::string> all = argv;
-        all.push_back("--");
-        all.push_back(spec);
-        parse(scope.app, all);
-        cli::loadOptionsFromArgs(args);  // malformed options: before any reading
-    }
+Volume loadWithOptions(const std::string& spec, const Keywords& keywords) {
+    const OptionValues values = valuesOf(kVolumeOptions, keywords);
+    loadOptionsFrom(values);  // malformed options: before any reading
     py::gil_scoped_release release;
     try {
-        return cli::loadVolumeWith(args);
-    } catch (const cli::UsageError&) {
+        return loadVolumeFrom(spec, values);
+    } catch (const OptionError&) {
         throw;
     } catch (const Error& e) {
         rethrowFileError(e, spec, true);
     }
 }
 
-std::vector<std::tuple<std::string, std::string, std::string, std::string>> loadOptionTable() {
-    CommandScope scope;
-    cli::VolumeArgs args;
-    cli::addVolumeOptions(scope.app, args);
-    return tableOf(scope.app);
-}
+OptionTableRows loadOptionTable() { return tableOf(kVolumeOptions); }
+
+OptionTableRows poppingOptionTable() { return tableOf(kSweepOptions); }
 
 }  // namespace splat::python

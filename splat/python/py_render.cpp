@@ -55,9 +55,9 @@ py::object renderResult(Image&& image, const RenderStats& stats, bool withStats)
     return py::make_tuple(a, statsDict(stats));
 }
 
-PyScene makeScene(const PyVolume& v, const std::vector<std::string>& argv,
+PyScene makeScene(const PyVolume& v, const Keywords& options,
                   const std::string& tfJson) {
-    return makeSceneFrom(v.volume, parseRenderSettings(argv, tfJson, v.volume.get(), true));
+    return makeSceneFrom(v.volume, parseRenderSettings(options, tfJson, v.volume.get(), true));
 }
 
 }  // namespace
@@ -76,9 +76,9 @@ PyScene makeSceneFrom(std::shared_ptr<const Volume> volume, RenderSettings s) {
 void bindRender(py::module_& m) {
     m.def(
         "_render",
-        [](const PyVolume& v, const std::vector<std::string>& argv, const std::string& tfJson,
+        [](const PyVolume& v, const Keywords& options, const std::string& tfJson,
            const py::object& progress, bool withStats) {
-            RenderSettings s = parseRenderSettings(argv, tfJson, v.volume.get(), true);
+            RenderSettings s = parseRenderSettings(options, tfJson, v.volume.get(), true);
             Interrupt in(progress);
             s.progress = in.progress();
             RenderStats stats;
@@ -88,17 +88,35 @@ void bindRender(py::module_& m) {
             });
             return renderResult(std::move(image), stats, withStats);
         },
-        py::arg("volume"), py::arg("argv"), py::arg("tf_json"), py::arg("progress"),
+        py::arg("volume"), py::arg("options"), py::arg("tf_json"), py::arg("progress"),
         py::arg("return_stats"));
     m.def("_render_options", &renderOptionTable);
+    m.def(
+        "_option_specs",
+        [] {
+            // (name, type, default, set, is a path) per option of the table, for the tests.
+            static const char* const types[] = {"flag", "integer", "unsigned",
+                                                "real", "text",    "list"};
+            std::vector<std::tuple<std::string, std::string, std::string, std::string, bool>> out;
+            for (const OptionSpec& o : optionTable()) {
+                const char* set = o.set == kVolumeOptions  ? "volume"
+                                  : o.set == kRenderOptions ? "render"
+                                  : o.set == kImageOptions  ? "image"
+                                                            : "sweep";
+                out.emplace_back(std::string(o.name), types[int(o.type)],
+                                 std::string(o.defaultText), set, o.path != OptionPath::None);
+            }
+            return out;
+        },
+        "The option table (splat/options.h): (name, type, default, set, is_path) per option.");
 
     py::class_<PyScene>(m, "_Scene")
-        .def(py::init(&makeScene), py::arg("volume"), py::arg("argv"), py::arg("tf_json"))
+        .def(py::init(&makeScene), py::arg("volume"), py::arg("options"), py::arg("tf_json"))
         .def(
             "render",
-            [](const PyScene& p, const std::vector<std::string>& argv, const std::string& tfJson,
+            [](const PyScene& p, const Keywords& options, const std::string& tfJson,
                const py::object& progress, bool withStats, bool depth) {
-                RenderSettings s = parseRenderSettings(argv, tfJson, &p.scene->volume(), true);
+                RenderSettings s = parseRenderSettings(options, tfJson, &p.scene->volume(), true);
                 Interrupt in(progress);
                 s.progress = frameProgress(in, p.cancel);
                 RenderStats stats;
@@ -111,7 +129,7 @@ void bindRender(py::module_& m) {
                     p.cancel.get());
                 return renderResult(std::move(image), stats, withStats);
             },
-            py::arg("argv"), py::arg("tf_json"), py::arg("progress"), py::arg("return_stats"),
+            py::arg("options"), py::arg("tf_json"), py::arg("progress"), py::arg("return_stats"),
             py::arg("depth"))
         .def(
             "sequence",

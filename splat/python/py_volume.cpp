@@ -366,10 +366,10 @@ background_value: the field's value where nothing is (default: the median of the
 
     m.def(
         "_load",
-        [](const std::string& spec, const std::vector<std::string>& argv) {
-            return share(loadWithOptions(spec, argv));
+        [](const std::string& spec, const Keywords& options) {
+            return share(loadWithOptions(spec, options));
         },
-        py::arg("spec"), py::arg("argv"));
+        py::arg("spec"), py::arg("options"));
     m.def("_load_options", &loadOptionTable);
     m.def(
         "_from_affine",

@@ -10,10 +10,10 @@
 //       frame its wall and CPU time, stage counters, level of detail used, pixel-filter passes
 //       (the filtered reference) and the camera (target, right, up, view, pixel size), and the
 //       scene's build time, splat count and bytes per splat. RENDER OPTIONS are `splat
-//       render`'s own (tools/cli/render_options.h: --renderer, --mode, --slab, --lod, --ewa,
+//       render`'s own, from the library's option table (splat/options.h: --renderer, --mode, --slab, --lod, --ewa,
 //       --pixel-filter, --size WxH or N, --threads (default 2), --elevation (default 15), ...),
 //       and --factorised-sheets N (Quality::factorisedSheets, not a `splat render` option yet),
-//       parsed by the same code, so any value the command line accepts (e.g. a new `--lod`
+//       read by the same code, so any value the command line accepts (e.g. a new `--lod`
 //       mode) works here too; TF is the --tf value (a preset or a JSON file). Frames listed in
 //       --save are written to DIR/frame_K.f32 (float RGBA, row 0 at the top); the reference
 //       renders only those.
@@ -35,7 +35,9 @@
 #include <string>
 #include <vector>
 
-#include "render_options.h"
+#include <CLI/CLI.hpp>
+
+#include "splat/options.h"
 #include "splat/error.h"
 #include "splat/scene.h"
 #include "splat/volume_io.h"
@@ -84,11 +86,19 @@ void writeFloats(const std::string& path, const splat::Image& image) {
 int renderRotation(const std::string& spec, const std::string& tf,
                    std::vector<std::string> args) {
     CLI::App app{"bench_frames render"};
-    splat::cli::RenderArgs r;
-    r.tf = tf;
-    r.threads = 2;
-    r.elevation = 15;
-    splat::cli::addRenderOptions(app, r, false);
+    splat::OptionValues values(splat::kRenderOptions);
+    values.textSlot("tf") = tf;
+    values.textSlot("threads") = "2";
+    values.textSlot("elevation") = "15";
+    for (const splat::OptionSpec* o : values.specs()) {
+        const std::string flag = "--" + std::string(o->name), help(o->help);
+        if (o->type == splat::OptionType::Flag)
+            app.add_flag(flag, values.flagSlot(o->name), help);
+        else if (o->type == splat::OptionType::TextList)
+            app.add_option(flag, values.listSlot(o->name), help);
+        else
+            app.add_option(flag, values.textSlot(o->name), help);
+    }
     int frames = 12, warmupFlag = 1;
     std::string saveList, out = ".";
     app.add_option("--frames", frames, "frames of the rotation");
@@ -110,7 +120,12 @@ int renderRotation(const std::string& spec, const std::string& tf,
         std::cerr << "bench_frames: error: " << e.what() << '\n';
         return 2;
     }
-    splat::RenderSettings s = splat::cli::settingsFromArgs(r, splat::cli::RenderUse{});
+    for (const splat::OptionSpec* o : values.specs())
+        if (app.get_option("--" + std::string(o->name))->count() > 0)
+            values.markGiven(o->name, false);
+    splat::RenderSettings s = splat::renderSettingsFrom(
+        values, splat::RenderUse{},
+        [](const std::string& line) { std::cerr << "bench_frames: warning: " << line << '\n'; });
     s.quality.factorisedSheets = factorised;
     frames = std::max(1, frames);
     const double elevation = s.camera.elevationDeg;
@@ -125,7 +140,7 @@ int renderRotation(const std::string& spec, const std::string& tf,
 
     auto volume = std::make_shared<const splat::Volume>(splat::loadVolume(spec));
     const auto built = Clock::now();
-    s = splat::cli::withFreeCameraTarget(s, *volume);
+    s = splat::withFreeCameraTarget(s, *volume);
     const splat::Scene scene(volume, s);
     const double sceneMs = msSince(built);
     const bool onlySaved = s.renderer == splat::RendererKind::Reference;

@@ -120,11 +120,12 @@ std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume) {
 
 Volume brickedGeometry(const VolumeArgs& volume, bool* aloneOut) {
     const LoadOptions options = loadOptionsFromArgs(volume);
-    const bool given = !volume.backgroundValue.empty() && volume.backgroundValue != "auto";
+    const std::string& background = volume.values.text("background-value");
+    const bool given = !background.empty() && background != "auto";
     bool alone = false;
     Volume geometry = volumeGeometry(volume.spec, options, &alone, !given);
     if (given) {
-        geometry.background = std::stof(volume.backgroundValue);
+        geometry.background = std::stof(background);
         geometry.backgroundSource = "--background-value";
     }
     if (aloneOut)

@@ -74,7 +74,7 @@ void registerBench(CLI::App& app) {
         out["volume"] = a->volume.spec;
         out["renderer"] = toString(settings.renderer);
         out["mode"] = toString(settings.mode);
-        out["size"] = a->render.size;
+        out["size"] = a->render.size();
         out["slab"] = settings.quality.slab;
         out["hardware_threads"] = std::thread::hardware_concurrency();
         out["scene"] = sceneOf(*cmd);

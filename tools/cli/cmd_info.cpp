@@ -79,7 +79,7 @@ void registerInfo(CLI::App& app) {
         }
         loadOptionsFromArgs(*args);
         // A folder of several DICOM series: list them (one is chosen with --series UID).
-        if (args->series.empty()) {
+        if (args->values.text("series").empty()) {
             const auto series = listDicomSeries(args->spec);
             if (series.size() > 1) {
                 std::printf("%s: %zu DICOM series (load one with --series UID)\n",

@@ -9,7 +9,7 @@
 #include "render_options.h"
 #include "scene_file.h"
 #include "splat/error.h"
-#include "technique_options.h"
+#include "splat/options.h"
 #include "view_options.h"
 #include "volume_options.h"
 

@@ -183,13 +183,13 @@ void registerPopping(CLI::App& app) {
         };
         PoppingResult result;
         try {
-            if (a->popping.path.empty()) {
+            if (a->popping.path().empty()) {
                 result = bricked ? analyzePopping(*geometry, settings, sweep, o)
                                  : analyzePopping(*scene, sweep, o);
             } else {
                 const CameraPath path = CameraPath::fromJson(
-                    a->popping.path, bricked ? settings.camera : scene->settings().camera,
-                    a->popping.frames);
+                    a->popping.path(), bricked ? settings.camera : scene->settings().camera,
+                    a->popping.frames());
                 result = bricked ? analyzePopping(*geometry, settings, path, o)
                                  : analyzePopping(*scene, path, o);
             }

@@ -103,8 +103,8 @@ nlohmann::json manifestOf(const RotateCommand& a, const RenderSettings& s) {
             {"renderer", toString(s.renderer)},
             {"mode", toString(s.mode)},
             {"classify", toString(s.classification)},
-            {"tf", a.render.tfInline.is_null() ? nlohmann::json(a.render.tf) : a.render.tfInline},
-            {"size", a.render.size},
+            {"tf", a.render.values.tfInline.empty() ? nlohmann::json(a.render.values.text("tf")) : nlohmann::json::parse(a.render.values.tfInline)},
+            {"size", a.render.size()},
             {"azimuth", s.camera.azimuthDeg},
             {"elevation", s.camera.elevationDeg},
             {"slab", s.quality.slab},
@@ -139,8 +139,8 @@ void renderTimeSteps(const RotateCommand& a, const std::shared_ptr<const Volume>
         std::shared_ptr<const Volume> volume = first;
         if (f > 0) {
             VolumeArgs step = a.volume;
-            step.time = std::to_string(a.firstStep + int(f));
-            volume = std::make_shared<const Volume>(loadVolumeWith(step));
+            step.values.set("time", std::to_string(a.firstStep + int(f)));
+            volume = std::make_shared<const Volume>(loadVolumeFrom(step.spec, step.values));
         }
         const Scene scene(volume, settings);
         const Image image = scene.render(settings.renderer, path.views[f]);
@@ -342,45 +342,156 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
 }
 }  // namespace
 
+namespace {
+
+/// The options of `splat rotate` besides the volume and rendering options.
+void addRotateOptions(CLI::App& cmd, RotateCommand& a) {
+    const std::string seq = "Sequence", out = "Output";
+    addOption(cmd, "--frames", a.frames, "number of frames", seq);
+    addOption(cmd, "--from", a.from, "first angle, degrees", seq);
+    addOption(cmd, "--to", a.to,
+              "last angle, degrees (inclusive: the last frame is at --to). Default: a full "
+              "turn that loops without repeating a view, from + 360 (frames - 1) / frames",
+              seq);
+    addOption(cmd, "--sweep", a.sweep, "the angle turned: azimuth or elevation", seq);
+    addOption(cmd, "--path", a.path,
+              "camera path JSON {\"keys\": [{\"azimuth\", \"elevation\", \"distance\", "
+              "\"pixel_size\"}, ...]}, interpolated over --frames (instead of --sweep)",
+              seq, PathKind::Input);
+    addOption(cmd, "--time-steps", a.timeSteps,
+              "time series: one frame per time step A..B (inclusive, e.g. 0:19; sets --frames); "
+              "the camera stays unless --from/--to or --path turn it over the sequence",
+              seq);
+    addOption(cmd, "--parallel-frames", a.parallelFrames,
+              "frames rendered at once, one thread each (0: automatic)", seq);
+    addSequenceBrickOptions(cmd, a.brick, seq, "every frame");
+    addOption(cmd, "-o,--output", a.outDir, "output folder for the frames (created)", out,
+              PathKind::Output);
+    addOption(cmd, "--name", a.name, "frame file name pattern (printf %d of the frame index)",
+              out);
+    addOption(cmd, "--format", a.format, "frame format: png, exr or tif", out);
+    addFlag(cmd, "--resume", a.resume, "render only the frames missing from the folder", out);
+    addFlag(cmd, "--overwrite", a.overwrite, "replace the frames the folder holds", out);
+    addOption(cmd, "--gif", a.gif, "also write an animated GIF", out, PathKind::Output);
+    addOption(cmd, "--contact-sheet", a.contact, "also write a contact sheet (all frames, tiled)",
+              out, PathKind::Output);
+    addOption(cmd, "--mp4", a.mp4,
+              "also write an MP4 video (needs the ffmpeg program; png frames)", out,
+              PathKind::Output);
+    addOption(cmd, "--fps", a.fps, "GIF and MP4 frames per second (1..100)", out);
+    addFlag(cmd, "-q,--quiet", a.quiet, "no progress output", out);
+}
+
+/// --time-steps A:B: sets --frames and the first frame's --time; refuses --time, a --frames
+/// that disagrees and mpirun.
+void checkTimeSteps(const CLI::App& cmd, RotateCommand& a) {
+    if (!a.volume.values.text("time").empty())
+        throw Error("--time-steps and --time exclude each other");
+    const auto [first, last] = parseTimeSteps(a.timeSteps);
+    const long long n = (long long)last - first + 1;
+    if (n > 100000) throw Error("--time-steps: at most 100000 frames");
+    if (given(cmd, "frames") && a.frames != n)
+        throw Error("--frames " + std::to_string(a.frames) + " and --time-steps " + a.timeSteps +
+                    " (" + std::to_string(n) + " frames) disagree; give one of them");
+    a.frames = int(n);
+    a.firstStep = first;
+    a.volume.values.set("time", std::to_string(first));  // the first frame's volume
+    if (processCount() > 1) throw Error("--time-steps renders in one process (without mpirun)");
+}
+
+/// Refuses what cannot run before anything is rendered or created, and warns about the
+/// options the run ignores.
+void checkRotateArgs(const CLI::App& cmd, RotateCommand& a) {
+    asUsage([&] {
+        if (a.frames < 1 || a.frames > 100000)
+            throw Error("--frames must be between 1 and 100000");
+        if (a.fps < 1 || a.fps > 100) throw Error("--fps must be between 1 and 100");
+        if (a.parallelFrames < 0 || a.parallelFrames > 1024)
+            throw Error("--parallel-frames must be between 0 and 1024");
+        if (!std::isfinite(a.from) || !std::isfinite(a.to) || std::abs(a.from) > 1e6 ||
+            std::abs(a.to) > 1e6)
+            throw Error("--from and --to must be finite angles (degrees)");
+        if (a.format != "png" && a.format != "exr" && a.format != "tif")
+            throw Error("--format must be png, exr or tif");
+        if (a.sweep != "azimuth" && a.sweep != "elevation")
+            throw Error("--sweep must be azimuth or elevation");
+        if (a.resume && a.overwrite)
+            throw Error("--resume and --overwrite exclude each other");
+        checkPattern(a.name);
+        if (!a.gif.empty() && lowerExtension(a.gif) != ".gif")
+            throw Error(a.gif + ": --gif needs a .gif file name");
+        if (!a.contact.empty()) checkImageExtension(a.contact);
+        if (!a.mp4.empty() && lowerExtension(a.mp4) != ".mp4")
+            throw Error(a.mp4 + ": --mp4 needs a .mp4 file name");
+        if (!a.mp4.empty() && a.format != "png")
+            throw Error("--mp4 is made from png frames (--format png)");
+        if (!a.timeSteps.empty()) checkTimeSteps(cmd, a);
+    });
+    if (!a.path.empty())
+        for (const char* k : {"from", "to", "sweep"})
+            if (given(cmd, k) && !fromScene(cmd, k))
+                warn(std::string("--") + k + " does not apply with --path (the path's keys " +
+                     "set the views); ignored");
+    if (a.gif.empty() && a.mp4.empty() && given(cmd, "fps") && !fromScene(cmd, "fps"))
+        warn("--fps applies to --gif and --mp4 only; ignored");
+}
+
+/// The views: a turn of the swept angle, or the camera path of --path.
+CameraPath rotatePath(const CLI::App& cmd, const RotateCommand& a, const RenderSettings& settings) {
+    if (!a.path.empty()) return CameraPath::fromJson(a.path, settings.camera, a.frames);
+    const double to = given(cmd, "to") ? a.to : a.from + 360.0 * (a.frames - 1) / a.frames;
+    return CameraPath::turn(settings.camera,
+                            a.sweep == "azimuth" ? CameraPath::Angle::Azimuth
+                                                 : CameraPath::Angle::Elevation,
+                            a.from, to, a.frames);
+}
+
+/// The display window (mip, xray) is fixed by the first frame a folder gets, and kept in the
+/// manifest so that resumed frames match: the window of a resumed folder, if it has one.
+std::optional<WriteOptions> resumedWindow(const RotateCommand& a) {
+    if (!a.resume) return std::nullopt;
+    std::ifstream in(fs::path(a.outDir) / kManifest);
+    if (!in) return std::nullopt;
+    try {
+        const nlohmann::json old = nlohmann::json::parse(in);
+        if (!old.contains("window")) return std::nullopt;
+        WriteOptions w;
+        w.mapping = DisplayMapping::Window;
+        w.windowLow = old["window"][0].get<float>();
+        w.windowHigh = old["window"][1].get<float>();
+        return withMetadata(w);
+    } catch (const std::exception&) {
+        return std::nullopt;
+    }
+}
+
+/// The GIF and contact sheet of the frames (those kept from an earlier run read back).
+void writeGifAndContactSheet(const RotateCommand& a, std::vector<Image>& shown,
+                             const std::vector<bool>& keep,
+                             const std::optional<WriteOptions>& display) {
+    for (std::size_t f = 0; f < shown.size(); ++f)
+        if (keep[f]) {
+            const Image im = readImage(frameFile(a, f));
+            shown[f] = a.format == "png" || !display ? im : toDisplay(im, *display);
+        }
+    WriteOptions asIs;
+    asIs.mapping = DisplayMapping::Display;
+    if (!a.gif.empty()) writeAnimatedGif(a.gif, shown, asIs, a.fps);
+    if (!a.contact.empty()) {
+        std::vector<Image> small;
+        for (const Image& im : shown) small.push_back(downscale(im, 160));
+        writeImage(a.contact, contactSheet(small), withMetadata(asIs));
+    }
+}
+
+}  // namespace
+
 void registerRotate(CLI::App& app) {
     auto a = std::make_shared<RotateCommand>();
     CLI::App* cmd = app.add_subcommand("rotate", "render a rotation sequence or a camera path");
     addVolumeOptions(*cmd, a->volume);
     addRenderOptions(*cmd, a->render, true);
-    const std::string seq = "Sequence", out = "Output";
-    addOption(*cmd, "--frames", a->frames, "number of frames", seq);
-    addOption(*cmd, "--from", a->from, "first angle, degrees", seq);
-    addOption(*cmd, "--to", a->to,
-              "last angle, degrees (inclusive: the last frame is at --to). Default: a full "
-              "turn that loops without repeating a view, from + 360 (frames - 1) / frames",
-              seq);
-    addOption(*cmd, "--sweep", a->sweep, "the angle turned: azimuth or elevation", seq);
-    addOption(*cmd, "--path", a->path,
-              "camera path JSON {\"keys\": [{\"azimuth\", \"elevation\", \"distance\", "
-              "\"pixel_size\"}, ...]}, interpolated over --frames (instead of --sweep)",
-              seq, PathKind::Input);
-    addOption(*cmd, "--time-steps", a->timeSteps,
-              "time series: one frame per time step A..B (inclusive, e.g. 0:19; sets --frames); "
-              "the camera stays unless --from/--to or --path turn it over the sequence",
-              seq);
-    addOption(*cmd, "--parallel-frames", a->parallelFrames,
-              "frames rendered at once, one thread each (0: automatic)", seq);
-    addSequenceBrickOptions(*cmd, a->brick, seq, "every frame");
-    addOption(*cmd, "-o,--output", a->outDir, "output folder for the frames (created)", out,
-              PathKind::Output);
-    addOption(*cmd, "--name", a->name, "frame file name pattern (printf %d of the frame index)",
-              out);
-    addOption(*cmd, "--format", a->format, "frame format: png, exr or tif", out);
-    addFlag(*cmd, "--resume", a->resume, "render only the frames missing from the folder", out);
-    addFlag(*cmd, "--overwrite", a->overwrite, "replace the frames the folder holds", out);
-    addOption(*cmd, "--gif", a->gif, "also write an animated GIF", out, PathKind::Output);
-    addOption(*cmd, "--contact-sheet", a->contact, "also write a contact sheet (all frames, tiled)",
-              out, PathKind::Output);
-    addOption(*cmd, "--mp4", a->mp4,
-              "also write an MP4 video (needs the ffmpeg program; png frames)", out,
-              PathKind::Output);
-    addOption(*cmd, "--fps", a->fps, "GIF and MP4 frames per second (1..100)", out);
-    addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
+    addRotateOptions(*cmd, *a);
     cmd->footer(
         "Examples:\n"
         "  splat rotate ch2.nii.gz --tf mri-head --frames 36 -o turn --gif turn.gif\n"
@@ -390,53 +501,7 @@ void registerRotate(CLI::App& app) {
     cmd->callback([a, cmd] {
         // Everything that can be refused is refused before anything is rendered or created.
         prepareCommand(*cmd, {"volume", "output"});
-        asUsage([&] {
-            if (a->frames < 1 || a->frames > 100000)
-                throw Error("--frames must be between 1 and 100000");
-            if (a->fps < 1 || a->fps > 100) throw Error("--fps must be between 1 and 100");
-            if (a->parallelFrames < 0 || a->parallelFrames > 1024)
-                throw Error("--parallel-frames must be between 0 and 1024");
-            if (!std::isfinite(a->from) || !std::isfinite(a->to) || std::abs(a->from) > 1e6 ||
-                std::abs(a->to) > 1e6)
-                throw Error("--from and --to must be finite angles (degrees)");
-            if (a->format != "png" && a->format != "exr" && a->format != "tif")
-                throw Error("--format must be png, exr or tif");
-            if (a->sweep != "azimuth" && a->sweep != "elevation")
-                throw Error("--sweep must be azimuth or elevation");
-            if (a->resume && a->overwrite)
-                throw Error("--resume and --overwrite exclude each other");
-            checkPattern(a->name);
-            if (!a->gif.empty() && lowerExtension(a->gif) != ".gif")
-                throw Error(a->gif + ": --gif needs a .gif file name");
-            if (!a->contact.empty()) checkImageExtension(a->contact);
-            if (!a->mp4.empty() && lowerExtension(a->mp4) != ".mp4")
-                throw Error(a->mp4 + ": --mp4 needs a .mp4 file name");
-            if (!a->mp4.empty() && a->format != "png")
-                throw Error("--mp4 is made from png frames (--format png)");
-            if (!a->timeSteps.empty()) {
-                if (!a->volume.time.empty())
-                    throw Error("--time-steps and --time exclude each other");
-                const auto [first, last] = parseTimeSteps(a->timeSteps);
-                const long long n = (long long)last - first + 1;
-                if (n > 100000) throw Error("--time-steps: at most 100000 frames");
-                if (given(*cmd, "frames") && a->frames != n)
-                    throw Error("--frames " + std::to_string(a->frames) + " and --time-steps " +
-                                a->timeSteps + " (" + std::to_string(n) +
-                                " frames) disagree; give one of them");
-                a->frames = int(n);
-                a->firstStep = first;
-                a->volume.time = std::to_string(first);  // the first frame's volume
-                if (processCount() > 1)
-                    throw Error("--time-steps renders in one process (without mpirun)");
-            }
-        });
-        if (!a->path.empty())
-            for (const char* k : {"from", "to", "sweep"})
-                if (given(*cmd, k) && !fromScene(*cmd, k))
-                    warn(std::string("--") + k + " does not apply with --path (the path's keys " +
-                         "set the views); ignored");
-        if (a->gif.empty() && a->mp4.empty() && given(*cmd, "fps") && !fromScene(*cmd, "fps"))
-            warn("--fps applies to --gif and --mp4 only; ignored");
+        checkRotateArgs(*cmd, *a);
         checkSequenceBrickOptions(*cmd, a->brick);
         RenderUse use;
         use.imageExt = "." + a->format;
@@ -478,15 +543,7 @@ void registerRotate(CLI::App& app) {
         const CameraPath path =
             fixedCamera
                 ? CameraPath{std::vector<CameraParams>(std::size_t(a->frames), settings.camera)}
-            : a->path.empty()
-                ? CameraPath::turn(
-                      settings.camera,
-                      a->sweep == "azimuth" ? CameraPath::Angle::Azimuth
-                                            : CameraPath::Angle::Elevation,
-                      a->from,
-                      given(*cmd, "to") ? a->to : a->from + 360.0 * (a->frames - 1) / a->frames,
-                      a->frames)
-                : CameraPath::fromJson(a->path, settings.camera, a->frames);
+                : rotatePath(*cmd, *a, settings);
         nlohmann::json manifest = manifestOf(*a, settings);
         std::vector<bool> keep(std::size_t(a->frames), false);
         std::shared_ptr<const Volume> volume;
@@ -509,7 +566,7 @@ void registerRotate(CLI::App& app) {
                     double(a->frames) * settings.camera.width * settings.camera.height >
                         double(1 << 28))
                     throw Error("--gif/--contact-sheet with " + std::to_string(a->frames) +
-                                " frames of " + a->render.size +
+                                " frames of " + a->render.size() +
                                 " would not fit in memory; use fewer frames or a smaller --size");
                 keep = prepareFolder(*a, manifest, settings.camera.width, settings.camera.height);
                 beginRun(*cmd);
@@ -522,29 +579,15 @@ void registerRotate(CLI::App& app) {
                     // The last step is loaded once up front: a step past the file's last is a
                     // usage error before any frame is rendered.
                     VolumeArgs last = a->volume;
-                    last.time = std::to_string(a->firstStep + a->frames - 1);
-                    (void)loadVolumeWith(last);
+                    last.values.set("time", std::to_string(a->firstStep + a->frames - 1));
+                    (void)loadVolumeFrom(last.spec, last.values);
                 }
                 std::error_code ec;
                 fs::create_directories(a->outDir, ec);
                 if (!fs::is_directory(a->outDir))
                     throw Error(a->outDir + ": cannot create output folder");
 
-                // The display window (mip, xray) is fixed by the first frame a folder gets, and
-                // kept in the manifest so that resumed frames match.
-                if (std::ifstream in(fs::path(a->outDir) / kManifest); in && a->resume) {
-                    try {
-                        const nlohmann::json old = nlohmann::json::parse(in);
-                        if (old.contains("window")) {
-                            WriteOptions w;
-                            w.mapping = DisplayMapping::Window;
-                            w.windowLow = old["window"][0].get<float>();
-                            w.windowHigh = old["window"][1].get<float>();
-                            display = withMetadata(w);
-                        }
-                    } catch (const std::exception&) {
-                    }
-                }
+                display = resumedWindow(*a);
             }
         } catch (const std::exception& e) {
             if (!bricked) throw;
@@ -599,22 +642,7 @@ void registerRotate(CLI::App& app) {
         progress.finish();
         if (rendered == 0 && !fs::exists(fs::path(a->outDir) / kManifest))
             writeTextAtomic(fs::path(a->outDir) / kManifest, manifest.dump(2) + "\n");
-        if (keepImages) {
-            // Frames kept from an earlier run are read back.
-            for (std::size_t f = 0; f < shown.size(); ++f)
-                if (keep[f]) {
-                    const Image im = readImage(frameFile(*a, f));
-                    shown[f] = a->format == "png" || !display ? im : toDisplay(im, *display);
-                }
-            WriteOptions asIs;
-            asIs.mapping = DisplayMapping::Display;
-            if (!a->gif.empty()) writeAnimatedGif(a->gif, shown, asIs, a->fps);
-            if (!a->contact.empty()) {
-                std::vector<Image> small;
-                for (const Image& im : shown) small.push_back(downscale(im, 160));
-                writeImage(a->contact, contactSheet(small), withMetadata(asIs));
-            }
-        }
+        if (keepImages) writeGifAndContactSheet(*a, shown, keep, display);
         if (!a->mp4.empty()) writeMp4(*a, ffmpeg);
         std::printf("wrote %zu frames to %s (%zu kept)%s%s%s%s%s%s (%.1f ms per frame)\n", rendered,
                     a->outDir.c_str(), std::size_t(a->frames) - rendered,

@@ -6,15 +6,18 @@
 #include <string>
 
 #include "splat/error.h"
+#include "splat/options.h"
 
 namespace splat::cli {
 
 inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 2;
 
-class UsageError : public Error {
+/// A usage error of the command line; the library's OptionError (a malformed option value)
+/// is one too.
+class UsageError : public OptionError {
   public:
-    explicit UsageError(const std::string& message) : Error(message) {}
+    explicit UsageError(const std::string& message) : OptionError(message) {}
 };
 
 /// Prints `splat: warning: LINE` on stderr, one line per line of `text`.
@@ -25,9 +28,22 @@ template <class F>
 auto asUsage(F&& parse) -> decltype(parse()) {
     try {
         return parse();
-    } catch (const UsageError&) {
+    } catch (const OptionError&) {
         throw;
     } catch (const Error& e) {
+        throw UsageError(e.what());
+    }
+}
+
+/// Runs `read` (reading options, maybe files); an OptionError it throws becomes a UsageError,
+/// other errors (a file that cannot be read) stay failures of the work.
+template <class F>
+auto asOptionUsage(F&& read) -> decltype(read()) {
+    try {
+        return read();
+    } catch (const UsageError&) {
+        throw;
+    } catch (const OptionError& e) {
         throw UsageError(e.what());
     }
 }

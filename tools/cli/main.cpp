@@ -101,7 +101,7 @@ int runCommand(int argc, char** argv) {
         std::replace(what.begin(), what.end(), '\n', ' ');
         printError(what + " (see '" + where + " --help')");
         return kExitUsage;
-    } catch (const UsageError& e) {
+    } catch (const splat::OptionError& e) {  // UsageError, or a malformed option value
         printError(e.what());
         return kExitUsage;
     } catch (

@@ -31,6 +31,8 @@ struct Entry {
     json initial;  ///< the value at registration: the default
     std::function<void(const json&)> setObject;
     std::function<json()> getObject;
+    /// An option of the library's table: why a value's text is not of its type ("" if it is).
+    std::function<std::string(const std::string&)> check;
 };
 
 struct CommandTable {
@@ -185,6 +187,11 @@ void applyKey(const CLI::App& cmd, CommandTable& t, Entry& e, const json& v,
         results.push_back(textOf(e, v, where, dir));
     }
     if (results.empty()) return;
+    if (e.check)
+        for (const std::string& r : results)
+            if (const std::string why = e.check(r); !why.empty())
+                throw UsageError(where + ": " + v.dump() + " is not a valid " + kindWord(e.kind) +
+                                 " (--" + e.key + ": " + why + ")");
     e.opt->add_result(results);
     try {
         e.opt->run_callback();
@@ -298,6 +305,88 @@ CLI::Option* addFlag(CLI::App& cmd, const std::string& names, bool& var, const s
     CLI::Option* o = cmd.add_flag(names, var, help)->group(group);
     detail::recordOption(cmd, o, ValueKind::Flag, PathKind::None, [&var] { return json(var); });
     return o;
+}
+
+namespace {
+
+ValueKind kindOf(OptionType t) {
+    switch (t) {
+        case OptionType::Flag:
+            return ValueKind::Flag;
+        case OptionType::Integer:
+            return ValueKind::Integer;
+        case OptionType::Unsigned:
+            return ValueKind::Unsigned;
+        case OptionType::Real:
+            return ValueKind::Real;
+        case OptionType::TextList:
+            return ValueKind::TextList;
+        case OptionType::Text:
+            break;
+    }
+    return ValueKind::Text;
+}
+
+PathKind pathOf(OptionPath p) {
+    return p == OptionPath::Input ? PathKind::Input
+                                  : p == OptionPath::Output ? PathKind::Output : PathKind::None;
+}
+
+/// A number option's text as a written scene holds it: typed (the text itself when it is
+/// not a number; such a value never runs).
+json typedNumber(OptionType type, const std::string& text) {
+    char* end = nullptr;
+    if (type == OptionType::Real) {
+        const double d = std::strtod(text.c_str(), &end);
+        return !text.empty() && *end == '\0' ? json(d) : json(text);
+    }
+    const long long i = std::strtoll(text.c_str(), &end, 10);
+    if (text.empty() || *end != '\0') return json(text);
+    return type == OptionType::Unsigned && i >= 0 ? json(static_cast<unsigned long long>(i))
+                                                  : json(i);
+}
+
+}  // namespace
+
+void addTableOptions(CLI::App& cmd, OptionValues& values, unsigned sets) {
+    for (const OptionSpec* spec : optionsOf(sets)) {
+        const std::string name(spec->name), flag = "--" + name, help(spec->help);
+        CLI::Option* o = nullptr;
+        std::function<json()> get;
+        if (spec->type == OptionType::Flag) {
+            bool& slot = values.flagSlot(name);
+            o = cmd.add_flag(flag, slot, help);
+            get = [&slot] { return json(slot); };
+        } else if (spec->type == OptionType::TextList) {
+            std::vector<std::string>& slot = values.listSlot(name);
+            o = cmd.add_option(flag, slot, help);
+            get = [&slot] { return json(slot); };
+        } else {
+            std::string& slot = values.textSlot(name);
+            o = cmd.add_option(flag, slot, help);
+            if (!spec->defaultText.empty()) o->default_str(std::string(spec->defaultText));
+            if (spec->type == OptionType::Text) {
+                get = [&slot] { return json(slot); };
+            } else {
+                // The library refuses negative counts: --help says so as CLI11's check would.
+                o->type_name(spec->type == OptionType::Unsigned ? std::string("UINT:NONNEGATIVE")
+                                                                : std::string(typeName(spec->type)));
+                get = [&slot, type = spec->type] { return typedNumber(type, slot); };
+            }
+        }
+        o->group(std::string(spec->group));
+        detail::recordOption(cmd, o, kindOf(spec->type), pathOf(spec->path), std::move(get));
+        tableOf(cmd).entries.back().check = [spec](const std::string& text) {
+            return checkOptionText(*spec, text);
+        };
+    }
+}
+
+void readGiven(const CLI::App& cmd, OptionValues& values) {
+    for (const OptionSpec* spec : values.specs())
+        if (given(cmd, std::string(spec->name)))
+            values.markGiven(spec->name, fromScene(cmd, std::string(spec->name)));
+    values.sceneFile = sceneFileOf(cmd);
 }
 
 void acceptObject(CLI::App& cmd, const std::string& key, std::function<void(const json&)> set,

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "splat/image_io.h"
+#include "splat/options.h"
 
 namespace splat::cli {
 
@@ -60,6 +61,14 @@ CLI::Option* addOption(CLI::App& cmd, const std::string& names, T& var, const st
 
 CLI::Option* addFlag(CLI::App& cmd, const std::string& names, bool& var, const std::string& help,
                      const std::string& group);
+
+/// The options of `sets` (OptionSet bits) from the library's option table, in its order:
+/// each bound to its slot in `values`, shown in its --help group with its default, and
+/// recorded for scene files (numbers written typed).
+void addTableOptions(CLI::App& cmd, OptionValues& values, unsigned sets);
+/// Marks in `values` the options given on the command line or by the scene file, and names
+/// the scene file (for messages about an inline transfer function).
+void readGiven(const CLI::App& cmd, OptionValues& values);
 
 /// A key whose scene value may also be a JSON object (e.g. an inline transfer function):
 /// `set` takes the object, `get` returns it for written scenes (null: the option's value).

@@ -8,7 +8,7 @@
 #include "scene_file.h"
 #include "splat/error.h"
 #include "splat/image_io.h"
-#include "technique_options.h"
+#include "splat/options.h"
 
 namespace splat::cli {
 

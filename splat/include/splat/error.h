@@ -11,8 +11,9 @@ class Error : public std::runtime_error {
     explicit Error(const std::string& message) : std::runtime_error(message) {}
 };
 
-/// An option that does not fit the input it is applied to (a time step past the last one
-/// the file holds): the command line reports it as a usage error (exit status 2).
+/// A malformed option value, a combination that cannot run, or an option that does not fit
+/// the input it is applied to (a time step past the last one the file holds): the command
+/// line exits with its usage status (2), Python raises splat.InputError.
 class OptionError : public Error {
   public:
     explicit OptionError(const std::string& message) : Error(message) {}

@@ -256,8 +256,4 @@ Projection parseProjection(std::string_view);
 Ewa parseEwa(std::string_view);
 Truth parseTruth(std::string_view);
 
-/// One line per setting that does not apply to the chosen mode/classification (e.g.
-/// shading in xray): the command line prints them as warnings.
-std::vector<std::string> inapplicableSettings(const RenderSettings&);
-
 }  // namespace splat

@@ -39,8 +39,9 @@ __all__ = [
 _X_JOINED = {"size", "dims"}
 
 
-def _flag(key: str) -> str:
-    return "--" + key.rstrip("_").replace("_", "-")
+def _name(key: str) -> str:
+    """A keyword's option name: pixel_size -> pixel-size, from_ -> from."""
+    return key.rstrip("_").replace("_", "-")
 
 
 def _number(v) -> str:
@@ -65,10 +66,11 @@ def _text(key: str, value) -> str:
     raise InputError(f"{key}=: unsupported value {value!r}")
 
 
-def _argv(options: dict) -> tuple[list[str], str]:
-    """Keyword arguments as the command line's flags, and a transfer function object as the
-    project's JSON (read like a scene file's inline "tf")."""
-    argv: list[str] = []
+def _argv(options: dict) -> tuple[list[tuple[str, str]], str]:
+    """Keyword arguments as (option name, text) pairs, read by the library's option table,
+    and a transfer function object as the project's JSON (read like a scene file's inline
+    "tf")."""
+    argv: list[tuple[str, str]] = []
     tf_json = ""
     for key, value in options.items():
         if value is None:
@@ -77,17 +79,17 @@ def _argv(options: dict) -> tuple[list[str], str]:
             tf = value if isinstance(value, TransferFunction) else TransferFunction(value)
             tf_json = tf.to_json()
             continue
-        flag = _flag(key)
+        name = _name(key)
         if isinstance(value, (bool, np.bool_)):
             if value:
-                argv.append(flag)
+                argv.append((name, "true"))
             continue
         if (key == "clip_plane" and isinstance(value, (list, tuple)) and value
                 and all(isinstance(v, (list, tuple, np.ndarray, str)) for v in value)):
             for v in value:  # repeatable: clip_plane=[(x, y, z, nx, ny, nz), ...]
-                argv += [flag, _text(key, v)]
+                argv.append((name, _text(key, v)))
             continue
-        argv += [flag, _text(key, value)]
+        argv.append((name, _text(key, value)))
     return argv, tf_json
 
 

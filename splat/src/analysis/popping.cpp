@@ -12,6 +12,7 @@
 #include <numeric>
 
 #include "frame/stopwatch.h"
+#include "analysis/median.h"
 #include "frame_journal.h"
 #include "splat/flip.h"
 #include "splat/image_io.h"
@@ -37,14 +38,7 @@ double rmsDiff(const Image& a, const Image& b, const Image* c = nullptr, const I
     return n ? std::sqrt(sum / double(3 * n)) : 0.0;
 }
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0;
-    const std::size_t m = v.size() / 2;
-    std::nth_element(v.begin(), v.begin() + m, v.end());
-    const double hi = v[m];
-    if (v.size() % 2) return hi;
-    return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + m));
-}
+using analysis::median;
 
 /// median + k * MAD (scaled to a standard deviation), and at least floor * median.
 double robustThreshold(const std::vector<double>& s, double k, double floorRatio) {

@@ -31,6 +31,7 @@
 #include <tuple>
 
 #include "analysis/html_report.h"
+#include "analysis/median.h"
 #include "analysis/svg_plot.h"
 #include "splat/atomic_file.h"
 #include "splat/error.h"
@@ -55,16 +56,7 @@ constexpr const char* kFiles[] = {"report.html", "metrics.csv", "summary.json"};
 
 double at(const std::vector<double>& v, std::size_t i) { return i < v.size() ? v[i] : kNaN; }
 
-double median(std::vector<double> v) {
-    v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }),
-            v.end());
-    if (v.empty()) return kNaN;
-    const std::size_t m = v.size() / 2;
-    std::nth_element(v.begin(), v.begin() + m, v.end());
-    const double hi = v[m];
-    if (v.size() % 2) return hi;
-    return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + m));
-}
+double median(std::vector<double> v) { return analysis::finiteMedian(std::move(v)); }
 
 json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 

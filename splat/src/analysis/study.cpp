@@ -11,12 +11,14 @@
 #include <optional>
 #include <sstream>
 
+#include "analysis/median.h"
 #include "frame/stopwatch.h"
 #include "splat/atomic_file.h"
 #include "splat/error.h"
 #include "splat/frame_farm.h"
 #include "splat/image_io.h"
 #include "splat/metrics.h"
+#include "splat/options.h"
 #include "splat/render.h"
 #include "splat/scene.h"
 
@@ -29,30 +31,7 @@ namespace splat {
 
 namespace {
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double parseNumber(const std::string& knob, const std::string& text) {
-    try {
-        std::size_t used = 0;
-        const double v = std::stod(text, &used);
-        if (used != text.size()) throw std::invalid_argument(text);
-        return v;
-    } catch (const std::exception&) {
-        throw Error("--sweep " + knob + ": '" + text + "' is not a number");
-    }
-}
-
-int parseInt(const std::string& knob, const std::string& text) {
-    const double v = parseNumber(knob, text);
-    if (v != std::floor(v) || std::abs(v) > 1e9)
-        throw Error("--sweep " + knob + ": '" + text + "' is not an integer");
-    return int(v);
-}
+using analysis::median;
 
 /// Peak resident set size since the last reset (Linux /proc; 0 elsewhere), MiB.
 void resetPeakMemory() {
@@ -171,81 +150,24 @@ class Progress {
 }  // namespace
 
 std::vector<std::string> studyKnobNames() {
-    return {"renderer",
-            "slab",
-            "early-termination",
-            "size",
-            "order",
-            "classify",
-            "kernel",
-            "sigma",
-            "radius",
-            "footprint-res",
-            "slab-radial-res",
-            "slab-depth-res",
-            "poly-tol",
-            "lod",
-            "ewa",
-            "pixel-filter"};
+    return {studyKnobs().begin(), studyKnobs().end()};
 }
 
 bool isSceneKnob(const std::string& n) {
-    return n == "classify" || n == "kernel" || n == "sigma" || n == "radius" ||
-           n == "footprint-res" || n == "slab-radial-res" || n == "slab-depth-res" ||
-           n == "poly-tol";
+    const OptionSpec* o = findOption(n);
+    return o && o->scope == OptionScope::Scene;
 }
 
 void applyKnob(RenderSettings& s, const std::string& n, const std::string& v) {
-    Quality& q = s.quality;
-    if (n == "renderer")
-        s.renderer = parseRenderer(v);
-    else if (n == "slab")
-        q.slab = parseNumber(n, v);
-    else if (n == "early-termination")
-        q.earlyTermination = parseNumber(n, v);
-    else if (n == "size") {
-        int w = 0, h = 0;
-        char x = 0;
-        std::istringstream in(v);
-        if (v.find_first_of("xX") == std::string::npos)
-            w = h = parseInt(n, v);
-        else if (!(in >> w >> x >> h))
-            throw Error("--sweep size: '" + v + "' must be N or WxH");
-        if (w < 1 || h < 1) throw Error("--sweep size: '" + v + "' must be positive");
-        s.camera.width = w;
-        s.camera.height = h;
-    } else if (n == "order")
-        s.order = parseOrder(v);
-    else if (n == "classify")
-        s.classification = parseClassification(v);
-    else if (n == "kernel")
-        s.kernel = v;
-    else if (n == "sigma")
-        s.kernelSigma = parseNumber(n, v);
-    else if (n == "radius")
-        s.kernelRadius = parseNumber(n, v);
-    else if (n == "footprint-res")
-        q.footprintResolution = parseInt(n, v);
-    else if (n == "slab-radial-res")
-        q.slabRadialResolution = parseInt(n, v);
-    else if (n == "slab-depth-res")
-        q.slabDepthResolution = parseInt(n, v);
-    else if (n == "poly-tol")
-        q.polynomialTolerance = parseNumber(n, v);
-    else if (n == "lod") {
-        q.lodAuto = v == "auto";
-        q.lodBrick = v == "brick";
-        q.lod = q.lodAuto || q.lodBrick ? 0 : parseNumber(n, v);
-    }
-    else if (n == "ewa")
-        q.ewa = parseEwa(v);
-    else if (n == "pixel-filter")
-        q.pixelFilter = parseNumber(n, v);
-    else {
+    const auto& knobs = studyKnobs();
+    if (std::find(knobs.begin(), knobs.end(), n) == knobs.end()) {
         std::string all;
-        for (const auto& k : studyKnobNames()) all += (all.empty() ? "" : ", ") + k;
+        for (const auto& k : knobs) all += (all.empty() ? "" : ", ") + std::string(k);
         throw Error("unknown study knob '" + n + "' (knobs: " + all + ")");
     }
+    // A study's size may be one number N: N x N pixels.
+    const bool square = n == "size" && v.find_first_of("xX") == std::string::npos;
+    applyOption(s, n, square ? v + "x" + v : v);
 }
 
 StudyKnob parseKnob(const std::string& text) {
@@ -337,6 +259,346 @@ RenderSettings judgingReference(const RenderSettings& base, const StudyOptions& 
 }
 }  // namespace
 
+namespace {
+
+/// One setting of a study: (knob, value) per swept knob.
+using Combo = std::vector<std::pair<std::string, std::string>>;
+
+// Slab knobs mean nothing to the axis-aligned splatter and the reference: their settings are
+// measured once (first slab values) and listed without the slab knobs.
+bool isSlabKnob(const std::string& k) {
+    return k == "slab" || k == "slab-radial-res" || k == "slab-depth-res";
+}
+
+bool isSheet(const RenderSettings& base, const Combo& combo) {
+    RenderSettings probe = base;
+    for (const auto& [k, v] : combo)
+        if (k == "renderer") applyKnob(probe, k, v);
+    return probe.renderer == RendererKind::Sheet;
+}
+
+/// Every combination of the swept values, scene knobs outermost (so that each Scene is built
+/// once), without the repeats of a slab knob where it means nothing.
+std::vector<Combo> studyCombinations(const RenderSettings& base,
+                                     const std::vector<StudyKnob>& sweeps) {
+    std::vector<StudyKnob> knobs = sweeps;
+    std::stable_partition(knobs.begin(), knobs.end(),
+                          [](const StudyKnob& k) { return isSceneKnob(k.name); });
+    std::vector<Combo> combos(1);
+    for (const auto& k : knobs) {
+        std::vector<Combo> next;
+        for (const auto& c : combos)
+            for (const auto& v : k.values) {
+                auto d = c;
+                d.emplace_back(k.name, v);
+                next.push_back(std::move(d));
+            }
+        combos = std::move(next);
+    }
+    std::erase_if(combos, [&](const Combo& combo) {
+        if (isSheet(base, combo)) return false;
+        for (const auto& [k, v] : combo)
+            if (isSlabKnob(k))
+                for (const auto& sw : knobs)
+                    if (sw.name == k && v != sw.values.front()) return true;
+        return false;
+    });
+    return combos;
+}
+
+/// The study's views: the base camera, or one per (azimuth, elevation) asked for.
+std::vector<CameraParams> studyViews(const RenderSettings& base, const StudyOptions& options) {
+    if (options.views.empty()) return {base.camera};
+    std::vector<CameraParams> views;
+    for (const glm::dvec2& v : options.views) {
+        CameraParams c = base.camera;
+        c.azimuthDeg = v.x;
+        c.elevationDeg = v.y;
+        views.push_back(c);
+    }
+    return views;
+}
+
+/// The references: the base model (its scene knobs), per view and image size, rendered once,
+/// read from and written to the cache folder, or rendered ahead on a frame farm.
+class StudyReferences {
+  public:
+    StudyReferences(std::shared_ptr<const Volume> volume, const RenderSettings& base,
+                    const StudyOptions& options)
+        : volume_(std::move(volume)), base_(base), options_(options) {}
+
+    /// The reference `frame` is judged against.
+    const Image& forFrame(const RenderSettings& frame) {
+        const RenderSettings r = judgingReference(base_, options_, frame, *volume_);
+        const std::string key = referenceKey(r, options_);
+        if (auto it = references_.find(key); it != references_.end()) return it->second;
+        if (auto it = prefetched_.find(key); it != prefetched_.end()) {
+            Image& img = references_[key] = std::move(it->second);
+            prefetched_.erase(it);
+            return img;
+        }
+        if (std::optional<Image> img = cached(r)) return references_[key] = std::move(*img);
+        Image img = render(r);
+        writeCache(r, img);
+        return references_[key] = std::move(img);
+    }
+
+    /// On a frame farm, every reference missing is rendered first, spread over its processes
+    /// (the ground truth is the costly part); nothing is timed while they run.
+    void renderOnFarm(FrameFarm& farm, const std::vector<Combo>& combos,
+                      const std::vector<CameraParams>& views) {
+        std::vector<RenderSettings> wanted;
+        std::vector<FrameJob> jobs;
+        for (const auto& combo : combos) {
+            RenderSettings s = base_;
+            for (const auto& [k, v] : combo) applyKnob(s, k, v);
+            for (const CameraParams& view : views) {
+                CameraParams c = view;
+                c.width = s.camera.width;
+                c.height = s.camera.height;
+                s.camera = c;
+                const RenderSettings r = judgingReference(base_, options_, s, *volume_);
+                // The farm's Scenes render the base pixel filter; a swept one stays on rank 0.
+                if (r.quality.pixelFilter != base_.quality.pixelFilter ||
+                    r.quality.pixelFilterTolerance != base_.quality.pixelFilterTolerance)
+                    continue;
+                const std::string key = referenceKey(r, options_);
+                if (prefetched_.count(key)) continue;
+                if (std::optional<Image> img = cached(r)) {
+                    prefetched_[key] = std::move(*img);
+                    continue;
+                }
+                prefetched_[key] = Image();  // claimed: rendered by the farm below
+                jobs.push_back({wanted.size(), r.camera});
+                wanted.push_back(r);
+            }
+        }
+        farm.render(
+            {RendererKind::Reference}, jobs,
+            [&](const FrameJob& job) {
+                SequenceFrame f;
+                f.view = job.view;
+                f.images.push_back(render(wanted[job.view]));
+                f.stats.resize(1);
+                return f;
+            },
+            [&](SequenceFrame&& f) {
+                const RenderSettings& r = wanted[f.view];
+                writeCache(r, f.images[0]);
+                prefetched_[referenceKey(r, options_)] = std::move(f.images[0]);
+            });
+    }
+
+    /// The peak of the references asked for so far: the PSNR scale, as in one process.
+    double peak() const {
+        double p = 0;
+        for (const auto& [k, img] : references_) p = std::max(p, double(peakOf(img)));
+        return p;
+    }
+
+  private:
+    std::string cacheFile(const std::string& key) const {
+        if (options_.cacheDir.empty()) return {};
+        return (std::filesystem::path(options_.cacheDir) /
+                ("reference_" + std::to_string(std::hash<std::string>{}(key + volume_->source)) +
+                 ".exr"))
+            .string();
+    }
+    std::optional<Image> cached(const RenderSettings& r) const {
+        const std::string file = cacheFile(referenceKey(r, options_));
+        if (!file.empty() && std::filesystem::exists(file)) {
+            // A cached reference that does not decode whole (damaged) is rendered again.
+            try {
+                Image img = readImage(file);
+                if (img.width == r.camera.width && img.height == r.camera.height) return img;
+            } catch (const Error&) {
+            }
+        }
+        return std::nullopt;
+    }
+    void writeCache(const RenderSettings& r, const Image& img) const {
+        const std::string file = cacheFile(referenceKey(r, options_));
+        if (file.empty()) return;
+        std::filesystem::create_directories(options_.cacheDir);
+        WriteOptions wo;
+        writeImage(file, img, wo);
+    }
+    Image render(const RenderSettings& r) {
+        if (!scene_) scene_ = std::make_unique<Scene>(volume_, r);
+        return scene_->render(r);
+    }
+
+    std::shared_ptr<const Volume> volume_;
+    const RenderSettings& base_;
+    const StudyOptions& options_;
+    std::map<std::string, Image> references_;
+    /// Rendered (or read) ahead on a frame farm, moved to references_ when a point first asks.
+    std::map<std::string, Image> prefetched_;
+    std::unique_ptr<Scene> scene_;
+};
+
+/// Points measured by an interrupted run (StudyOptions::pointJournal), by label.
+std::map<std::string, nlohmann::json> readPointJournal(const StudyOptions& options) {
+    std::map<std::string, nlohmann::json> journaled;
+    if (options.pointJournal.empty() || !std::filesystem::exists(options.pointJournal))
+        return journaled;
+    try {
+        std::ifstream in(options.pointJournal);
+        for (const auto& p : nlohmann::json::parse(in)) journaled[p.at("label")] = p;
+    } catch (const std::exception&) {
+        journaled.clear();  // unreadable: measured again
+    }
+    return journaled;
+}
+
+/// Adds a measured point to the journal and writes it whole.
+void journalPoint(const StudyOptions& options, std::map<std::string, nlohmann::json>& journaled,
+                  const StudyPoint& point, std::size_t visible) {
+    if (options.pointJournal.empty()) return;
+    nlohmann::json j = pointJson(point);
+    j["visible"] = visible;
+    journaled[point.label()] = j;
+    nlohmann::json all = nlohmann::json::array();
+    for (const auto& [label, p] : journaled) all.push_back(p);
+    writeTextAtomic(options.pointJournal, all.dump() + "\n");
+}
+
+/// The point of a combination: its knobs (without slab knobs where they mean nothing) in the
+/// order of the sweeps as given, for the label.
+StudyPoint pointOf(const RenderSettings& base, const Combo& combo, const StudyOptions& options) {
+    StudyPoint point;
+    point.knobs = combo;
+    if (!isSheet(base, combo))
+        std::erase_if(point.knobs, [&](const auto& kv) { return isSlabKnob(kv.first); });
+    std::stable_sort(point.knobs.begin(), point.knobs.end(), [&](const auto& a, const auto& b) {
+        auto pos = [&](const std::string& n) {
+            for (std::size_t i = 0; i < options.sweeps.size(); ++i)
+                if (options.sweeps[i].name == n) return i;
+            return options.sweeps.size();
+        };
+        return pos(a.first) < pos(b.first);
+    });
+    return point;
+}
+
+/// A frame of the Scene with the per-frame knobs of `s`.
+RenderSettings frameOf(const Scene& scene, const RenderSettings& s) {
+    RenderSettings frame = scene.settings();
+    frame.renderer = s.renderer;
+    frame.order = s.order;
+    frame.camera = s.camera;
+    frame.background = s.background;
+    frame.threads = s.threads;
+    frame.quality.slab = s.quality.slab;
+    frame.quality.earlyTermination = s.quality.earlyTermination;
+    frame.quality.referenceStep = s.quality.referenceStep;
+    frame.quality.referenceTolerance = s.quality.referenceTolerance;
+    frame.quality.tileSize = s.quality.tileSize;
+    frame.quality.lod = s.quality.lod;
+    frame.quality.lodAuto = s.quality.lodAuto;
+    frame.quality.lodBrick = s.quality.lodBrick;
+    frame.quality.ewa = s.quality.ewa;
+    frame.quality.pixelFilter = s.quality.pixelFilter;
+    frame.quality.pixelFilterTolerance = s.quality.pixelFilterTolerance;
+    return frame;
+}
+
+/// `frame` at view `view` with the image size of `s`.
+RenderSettings atView(RenderSettings frame, const CameraParams& view, const RenderSettings& s) {
+    frame.camera = view;
+    frame.camera.width = s.camera.width;
+    frame.camera.height = s.camera.height;
+    return frame;
+}
+
+/// What a study measures a point with.
+struct StudyRun {
+    std::shared_ptr<const Volume> volume;
+    const RenderSettings& base;
+    const StudyOptions& options;
+    const std::vector<CameraParams>& views;
+    StudyReferences& references;
+    Progress& progress;
+};
+
+/// Renders the point's views (warm-up, then the timed repeats) and compares each with its
+/// reference: times, memory, splat counts and errors. Returns the most splats of a frame.
+std::size_t measurePoint(const StudyRun& run, const Scene& scene, const RenderSettings& s,
+                         StudyPoint& point) {
+    const StudyOptions& options = run.options;
+    std::size_t visible = 0;
+    std::vector<double> ms;
+    double sumSq = 0, sumMax = 0, sumFlip = 0;
+    for (std::size_t v = 0; v < run.views.size(); ++v) {
+        RenderSettings frame = atView(point.settings, run.views[v], s);
+        Image img;
+        RenderStats st;
+        for (int r = 0; r < options.warmup + options.repeats; ++r) {
+            frame.progress = [&](std::size_t, std::size_t, const std::string& what) {
+                return run.progress.poll(point.label() + ": " + what);
+            };
+            img = scene.render(frame, &st);
+            frame.progress = nullptr;
+            if (r >= options.warmup) ms.push_back(st.milliseconds);
+            if (r >= options.warmup && st.exactPixels > 0) ++point.exactFrames;
+            run.progress.step(point.label());
+        }
+        if (v == 0) {
+            point.splats = st.splats;
+            point.footprintPixels = st.footprintPixels;
+        }
+        visible = std::max(visible, st.splats);
+        point.peakMiB = std::max(point.peakMiB, peakMemoryMiB());
+        const Image& ref = run.references.forFrame(frame);
+        point.truthFilter =
+            std::max(point.truthFilter,
+                     judgingReference(run.base, options, frame, *run.volume).quality.pixelFilter);
+        const ImageMetrics m = compareImages(img, ref);
+        sumSq += m.rmse * m.rmse;
+        sumMax = std::max(sumMax, m.maxAbs);
+#if defined(SPLAT_STUDY_HAVE_FLIP)
+        const float peak = peakOf(ref);
+        FlipOptions fo;
+        fo.pixelsPerDegree = options.pixelsPerDegree;
+        sumFlip += flipMean(displayValues(img, frame.mode, peak),
+                            displayValues(ref, frame.mode, peak), fo);
+#else
+        (void)sumFlip;
+#endif
+    }
+    const double views = double(run.views.size());
+    point.rmse = std::sqrt(sumSq / views);
+    point.maxAbs = sumMax;
+    point.psnr = 20.0 * std::log10(std::max(run.references.peak(), 1e-12) /
+                                   std::max(point.rmse, 1e-300));
+#if defined(SPLAT_STUDY_HAVE_FLIP)
+    point.flip = sumFlip / views;
+#endif
+    point.msMedian = median(ms);
+    point.msMin = *std::min_element(ms.begin(), ms.end());
+    point.msMax = *std::max_element(ms.begin(), ms.end());
+    std::vector<double> dev;
+    for (double t : ms) dev.push_back(std::abs(t - point.msMedian));
+    point.msMad = median(dev);
+    point.footprintPixelRate =
+        point.msMedian > 0 ? double(point.footprintPixels) / (point.msMedian / 1000.0) : 0;
+    return visible;
+}
+
+/// A point measured by an interrupted run: its figures are kept, and its references loaded as
+/// that run did (the PSNR scale is the peak of those seen so far).
+void restoreJournaled(const StudyRun& run, const RenderSettings& s, StudyPoint& point,
+                      const nlohmann::json& saved) {
+    for (const CameraParams& view : run.views) {
+        (void)run.references.forFrame(atView(point.settings, view, s));
+        for (int r = 0; r < run.options.warmup + run.options.repeats; ++r)
+            run.progress.step(point.label());
+    }
+    restorePoint(point, saved);
+}
+
+}  // namespace
+
 StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings& base,
                      const StudyOptions& options) {
     const auto start = Clock::now();
@@ -351,295 +613,43 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
     result.flipAvailable = true;
 #endif
     for (const auto& k : options.sweeps) (void)parseKnob(k.name + "=" + k.values.front());
-
-    // Every combination: scene knobs outermost, so that each Scene is built once.
-    std::vector<StudyKnob> knobs = options.sweeps;
-    std::stable_partition(knobs.begin(), knobs.end(),
-                          [](const StudyKnob& k) { return isSceneKnob(k.name); });
-    std::vector<std::vector<std::pair<std::string, std::string>>> combos(1);
-    for (const auto& k : knobs) {
-        std::vector<std::vector<std::pair<std::string, std::string>>> next;
-        for (const auto& c : combos)
-            for (const auto& v : k.values) {
-                auto d = c;
-                d.emplace_back(k.name, v);
-                next.push_back(std::move(d));
-            }
-        combos = std::move(next);
-    }
-    // Slab knobs mean nothing to the axis-aligned splatter and the reference: their
-    // settings are measured once (first slab values) and listed without the slab knobs.
-    auto isSlabKnob = [](const std::string& k) {
-        return k == "slab" || k == "slab-radial-res" || k == "slab-depth-res";
-    };
-    auto isSheet = [&](const std::vector<std::pair<std::string, std::string>>& combo) {
-        RenderSettings probe = base;
-        for (const auto& [k, v] : combo)
-            if (k == "renderer") applyKnob(probe, k, v);
-        return probe.renderer == RendererKind::Sheet;
-    };
-    std::erase_if(combos, [&](const auto& combo) {
-        if (isSheet(combo)) return false;
-        for (const auto& [k, v] : combo)
-            if (isSlabKnob(k))
-                for (const auto& sw : knobs)
-                    if (sw.name == k && v != sw.values.front()) return true;
-        return false;
-    });
-    std::vector<CameraParams> views;
-    if (options.views.empty())
-        views.push_back(base.camera);
-    else
-        for (const glm::dvec2& v : options.views) {
-            CameraParams c = base.camera;
-            c.azimuthDeg = v.x;
-            c.elevationDeg = v.y;
-            views.push_back(c);
-        }
+    const std::vector<Combo> combos = studyCombinations(base, options.sweeps);
+    const std::vector<CameraParams> views = studyViews(base, options);
     Progress progress(options.progress,
                       combos.size() * views.size() * std::size_t(options.repeats + options.warmup));
-
-    // References: the base model (its scene knobs), per view and image size.
-    std::map<std::string, Image> references;
-    std::unique_ptr<Scene> referenceScene;
-    auto cacheFile = [&](const std::string& key) {
-        return options.cacheDir.empty()
-                   ? std::string()
-                   : (std::filesystem::path(options.cacheDir) /
-                      ("reference_" +
-                       std::to_string(std::hash<std::string>{}(key + volume->source)) + ".exr"))
-                         .string();
-    };
-    // References rendered (or read) ahead on a frame farm, moved to `references` when a point
-    // first asks for them: the PSNR scale is the peak of the references asked for so far,
-    // as in one process.
-    std::map<std::string, Image> prefetched;
-    auto cachedReference = [&](const RenderSettings& r) -> std::optional<Image> {
-        const std::string file = cacheFile(referenceKey(r, options));
-        if (!file.empty() && std::filesystem::exists(file)) {
-            // A cached reference that does not decode whole (damaged) is rendered again.
-            try {
-                Image img = readImage(file);
-                if (img.width == r.camera.width && img.height == r.camera.height) return img;
-            } catch (const Error&) {
-            }
-        }
-        return std::nullopt;
-    };
-    auto writeCache = [&](const RenderSettings& r, const Image& img) {
-        const std::string file = cacheFile(referenceKey(r, options));
-        if (file.empty()) return;
-        std::filesystem::create_directories(options.cacheDir);
-        WriteOptions wo;
-        writeImage(file, img, wo);
-    };
-    auto renderReference = [&](const RenderSettings& r) {
-        if (!referenceScene) referenceScene = std::make_unique<Scene>(volume, r);
-        return referenceScene->render(r);
-    };
-    auto referenceFor = [&](const RenderSettings& frame) -> const Image& {
-        const RenderSettings r = judgingReference(base, options, frame, *volume);
-        const std::string key = referenceKey(r, options);
-        if (auto it = references.find(key); it != references.end()) return it->second;
-        if (auto it = prefetched.find(key); it != prefetched.end()) {
-            Image& img = references[key] = std::move(it->second);
-            prefetched.erase(it);
-            return img;
-        }
-        if (std::optional<Image> img = cachedReference(r)) return references[key] = std::move(*img);
-        Image img = renderReference(r);
-        writeCache(r, img);
-        return references[key] = std::move(img);
-    };
-    // On a frame farm, every reference missing is rendered first, spread over its processes
-    // (the ground truth is the costly part); nothing is timed while they run.
-    if (FrameFarm* farm = installedFrameFarm()) {
-        std::vector<RenderSettings> wanted;
-        std::vector<FrameJob> jobs;
-        for (const auto& combo : combos) {
-            RenderSettings s = base;
-            for (const auto& [k, v] : combo) applyKnob(s, k, v);
-            for (const CameraParams& view : views) {
-                CameraParams c = view;
-                c.width = s.camera.width;
-                c.height = s.camera.height;
-                s.camera = c;
-                const RenderSettings r = judgingReference(base, options, s, *volume);
-                // The farm's Scenes render the base pixel filter; a swept one stays on rank 0.
-                if (r.quality.pixelFilter != base.quality.pixelFilter ||
-                    r.quality.pixelFilterTolerance != base.quality.pixelFilterTolerance)
-                    continue;
-                const std::string key = referenceKey(r, options);
-                if (prefetched.count(key)) continue;
-                if (std::optional<Image> img = cachedReference(r)) {
-                    prefetched[key] = std::move(*img);
-                    continue;
-                }
-                prefetched[key] = Image();  // claimed: rendered by the farm below
-                jobs.push_back({wanted.size(), r.camera});
-                wanted.push_back(r);
-            }
-        }
-        farm->render(
-            {RendererKind::Reference}, jobs,
-            [&](const FrameJob& job) {
-                SequenceFrame f;
-                f.view = job.view;
-                f.images.push_back(renderReference(wanted[job.view]));
-                f.stats.resize(1);
-                return f;
-            },
-            [&](SequenceFrame&& f) {
-                const RenderSettings& r = wanted[f.view];
-                writeCache(r, f.images[0]);
-                prefetched[referenceKey(r, options)] = std::move(f.images[0]);
-            });
-    }
-
-    // Points measured by an interrupted run (StudyOptions::pointJournal), by label.
-    std::map<std::string, nlohmann::json> journaled;
-    if (!options.pointJournal.empty() && std::filesystem::exists(options.pointJournal)) {
-        try {
-            std::ifstream in(options.pointJournal);
-            for (const auto& p : nlohmann::json::parse(in)) journaled[p.at("label")] = p;
-        } catch (const std::exception&) {
-            journaled.clear();  // unreadable: measured again
-        }
-    }
+    StudyReferences references(volume, base, options);
+    if (FrameFarm* farm = installedFrameFarm()) references.renderOnFarm(*farm, combos, views);
+    std::map<std::string, nlohmann::json> journaled = readPointJournal(options);
+    const StudyRun run{volume, base, options, views, references, progress};
 
     std::unique_ptr<Scene> scene;
     std::string sceneKey = "?";
-    for (const auto& combo : combos) {
+    for (const Combo& combo : combos) {
         RenderSettings s = base;
         std::string key;
         for (const auto& [k, v] : combo) {
             applyKnob(s, k, v);
             if (isSceneKnob(k)) key += k + "=" + v + ";";
         }
-        StudyPoint point;
-        point.knobs = combo;
-        if (!isSheet(combo))
-            std::erase_if(point.knobs, [&](const auto& kv) { return isSlabKnob(kv.first); });
-        // Keep the order of the sweeps as given for the label.
-        std::stable_sort(point.knobs.begin(), point.knobs.end(), [&](const auto& a, const auto& b) {
-            auto pos = [&](const std::string& n) {
-                for (std::size_t i = 0; i < options.sweeps.size(); ++i)
-                    if (options.sweeps[i].name == n) return i;
-                return options.sweeps.size();
-            };
-            return pos(a.first) < pos(b.first);
-        });
+        StudyPoint point = pointOf(base, combo, options);
         resetPeakMemory();
         if (key != sceneKey || !scene) {
             scene.reset();
-            RenderSettings sceneSettings = s;
             // The Scene is validated against its first renderer (iso: the reference).
-            scene = std::make_unique<Scene>(volume, sceneSettings);
+            scene = std::make_unique<Scene>(volume, s);
             sceneKey = key;
         }
-        RenderSettings frame = scene->settings();
-        frame.renderer = s.renderer;
-        frame.order = s.order;
-        frame.camera = s.camera;
-        frame.background = s.background;
-        frame.threads = s.threads;
-        frame.quality.slab = s.quality.slab;
-        frame.quality.earlyTermination = s.quality.earlyTermination;
-        frame.quality.referenceStep = s.quality.referenceStep;
-        frame.quality.referenceTolerance = s.quality.referenceTolerance;
-        frame.quality.tileSize = s.quality.tileSize;
-        frame.quality.lod = s.quality.lod;
-        frame.quality.lodAuto = s.quality.lodAuto;
-        frame.quality.lodBrick = s.quality.lodBrick;
-        frame.quality.ewa = s.quality.ewa;
-        frame.quality.pixelFilter = s.quality.pixelFilter;
-        frame.quality.pixelFilterTolerance = s.quality.pixelFilterTolerance;
-        point.settings = frame;
+        point.settings = frameOf(*scene, s);
         if (auto done = journaled.find(point.label()); done != journaled.end()) {
-            // Measured by an interrupted run: its figures are kept, and its references
-            // loaded as that run did (the PSNR scale is the peak of those seen so far).
-            for (std::size_t v = 0; v < views.size(); ++v) {
-                frame.camera = views[v];
-                frame.camera.width = s.camera.width;
-                frame.camera.height = s.camera.height;
-                (void)referenceFor(frame);
-                for (int r = 0; r < options.warmup + options.repeats; ++r)
-                    progress.step(point.label());
-            }
-            restorePoint(point, done->second);
+            restoreJournaled(run, s, point, done->second);
             result.visibleVoxels =
                 std::max(result.visibleVoxels, done->second.value("visible", std::size_t(0)));
             result.points.push_back(std::move(point));
             continue;
         }
-        std::size_t visibleHere = 0;
-        std::vector<double> ms;
-        double sumSq = 0, sumMax = 0, sumFlip = 0;
-        for (std::size_t v = 0; v < views.size(); ++v) {
-            frame.camera = views[v];
-            frame.camera.width = s.camera.width;
-            frame.camera.height = s.camera.height;
-            Image img;
-            RenderStats st;
-            for (int r = 0; r < options.warmup + options.repeats; ++r) {
-                frame.progress = [&](std::size_t, std::size_t, const std::string& what) {
-                    return progress.poll(point.label() + ": " + what);
-                };
-                img = scene->render(frame, &st);
-                frame.progress = nullptr;
-                if (r >= options.warmup) ms.push_back(st.milliseconds);
-                if (r >= options.warmup && st.exactPixels > 0) ++point.exactFrames;
-                progress.step(point.label());
-            }
-            if (v == 0) {
-                point.splats = st.splats;
-                point.footprintPixels = st.footprintPixels;
-            }
-            result.visibleVoxels = std::max(result.visibleVoxels, st.splats);
-            visibleHere = std::max(visibleHere, st.splats);
-            const double peakHere = peakMemoryMiB();
-            point.peakMiB = std::max(point.peakMiB, peakHere);
-            const Image& ref = referenceFor(frame);
-            point.truthFilter = std::max(
-                point.truthFilter,
-                judgingReference(base, options, frame, *volume).quality.pixelFilter);
-            const ImageMetrics m = compareImages(img, ref);
-            sumSq += m.rmse * m.rmse;
-            sumMax = std::max(sumMax, m.maxAbs);
-#if defined(SPLAT_STUDY_HAVE_FLIP)
-            const float peak = peakOf(ref);
-            FlipOptions fo;
-            fo.pixelsPerDegree = options.pixelsPerDegree;
-            sumFlip += flipMean(displayValues(img, frame.mode, peak),
-                                displayValues(ref, frame.mode, peak), fo);
-#else
-            (void)sumFlip;
-#endif
-        }
-        point.rmse = std::sqrt(sumSq / double(views.size()));
-        point.maxAbs = sumMax;
-        double refPeak = 0;
-        for (const auto& [k, img] : references) refPeak = std::max(refPeak, double(peakOf(img)));
-        point.psnr = 20.0 * std::log10(std::max(refPeak, 1e-12) / std::max(point.rmse, 1e-300));
-#if defined(SPLAT_STUDY_HAVE_FLIP)
-        point.flip = sumFlip / double(views.size());
-#endif
-        point.msMedian = median(ms);
-        point.msMin = *std::min_element(ms.begin(), ms.end());
-        point.msMax = *std::max_element(ms.begin(), ms.end());
-        std::vector<double> dev;
-        for (double t : ms) dev.push_back(std::abs(t - point.msMedian));
-        point.msMad = median(dev);
-        point.footprintPixelRate =
-            point.msMedian > 0 ? double(point.footprintPixels) / (point.msMedian / 1000.0) : 0;
-        if (!options.pointJournal.empty()) {
-            nlohmann::json j = pointJson(point);
-            j["visible"] = visibleHere;
-            journaled[point.label()] = j;
-            nlohmann::json all = nlohmann::json::array();
-            for (const auto& [label, p] : journaled) all.push_back(p);
-            writeTextAtomic(options.pointJournal, all.dump() + "\n");
-        }
+        const std::size_t visible = measurePoint(run, *scene, s, point);
+        result.visibleVoxels = std::max(result.visibleVoxels, visible);
+        journalPoint(options, journaled, point, visible);
         result.points.push_back(std::move(point));
     }
     markPareto(result.points);

@@ -76,23 +76,4 @@ bool Clipping::keeps(const glm::dvec3& x) const {
     return true;
 }
 
-std::vector<std::string> inapplicableSettings(const RenderSettings& s) {
-    std::vector<std::string> out;
-    const char* mode = toString(s.mode);
-    const bool projective = s.mode == RenderMode::Xray || s.mode == RenderMode::Mip;
-    if (s.shading.enabled && projective)
-        out.push_back(std::string("shading does not apply to ") + mode +
-                      " (no surfaces or emission to light); ignored");
-    if (s.edges.enabled() && s.mode != RenderMode::Dvr)
-        out.push_back(std::string("edge enhancement scales dvr opacity; ignored in ") + mode);
-    if (s.mode != RenderMode::Dvr && s.mode != RenderMode::Iso &&
-        s.classification == Classification::Post)
-        out.push_back(std::string("--classify post does not apply to ") + mode +
-                      " (no transfer function); ignored");
-    if (s.mode == RenderMode::Iso && s.renderer != RendererKind::Reference &&
-        s.order == CompositeOrder::BackToFront)
-        out.push_back("iso in the splatters composites front to back; --order btf ignored");
-    return out;
-}
-
 }  // namespace splat
