@@ -7,11 +7,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <mutex>
 
 #include "footprint/ellipse.h"
 #include "footprint/lanes.h"
 #include "frame/compositing.h"
 #include "frame/stopwatch.h"
+#include "splatters/cell_index.h"
 #include "splatters/splatter.h"
 
 namespace splat {
@@ -134,6 +137,38 @@ SheetStamp sheetStamp(const Factorisation& f, int q, const footprint::FootprintT
     return st;
 }
 
+/// The factorised sheets' state per scene (Scene::Impl::state), made on first use: the
+/// list's order along i (a counting sort on the slice index; the list is in (k, j, i) order,
+/// so sorting by i keeps rows by (k, j) within a slice) and where each slice starts in it.
+class SliceOrderI {
+  public:
+    explicit SliceOrderI(const Scene::Impl& scene) : scene_(scene) {}
+    struct Order {
+        std::vector<std::uint32_t> order, start;
+        std::uint32_t at(std::size_t n) const { return order[n]; }
+    };
+    const Order& get() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!order_) {
+            const std::vector<std::uint16_t>& index = scene_.splats.i;
+            auto o = std::make_unique<Order>();
+            o->start.assign(std::size_t(scene_.volume->dims.x) + 1, 0);
+            for (std::uint16_t q : index) ++o->start[std::size_t(q) + 1];
+            for (std::size_t q = 1; q < o->start.size(); ++q) o->start[q] += o->start[q - 1];
+            std::vector<std::uint32_t> next(o->start.begin(), o->start.end() - 1);
+            o->order.resize(index.size());
+            for (std::size_t n = 0; n < index.size(); ++n) o->order[next[index[n]]++] = std::uint32_t(n);
+            order_ = std::move(o);
+        }
+        return *order_;
+    }
+
+  private:
+    const Scene::Impl& scene_;
+    std::mutex mutex_;
+    std::unique_ptr<Order> order_;
+};
+
 /// The splats in sheet order: sheet q holds [start[q], start[q + 1]), by row v then u.
 struct SheetSplats {
     std::vector<std::uint16_t> u, v;
@@ -144,7 +179,8 @@ struct SheetSplats {
 SheetSplats sheetSplats(const Scene::Impl& scene, int m, int u, int v, const float* er,
                         const float* eg, const float* eb) {
     const SplatList& s = scene.splats;
-    const Scene::Impl::SliceOrder& order = scene.sliceOrder(m);
+    (void)m;  // sheets along i only: the other axes read the list in place (ListRows)
+    const SliceOrderI::Order& order = scene.state<SliceOrderI>().get();
     const std::vector<std::uint16_t>* axes[3] = {&s.i, &s.j, &s.k};
     const std::vector<std::uint16_t>&iu = *axes[u], &iv = *axes[v];
     SheetSplats out;
@@ -169,7 +205,7 @@ SheetSplats sheetSplats(const Scene::Impl& scene, int m, int u, int v, const flo
 
 /// The splats of row v of sheet q, list positions [first, second), by u, from one of two
 /// sources. Sheets along j or k (ListRows): a row (k, j) of the list is consecutive
-/// (Scene::Impl::cellStarts), read in place. Sheets along i (GatheredRows): the list
+/// (CellIndex::cellStarts), read in place. Sheets along i (GatheredRows): the list
 /// gathered in sheet order (SheetSplats), rows found by bisection.
 struct ListRows {
     const SplatList& s;
@@ -390,10 +426,11 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
     SheetSplats gathered;
     if (f.m == 0) gathered = sheetSplats(scene, f.m, f.u, f.v, er, eg, eb);
     const GatheredRows gatheredRows{gathered, dims[f.v]};
+    CellIndex& cells = scene.state<CellIndex>();
     const ListRows listRows{scene.splats,
-                            scene.cellStarts(),
+                            cells.cellStarts(),
                             std::size_t(dims.y),
-                            std::size_t(scene.cellsX()),
+                            std::size_t(cells.cellsX()),
                             f.m,
                             dims[f.v],
                             er,
