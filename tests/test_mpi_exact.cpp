@@ -82,8 +82,8 @@ TEST_CASE("mpi: exact sheet bricks on 2 and 3 ranks match one process within 1e-
     CHECK(rank0Bytes(fast.out) < rank0Bytes(exact.out));
 }
 
-// The brief's view of the bricked reference mip: 4 ranks, a brick each (README "Beyond one
-// machine" bounds it by 1e-5 of the peak; it was 2.0e-4 before the mip polished every hill).
+// The bricked reference mip of an oblique view: 4 ranks, a brick each (docs/parallel.md bounds
+// it by 1e-5 of the peak; it was 2.0e-4 before the mip polished every hill).
 TEST_CASE("mpi: the reference's bricked mip on 4 ranks matches one process within 1e-5", "[.mpi]") {
     const fs::path dir = testTmpDir("mpi_mip_reference");
     auto args = [&](const std::string& out, const std::string& bricks) {

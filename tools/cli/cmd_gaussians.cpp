@@ -17,35 +17,12 @@ namespace splat::cli {
 
 namespace {
 
-glm::dvec3 parseVector(const std::string& text, const std::string& what) {
-    glm::dvec3 v;
-    char tail = 0;
-    if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v.x, &v.y, &v.z, &tail) != 3)
-        throw UsageError(what + " must be X,Y,Z (got '" + text + "')");
-    return v;
-}
-
-CameraParams cameraOf(const RenderArgs& a) {
-    CameraParams c;
-    const glm::ivec2 size = asUsage([&] { return parseSize(a.size, "--size"); });
-    c.width = size.x;
-    c.height = size.y;
-    c.azimuthDeg = a.azimuth;
-    c.elevationDeg = a.elevation;
-    if (a.projection != "ortho" && a.projection != "perspective")
-        throw UsageError("--projection must be ortho or perspective");
-    c.projection =
-        a.projection == "perspective" ? Projection::Perspective : Projection::Orthographic;
-    c.pixelSize = a.pixelSize;
-    c.fovDeg = a.fov;
-    c.distance = a.distance;
-    if (!a.eye.empty()) {
-        c.lookAtSet = true;
-        c.eye = parseVector(a.eye, "--eye");
-        c.lookAt = a.lookAt.empty() ? glm::dvec3(NAN) : parseVector(a.lookAt, "--look-at");
-        if (!a.up.empty()) c.upHint = parseVector(a.up, "--up");
-    }
-    return c;
+/// The view and quality options of a Gaussian scene, read by the library's option parser as
+/// for a volume (the renderer aside: the Gaussian renderers are not volume renderers).
+RenderSettings gaussianViewOf(const RenderArgs& a) {
+    OptionValues values = a.values;
+    values.set("renderer", "axis");
+    return asOptionUsage([&] { return parseRenderOptions(values); });
 }
 
 }  // namespace
@@ -74,13 +51,16 @@ void printGaussianInfo(const std::string& spec) {
 
 void renderGaussianFile(const CLI::App& cmd, const RenderArgs& args, const std::string& spec,
                         const std::string& output) {
+    const RenderSettings view = gaussianViewOf(args);
     GaussianRenderOptions o;
-    o.renderer = asUsage(
-        [&] { return parseGaussianRenderer(given(cmd, "renderer") ? args.renderer : "3dgs"); });
-    o.threads = args.threads;
-    o.slab = given(cmd, "slab") ? args.slab : 0;
-    o.tolerance = args.refTolerance;
-    CameraParams camera = cameraOf(args);
+    o.renderer = asUsage([&] {
+        return parseGaussianRenderer(given(cmd, "renderer") ? args.values.text("renderer")
+                                                            : "3dgs");
+    });
+    o.threads = view.threads;
+    o.slab = given(cmd, "slab") ? view.quality.slab : 0;
+    o.tolerance = view.quality.referenceTolerance;
+    CameraParams camera = view.camera;
     const GaussianScene scene = openGaussians(spec);
     if (camera.lookAtSet && std::isnan(camera.lookAt.x)) camera.lookAt = scene.geometry().center();
     const auto t0 = std::chrono::steady_clock::now();
@@ -118,7 +98,6 @@ void registerGaussians(CLI::App& app) {
             throw UsageError("the output of splat gaussians must be a .ply file");
         RenderUse use;
         RenderSettings settings = settingsFromArgs(args->render, use);
-        loadOptionsFromArgs(args->volume);
         const Volume volume = loadVolumeFromArgs(args->volume);
         settings = withDataDefaults(args->render, settings, volume);
         const GaussianScene scene = gaussiansFromVolume(volume, settings);

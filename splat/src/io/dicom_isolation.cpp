@@ -224,7 +224,7 @@ DicomLayout checkDicomLengths(const std::vector<unsigned char>& b, const std::st
 /// assertions: a malformed file can abort the process inside gdcm::Reader (SIGABRT from
 /// gdcm::DataSet::ReadNested, FileMetaInformation::ReadCompat, ...). Each GDCM parse is
 /// first tried in a child; a child killed by a signal becomes one error line. Measured
-/// cost: README "Input files" (fork per slice of a 500-slice series).
+/// cost: docs/decisions.md (fork per slice of a 500-slice series).
 void survivesInChild(const std::string& name, const char* what, const std::function<void()>& work) {
     std::fflush(nullptr);
     const pid_t pid = fork();

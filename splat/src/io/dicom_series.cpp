@@ -197,7 +197,7 @@ std::vector<SliceInfo> readInfos(const std::vector<fs::path>& files) {
         std::remove_if(checked.begin(), checked.end(), [&](const Checked& c) { return !image(c); }),
         checked.end());
     // Every header is first parsed in one child process for the whole series (one fork per
-    // series, not per slice: README "Input files" has the measured cost); the child records
+    // series, not per slice: docs/decisions.md has the measured cost); the child records
     // which file it is in, so a death names the file.
     auto* at = static_cast<std::size_t*>(mmap(nullptr, sizeof(std::size_t), PROT_READ | PROT_WRITE,
                                               MAP_SHARED | MAP_ANONYMOUS, -1, 0));
