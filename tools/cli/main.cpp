@@ -101,11 +101,9 @@ int runCommand(int argc, char** argv) {
         std::replace(what.begin(), what.end(), '\n', ' ');
         printError(what + " (see '" + where + " --help')");
         return kExitUsage;
-    } catch (const splat::OptionError& e) {  // UsageError, or a malformed option value
-        printError(e.what());
-        return kExitUsage;
-    } catch (
-        const splat::OptionError& e) {  // an option the input cannot honour (--time past the end)
+    } catch (const splat::OptionError& e) {
+        // UsageError, a malformed option value, or an option the input cannot honour (--time
+        // past the last step)
         printError(e.what());
         return kExitUsage;
     } catch (const std::exception& e) {
