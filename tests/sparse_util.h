@@ -1,8 +1,10 @@
 #pragma once
-// The test data of the OpenVDB and OME-Zarr readers, written once per test run by
+// The test data of the OpenVDB and OME-Zarr readers, written once per test process by
 // tests/sparse/make_sparse_data.py with the formats' own Python libraries (python3-openvdb,
 // python3-zarr, nibabel). sparseData() is empty (and the caller skips with a message) when
 // one of them is missing.
+#include <unistd.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
@@ -13,11 +15,26 @@
 
 namespace splat::test {
 
+/// Removes this process's copy of the data when the process ends.
+struct SparseDataDir {
+    std::optional<std::filesystem::path> path;
+    ~SparseDataDir() {
+        std::error_code ec;
+        if (path) std::filesystem::remove_all(*path, ec);
+    }
+};
+
+/// The data, written by this process into a folder of its own (ctest runs test cases as
+/// concurrent processes, which must not write one folder at the same time; writing it takes
+/// under a second).
 inline std::optional<std::filesystem::path> sparseData() {
     static std::once_flag once;
+    static SparseDataDir owned;
     static std::optional<std::filesystem::path> dir;
     std::call_once(once, [] {
-        const std::filesystem::path out = testTmpDir("sparse_data");
+        const std::filesystem::path out =
+            testTmpDir("sparse_data_" + std::to_string(long(getpid())));
+        owned.path = out;
         const std::string cmd = std::string("/usr/bin/python3 ") + SPLAT_TEST_SOURCE_DIR +
                                 "/sparse/make_sparse_data.py " + out.string();
         const int status = std::system(cmd.c_str());

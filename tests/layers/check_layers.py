@@ -5,8 +5,9 @@ The library (splat/src) is built in floors, lowest first; a file may include a h
 its own folder or of a folder on a lower floor, never one above, nor one on its own floor
 (the renderers do not know each other) but for the one-way uses listed in SIBLING_USES:
 
-  0  model, io        the model: volume, settings, classification, splat list, Scene,
-                      transfer table, levels of detail; reading and writing files
+  0  model, io,       the model: volume, settings, classification, splat list, Scene,
+     options          transfer table, levels of detail; reading and writing files; the
+                      option table and the parsers of option values into settings
   1  frame            the frame stages the renderers share: projection, binning to tiles,
                       the tile sweep, sheet buffers, compositing, per-frame workspaces
   2  splatters,       the renderers; each keeps its own per-scene state
@@ -33,7 +34,7 @@ import sys
 import tempfile
 
 FLOORS = [
-    ("model", "io"),
+    ("model", "io", "options"),
     ("frame",),
     ("splatters", "reference", "gaussians"),
     ("dispatch",),
