@@ -27,6 +27,9 @@
 #ifndef SPLAT_CHILD_ASAN
 #define SPLAT_CHILD_ASAN 0
 #endif
+#if SPLAT_CHILD_ASAN
+#include <sanitizer/common_interface_defs.h>
+#endif
 
 namespace splat::detail {
 
@@ -53,6 +56,11 @@ void parseInChild(const std::string& name, const std::string& format, const std:
             }
         }
 #endif
+#if SPLAT_CHILD_ASAN
+        // A sanitizer's death in the child (its allocator refusing a size the file declares)
+        // is the child's failure, reported by the parent below, not the host fuzzer's finding.
+        __sanitizer_set_death_callback(nullptr);
+#endif
         std::set_new_handler([] { _exit(3); });
         // The library's messages are not for the user, and the host's crash handlers (a test
         // framework's, a fuzzer's) must not report the child's death as their own.
@@ -74,6 +82,9 @@ void parseInChild(const std::string& name, const std::string& format, const std:
     if (WIFEXITED(status) && WEXITSTATUS(status) == 3)
         throw Error(name + ": malformed " + format + " file (" + library +
                     " ran out of memory reading it)");
+    if (WIFEXITED(status) && WEXITSTATUS(status) != 0)  // a sanitizer ended the child
+        throw Error(name + ": malformed " + format + " file (" + library +
+                    " failed on it, exit status " + std::to_string(WEXITSTATUS(status)) + ")");
     if (WIFSIGNALED(status)) {
         const int sig = WTERMSIG(status);
         throw Error(name + ": malformed " + format + " file (" + library + " died on it with " +
