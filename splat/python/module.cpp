@@ -1,4 +1,4 @@
-// The Python module splat._splat (README "Python"; the package splat/__init__.py re-exports
+// The Python module splat._splat (docs/python.md; the package splat/__init__.py re-exports
 // it): exception types, the long-call runner and the module's parts, one file per public
 // type as in OpenImageIO's bindings.
 #include <filesystem>

@@ -1,5 +1,5 @@
 #pragma once
-// What every binding file of the Python module shares (README "Python"): the exception
+// What every binding file of the Python module shares (docs/python.md): the exception
 // types, the long-call runner that releases the GIL and turns Ctrl-C into cancellation, and
 // the keyword-argument reader (py_options.cpp).
 #include <pybind11/numpy.h>

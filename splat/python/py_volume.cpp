@@ -1,6 +1,6 @@
 // splat.Volume: a 3-D NumPy array [z, y, x] (x fastest in memory, as scikit-image and
 // SimpleITK index) with spacing and origin given x, y, z; splat.load for every format the CLI
-// reads; splat.from_nibabel's affine step. README "Python" states the conversions.
+// reads; splat.from_nibabel's affine step. docs/python.md states the conversions.
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -309,7 +309,7 @@ background_value: the field's value where nothing is (default: the median of the
             "(min, max) of the samples.")
         .def_property_readonly(
             "background_value", [](const PyVolume& p) { return p.volume->background; },
-            "The field's value where nothing is (b of splat/DESIGN.md).")
+            "The field's value where nothing is (b of docs/design.md).")
         .def_property_readonly(
             "background_source", [](const PyVolume& p) { return p.volume->backgroundSource; },
             "Where background_value came from.")

@@ -145,7 +145,7 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
     if (settings.renderer == RendererKind::Sheet && composite == BrickComposite::Fast)
         warn(
             "--renderer sheet with --brick-composite fast is approximate where its slabs cross a "
-            "brick face (README \"Beyond one machine\"); --brick-composite exact is not");
+            "brick face (docs/parallel.md); --brick-composite exact is not");
     char b[64];
     std::snprintf(b, sizeof b, "%.9g", double(geometry.background));
     runMetadata().push_back(

@@ -1,6 +1,6 @@
 #pragma once
 // `splat render --bricks K`, and `splat render` under `mpirun -np P` (K = P unless given):
-// sort-last bricked rendering (splat/bricks.h, README "Beyond one machine").
+// sort-last bricked rendering (splat/bricks.h, docs/parallel.md).
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -29,7 +29,7 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
                      std::uint64_t rankBytes, bool* wholeFits = nullptr, bool quiet = false,
                      double extraSampleBytes = 0);
 
-/// The options of a sequence in bricks (`rotate`, `popping`; README "Beyond one machine").
+/// The options of a sequence in bricks (`rotate`, `popping`; docs/parallel.md).
 struct SequenceBrickArgs {
     int bricks = 0;         ///< --bricks K (0: off, or chosen from the budget under mpirun)
     double rankMemory = 0;  ///< --rank-memory MiB; 0: the default under mpirun
@@ -43,7 +43,7 @@ void addSequenceBrickOptions(CLI::App& cmd, SequenceBrickArgs& b, const std::str
 /// Their values' checks (UsageError), and the warning for --compositor without mpirun.
 void checkSequenceBrickOptions(const CLI::App& cmd, const SequenceBrickArgs& b);
 
-/// Whether a sequence (`rotate`, `popping`) renders in bricks, README "Beyond one machine":
+/// Whether a sequence (`rotate`, `popping`) renders in bricks, docs/parallel.md:
 /// when asked (`bricks` > 0), or when the budget per process (`rankMiB`, 0: defaultRankBytes)
 /// says the volume does not fit one (mpirun, --rank-memory; `extraSampleBytes` as in
 /// bricksFromBudget); else frames in parallel (`bricks` 0). Every rank decides alike (the same

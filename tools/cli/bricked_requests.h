@@ -1,12 +1,11 @@
 #pragma once
-// Bricked frames on request (`splat popping` in bricks under mpirun, README "Beyond one
-// machine"): the analysis decides which frames it needs as it goes (the refinement bisects
-// towards an event), so it runs on rank 0 alone and asks the group for each frame: rank 0
-// broadcasts the view and the renderer, every rank renders its bricks of it
-// (BrickedFrames::render, collective) and the group composites the frame onto rank 0. The
-// other ranks serve these requests until rank 0 ends them. The core library stays free of
-// MPI: the requests travel through BrickGroup::broadcast, and the analyser sees one
-// frame-rendering callback (PoppingOptions::renderFrame).
+// Bricked frames on request (`splat popping` in bricks under mpirun, docs/parallel.md): the
+// analysis decides which frames it needs as it goes (the refinement bisects towards an event), so
+// it runs on rank 0 alone and asks the group for each frame: rank 0 broadcasts the view and the
+// renderer, every rank renders its bricks of it (BrickedFrames::render, collective) and the group
+// composites the frame onto rank 0. The other ranks serve these requests until rank 0 ends them.
+// The core library stays free of MPI: the requests travel through BrickGroup::broadcast, and the
+// analyser sees one frame-rendering callback (PoppingOptions::renderFrame).
 //
 // Failure: a frame that fails on any rank fails on every rank (BrickedFrames agrees before
 // it composites); rank 0's error ends the analysis and the requests, the others keep serving

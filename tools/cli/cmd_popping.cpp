@@ -98,7 +98,7 @@ void registerPopping(CLI::App& app) {
         // The Scene is validated against its first renderer (iso: the reference alone).
         settings.renderer = o.renderers.front();
         checkSequenceBrickOptions(*cmd, a->brick);
-        // Bricks, or frames in parallel under mpirun (README "Beyond one machine",
+        // Bricks, or frames in parallel under mpirun (docs/parallel.md,
         // chooseSequenceBricks); each renderer holds its own Scenes of the same samples.
         const SequenceBricks choice =
             chooseSequenceBricks(a->volume, settings, a->brick.bricks, a->brick.rankMemory,
@@ -133,13 +133,13 @@ void registerPopping(CLI::App& app) {
         else if (bricked && sheet && a->brick.composite == "fast")
             warn(
                 "--brick-composite fast: the image-aligned splatter is approximate where its "
-                "slabs cross a brick face, so its findings may change with the bricks (README "
-                "\"Beyond one machine\"); --brick-composite exact is not");
+                "slabs cross a brick face, so its findings may change with the bricks ("
+                "docs/parallel.md); --brick-composite exact is not");
         if (bricked && !alone)
             warn(a->volume.spec +
                  ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, "
                  "an ANALYZE pair): every rank loads the whole volume once and keeps its brick");
-        // README "Beyond one machine": in bricks every rank loads its bricks and builds their
+        // docs/parallel.md: in bricks every rank loads its bricks and builds their
         // Scenes once (splat/bricks.h BrickedFrames; a brick that cannot be read fails every
         // rank here, before any file is written); rank 0 runs the analysis and asks the group
         // for every frame it needs (bricked_requests.h), the other ranks serve them.

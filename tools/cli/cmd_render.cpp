@@ -91,7 +91,7 @@ void registerRender(CLI::App& app) {
             warn(
                 "--brick-composite applies to bricked renders (--bricks or mpirun) of "
                 "--renderer sheet: ignored");
-        // README "Beyond one machine": bricks when asked, or chosen from the budget.
+        // docs/parallel.md: bricks when asked, or chosen from the budget.
         if (bricked) {
             if (!workerProcess()) beginRun(*cmd);
             renderBrickedToFile(
@@ -118,7 +118,7 @@ void registerRender(CLI::App& app) {
             args->output.c_str(), image.width, image.height, toString(settings.renderer),
             toString(settings.mode), stats.splats, stats.voxels, skipped,
             renderer.splats().bytes() / 1048576.0, stats.milliseconds);
-        // Issue 12: what the frame modelled.
+        // What the frame modelled.
         std::printf(
             "modelled: %zu voxels classified away, gradients %s, %s path%s, %zu splats "
             "early-terminated, %zu footprint pixels\n",

@@ -295,7 +295,7 @@ void checkExtraOutput(const std::string& path, const char* flag) {
     if (::access(parent.c_str(), W_OK) != 0)
         throw Error(path + ": the folder '" + parent.string() + "' is not writable");
 }
-/// The frames of a bricked sequence (README "Beyond one machine"), on every rank of
+/// The frames of a bricked sequence (docs/parallel.md), on every rank of
 /// `group`: each loads its bricks and builds their Scenes once, then every view not kept is
 /// rendered by them and composited; rank 0 hands it to `emit` (view, image, milliseconds).
 /// A failure on rank 0 (writing a frame) or on any rank ends every rank at the next frame.
@@ -308,7 +308,7 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
     if (leader && settings.renderer == RendererKind::Sheet && a.brick.composite == "fast")
         warn(
             "--renderer sheet with --brick-composite fast is approximate where its slabs cross a "
-            "brick face (README \"Beyond one machine\"); --brick-composite exact is not");
+            "brick face (docs/parallel.md); --brick-composite exact is not");
     BrickedFrames frames(
         geometry, brickLoader(a.volume), settings, bricks, group,
         a.brick.composite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
@@ -507,7 +507,7 @@ void registerRotate(CLI::App& app) {
         use.imageExt = "." + a->format;
         RenderSettings settings = settingsFromArgs(a->render, use);
         loadOptionsFromArgs(a->volume);
-        // Bricks, or frames in parallel (README "Beyond one machine", chooseSequenceBricks).
+        // Bricks, or frames in parallel (docs/parallel.md, chooseSequenceBricks).
         const SequenceBricks choice =
             chooseSequenceBricks(a->volume, settings, a->brick.bricks, a->brick.rankMemory);
         const int bricks = choice.bricks;

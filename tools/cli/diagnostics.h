@@ -1,5 +1,5 @@
 #pragma once
-// What the command line tells its user besides its results (README "Command line", exit
+// What the command line tells its user besides its results (docs/command-line.md, exit
 // statuses): warnings are one line `splat: warning: ...` on stderr; errors one line
 // `splat: error: ...`. A UsageError (unknown option, malformed value, bad combination, bad
 // scene file) exits with status 2, any other failure of the work with status 1.

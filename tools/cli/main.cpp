@@ -1,4 +1,4 @@
-// The `splat` command-line program: see README.md ("Command line") and splat/DESIGN.md.
+// The `splat` command-line program: see docs/command-line.md and docs/design.md.
 // Exit statuses: 0 success, 1 the work failed, 2 usage error (diagnostics.h).
 #include <CLI/CLI.hpp>
 #include <algorithm>

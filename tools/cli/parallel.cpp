@@ -101,7 +101,7 @@ void checkCompositor(const std::string& name) {
     if (name == "icet" && !icet)
         throw UsageError(
             "--compositor icet: this splat was built without IceT (SPLAT_ICET; Debian: "
-            "paraview-dev, README \"Building\"); use --compositor direct");
+            "paraview-dev, docs/building.md); use --compositor direct");
 }
 
 std::unique_ptr<BrickGroup> brickGroup(const std::string& compositor) {

@@ -1,5 +1,5 @@
 #pragma once
-// The `splat` program under mpirun (issue 26, README "Beyond one machine"). Built with MPI
+// The `splat` program under mpirun (docs/parallel.md). Built with MPI
 // (SPLAT_MPI), the program initialises MPI only when an MPI launcher started it (its
 // environment says so: splat/mpi/session.h), so a plain `splat ...` never touches MPI.
 // Under `mpirun -np K`, rank 0 runs the command and writes every output and message; the
@@ -46,7 +46,7 @@ void serveFrames(const std::function<Scene()>& build);
 
 /// `--compositor direct|icet|auto` of render, rotate and popping: how the ranks composite the partial
 /// images of bricks (splat/mpi/brick_group.h; direct by default, chosen from measurement:
-/// README "Direct-send beside IceT"). auto: icet when this splat was built with IceT
+/// docs/parallel.md "Direct-send beside IceT"). auto: icet when this splat was built with IceT
 /// (SPLAT_ICET), else direct. A name that is none of the three, or icet in a splat built
 /// without IceT, is a UsageError.
 void checkCompositor(const std::string& name);

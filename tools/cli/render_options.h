@@ -1,8 +1,7 @@
 #pragma once
-// The rendering options shared by render, rotate, bench, popping and study (README "Command
-// line"), registered from the library's option table (splat/options.h) in the --help groups
-// Classification, Camera, Renderer, Quality and Output; a scene file (--scene, scene_file.h)
-// may hold any of them.
+// The rendering options shared by render, rotate, bench, popping and study (docs/command-line.md),
+// registered from the library's option table (splat/options.h) in the --help groups Classification,
+// Camera, Renderer, Quality and Output; a scene file (--scene, scene_file.h) may hold any of them.
 #include <CLI/CLI.hpp>
 #include <string>
 

@@ -1,7 +1,7 @@
 #pragma once
 // The journal of a resumable command (popping's frames, study's measured points): a hidden
 // folder in the report folder that holds the work done so far, so that `--resume` after an
-// interruption does only the rest (README "Reliability").
+// interruption does only the rest (docs/reliability.md).
 #include <CLI/CLI.hpp>
 #include <filesystem>
 

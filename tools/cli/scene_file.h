@@ -1,6 +1,6 @@
 #pragma once
 // Options of a subcommand, remembered so that a scene file can hold every one of them
-// (README "Scene files", splat/DESIGN.md "Decisions"): a scene key is an option's long name
+// (docs/command-line.md "Scene files", docs/decisions.md): a scene key is an option's long name
 // without dashes ("pixel-size", "output"; "volume" for the VOLUME argument). Reading a
 // scene feeds each key to its option through CLI11's own conversion, so a scene accepts
 // exactly what the command line accepts (typed JSON numbers, arrays and booleans, or the

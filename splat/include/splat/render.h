@@ -47,7 +47,7 @@ double ewaLowPass(const RenderSettings& settings, const Volume& volume);
 
 /// The pixel filter sigma (pixels; 0: one ray at each pixel centre) of the reference that
 /// `truth` asks for, to judge the splatters' frames of `settings` at `views` over `volume`
-/// (README "Aliasing and EWA"): Point 0; Filtered the pixel filter given
+/// (docs/accuracy.md "Aliasing and EWA"): Point 0; Filtered the pixel filter given
 /// (Quality::pixelFilter), else Quality::kEwaDefaultSigma; Auto the pixel filter given, else
 /// kEwaDefaultSigma where EWA is on in any of `views` (ewaLowPass: a filtered image is judged
 /// against a filtered truth), else 0. The filtered reference traces s x s rays per pixel (s

@@ -2,7 +2,7 @@
 // The vocabulary of a render: what to draw (mode, classification, transfer function,
 // kernel, shading), how (renderer, compositing order, camera) and the Quality knobs that
 // trade speed for accuracy. Every such knob lives in Quality, so that a speed/accuracy
-// study can move any of them; defaults are the figures the README's tables are made with.
+// study can move any of them; defaults are the figures docs/accuracy.md's tables are made with.
 #include <cstddef>
 #include <functional>
 #include <glm/glm.hpp>
@@ -36,13 +36,13 @@ enum class CompositeOrder { FrontToBack, BackToFront };
 /// voxel covers fewer than Quality::kEwaAutoPixels pixels.
 enum class Ewa { Off, On, Auto };
 /// The reference an analysis judges the splatters against (popping, study, bench_accuracy;
-/// README "Aliasing and EWA"): the point-sampled reference (one ray per pixel centre), the
-/// pixel-filtered one (Quality::pixelFilter, or Quality::kEwaDefaultSigma), or (auto) the
+/// docs/accuracy.md "Aliasing and EWA"): the point-sampled reference (one ray per pixel centre),
+/// the pixel-filtered one (Quality::pixelFilter, or Quality::kEwaDefaultSigma), or (auto) the
 /// filtered one where the splatters' frames are filtered (EWA on, or a pixel filter given)
 /// and the point-sampled one elsewhere.
 enum class Truth { Auto, Point, Filtered };
 
-/// Blinn-Phong shading, one model for every renderer and mode (splat/DESIGN.md "Shading"):
+/// Blinn-Phong shading, one model for every renderer and mode (docs/decisions.md "Shading"):
 ///   c' = c (ambient + diffuse |n.l|) + specular |n.h|^shininess
 /// for a colour c and unit normal n (two-sided), l the direction towards the light and h the
 /// half vector between l and the direction towards the eye. Pre-classified dvr shades the
@@ -64,14 +64,14 @@ struct EdgeEnhancement {
     bool enabled() const { return gain != 0.0f; }
 };
 
-/// Clipping in world units of the reconstructed field, in every renderer (issue 13): the
+/// Clipping in world units of the reconstructed field, in every renderer: the
 /// reference clips each ray to the kept region, the splatters cut each sheet pixel's path at
 /// it (frame/clip_cut.h), and the voxels whose kernels reach the region are kept, so the cut
 /// face shows the reconstruction of all the data exactly where the plane is.
 struct ClipPlane {
     glm::dvec3 point{0.0}, normal{0.0, 0.0, 1.0};  ///< keeps (x - point) . normal <= 0
 };
-/// Segmentation labels (splat/DESIGN.md "Labels"): a label volume on the scene volume's grid
+/// Segmentation labels (docs/decisions.md "Labels"): a label volume on the scene volume's grid
 /// rendered with a colour and opacity per label, never interpolated: each sheet pixel takes
 /// the label of the voxel whose kernel weighs most there (nearest-label classification; the
 /// reference: the nearest voxel), so only colours of the table appear. With an intensity
@@ -124,23 +124,23 @@ struct Quality {
     /// of twice the size (Laur & Hanrahan). 0 = off: always the full-resolution list.
     /// 0..64. Ignored when lodAuto is set.
     double lod = 0;
-    /// Level of detail chosen per view from the error it adds (`--lod auto`, README "Level of
-    /// detail"): in the modes where it was measured free in accuracy against the pixel-filtered
-    /// reference (lodAutoApplies, model/level_of_detail.h), the coarsest level whose merged
-    /// splats, low-passed to what the filtered reference sees (the level-0 kernel plus the
-    /// pixel filter, less the pyramid's box), still sum to a constant on their grid; a
-    /// pixel or more per voxel keeps level 0 (bit-identical to lod 0).
+    /// Level of detail chosen per view from the error it adds (`--lod auto`,
+    /// docs/speed-vs-accuracy.md "Level of detail"): in the modes where it was measured free in
+    /// accuracy against the pixel-filtered reference (lodAutoApplies, model/level_of_detail.h), the
+    /// coarsest level whose merged splats, low-passed to what the filtered reference sees (the
+    /// level-0 kernel plus the pixel filter, less the pyramid's box), still sum to a constant on
+    /// their grid; a pixel or more per voxel keeps level 0 (bit-identical to lod 0).
     bool lodAuto = false;
-    /// Level of detail per brick and view (`--lod brick`, issue 27, model/brick_lod.h): in the
+    /// Level of detail per brick and view (`--lod brick`, model/brick_lod.h): in the
     /// modes of lodAuto, a level per brick of 16^3 voxels, the coarsest the projected voxel size
     /// at the brick allows (lodAutoLevel) whose dropped detail and whose seams with finer
     /// neighbours stay within a tolerance of the field, each level splatted as lodAuto splats
     /// it; the frame sums a frame per level (X-ray). Ignored when lodAuto is set.
     bool lodBrick = false;
     /// Pixel filter, a Gaussian of this standard deviation in pixels truncated at 4 sigma
-    /// (README "Aliasing and EWA"). Reference ray caster: 0 samples each pixel at its centre;
-    /// > 0 supersamples s x s rays per pixel (s = 2, 4, 8, 16) and filters, doubling s until
-    /// the filtered image's RMS change, relative to its largest value, is below
+    /// (docs/accuracy.md "Aliasing and EWA"). Reference ray caster: 0 samples each pixel at its
+    /// centre; > 0 supersamples s x s rays per pixel (s = 2, 4, 8, 16) and filters, doubling s
+    /// until the filtered image's RMS change, relative to its largest value, is below
     /// pixelFilterTolerance. Splatters: the EWA low-pass (0: kEwaDefaultSigma). 0..4.
     double pixelFilter = 0;
     double pixelFilterTolerance = 2e-4;
@@ -148,7 +148,7 @@ struct Quality {
     /// the Gaussian pixel filter, energy kept (footprint/ellipse.h, ewaFootprint). Auto: on in
     /// xray while a voxel covers fewer than kEwaAutoPixels pixels (measured to lower the error
     /// against the filtered reference there, and to raise it in dvr): the default, which
-    /// leaves every other mode and image size bit-identical to off (README "Aliasing and
+    /// leaves every other mode and image size bit-identical to off (docs/accuracy.md "Aliasing and
     /// EWA").
     Ewa ewa = Ewa::Auto;
     /// Axis-aligned splatter, orthographic pre-classified dvr without clipping, labels, EWA or
@@ -161,7 +161,7 @@ struct Quality {
     int factorisedSheets = 0;
     /// The EWA low-pass when pixelFilter is 0, pixels (pbrt-v4's Gaussian pixel filter).
     static constexpr double kEwaDefaultSigma = 0.5;
-    /// Ewa::Auto turns EWA on while a voxel covers fewer pixels than this (measured, README).
+    /// Ewa::Auto turns EWA on while a voxel covers fewer pixels than this (measured: docs/accuracy.md "Aliasing and EWA").
     static constexpr double kEwaAutoPixels = 1.0;
 };
 
@@ -183,7 +183,7 @@ struct RenderSettings {
     Labels labels;                             ///< dvr: segmentation labels
     int threads = 0;                           ///< every stage of a frame; 0: all cores
     Quality quality;
-    /// Progress inside one frame (issue 24): called, serialised, after every screen tile of
+    /// Progress inside one frame: called, serialised, after every screen tile of
     /// a splatter (`what` "tiles"; the streaming path: after every chunk, "chunks") and every
     /// image row of the reference ray caster ("rows"), with a total known up front. Returning
     /// false cancels the frame: the tiles and rows not yet started are skipped and render
@@ -209,7 +209,7 @@ struct RenderStats {
     /// Stage times, ms: shade, project, order (visiting keys), bin, tiles (cut kernels into
     /// sheets and composite), resolve (background).
     double shadeMs = 0, projectMs = 0, orderMs = 0, binMs = 0, tilesMs = 0;
-    /// What the frame modelled (issue 12: only what the scene needs, visibly).
+    /// What the frame modelled: only what the scene needs, visibly.
     bool perspective = false;         ///< the perspective path ran (per-splat footprints)
     std::size_t normals = 0;          ///< splat normals held by the Scene (0: no gradients)
     std::size_t pathScalePixels = 0;  ///< per-pixel perspective path scales allocated

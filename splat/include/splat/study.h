@@ -1,5 +1,5 @@
 #pragma once
-// Speed-accuracy studies (issue 12): render a volume under every combination of the
+// Speed-accuracy studies: render a volume under every combination of the
 // swept knobs that trade speed for accuracy, time each setting (median over repeats
 // after a warm-up), measure its peak memory, splat count and footprint-pixel rate, and
 // its error against the reference ray caster of the same model (RMSE, PSNR, max, mean

@@ -1,4 +1,4 @@
-"""splat: splatting volume renderer, from Python (README "Python").
+"""splat: splatting volume renderer, from Python (docs/python.md).
 
 Volumes are NumPy arrays indexed [z, y, x] (x fastest in memory, as scikit-image and
 SimpleITK); spacing and origin are given (x, y, z). Keyword arguments are the command line's

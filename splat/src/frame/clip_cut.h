@@ -1,5 +1,5 @@
 #pragma once
-// The exact cut face in the splatters (issue 13): the reconstructed field is cut at the clip
+// The exact cut face in the splatters: the reconstructed field is cut at the clip
 // planes and crop box per pixel, not per voxel. Each pixel's ray is intersected with the kept
 // region (model/clip_region.h) and the interval is expressed in sheet coordinates s (sheet k
 // of the visiting order spans s in [k - 1/2, k + 1/2]). A sheet pixel keeps the fraction of

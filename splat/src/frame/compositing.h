@@ -36,7 +36,7 @@ void compositeOpticalDepthRow(float* r, float* g, float* b, float* a, CompositeO
                               const float* tau, const float* er, const float* eg,
                               const float* eb);
 
-/// Compositing state of one tile: premultiplied colour and opacity (b in splat/DESIGN.md) for
+/// Compositing state of one tile: premultiplied colour and opacity (b in docs/design.md) for
 /// dvr; for mip the running maximum and for xray the running sum, both in r.
 class TileAccumulator {
   public:

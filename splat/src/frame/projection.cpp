@@ -13,7 +13,7 @@ namespace splat {
 namespace {
 
 /// Auto: X-ray, where the image is linear in the footprints and EWA is the filtered
-/// reference's convolution (README "Aliasing and EWA": 21-42x lower error). Not dvr: the
+/// reference's convolution (docs/accuracy.md "Aliasing and EWA": 21-42x lower error). Not dvr: the
 /// low-pass widens extinction before the exponential, so opaque silhouettes grow (measured
 /// worse on phantom:64 ct-soft); nor mip, iso (a maximum and a first hit of a blurred field).
 bool ewaAutoApplies(RenderMode mode) { return mode == RenderMode::Xray; }

@@ -1,5 +1,5 @@
 #pragma once
-// Error-driven level of detail per brick and view (issue 27; Laur & Hanrahan, "Hierarchical
+// Error-driven level of detail per brick and view (Laur & Hanrahan, "Hierarchical
 // splatting", SIGGRAPH 1991, with the merged levels filtered as in level_of_detail.h).
 //
 // `--lod brick` (Quality::lodBrick) cuts the level-0 grid into bricks of kLodBrick^3 voxels,
@@ -12,7 +12,7 @@
 // levelOfDetail): per brick, the seams below keep bricks with field on their faces at the
 // finest level of their neighbours, so on volumes of contiguous tissue the rule is the
 // full-resolution splatter (its accuracy, nearly its time) where the per-view rule is 6x
-// faster at 1.2-7x the error (README "Level of detail").
+// faster at 1.2-7x the error (docs/speed-vs-accuracy.md "Level of detail").
 //
 // Derivation of the choice. A brick B splatted from level L renders (level_of_detail.h)
 //     I_L = P[ f_L ],   f_L = sum_c m_c (h_L * g_L)(x - x_c),   m_c = (f * D_L)(x_c),

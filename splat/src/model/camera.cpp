@@ -1,4 +1,4 @@
-// Orthographic and perspective cameras following splat/DESIGN.md's convention.
+// Orthographic and perspective cameras following docs/design.md's convention.
 #include "splat/camera.h"
 
 #include <cmath>
@@ -62,10 +62,10 @@ Camera::Camera(const CameraParams& params, const Volume& volume) : params_(param
 
     boundingRadius = 0.5 * glm::length(glm::dvec3(volume.dims) * volume.spacing);
     const double side = double(std::min(params.width, params.height));
-    // The one place where the world frame meets the volume's frame (splat/DESIGN.md "World
-    // frame"): the parameters are world (RAS), the renderers work in the volume's frame,
-    // world = direction * frame, so world points and directions turn by direction^T. For an
-    // oblique volume this is a change of basis of the view, not a resampling of the data.
+    // The one place where the world frame meets the volume's frame (docs/design.md "World frame"):
+    // the parameters are world (RAS), the renderers work in the volume's frame, world = direction *
+    // frame, so world points and directions turn by direction^T. For an oblique volume this is a
+    // change of basis of the view, not a resampling of the data.
     const glm::dmat3 toFrame = glm::transpose(volume.direction);
     if (params.lookAtSet) {
         CameraParams p = params;

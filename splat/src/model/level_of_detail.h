@@ -1,5 +1,5 @@
 #pragma once
-// Level of detail for sub-pixel voxels (issue 11; Laur & Hanrahan, "Hierarchical splatting",
+// Level of detail for sub-pixel voxels (Laur & Hanrahan, "Hierarchical splatting",
 // SIGGRAPH 1991): the next level of a scene merges each 2x2x2 cell of voxels into one splat
 // on a grid of twice the spacing, splatted with the same kernel (in voxel units), so twice
 // as wide in world units. Values are averaged over the eight voxels of a cell, the voxels
@@ -40,8 +40,8 @@ double voxelPixels(const Camera& camera, const Volume& volume);
 double lodBoxVariance(int level);
 
 /// `--lod auto` (Quality::lodAuto): how a merged level L is splatted so that it reconstructs
-/// the level-0 field low-passed as the pixel-filtered reference sees it. Derivation (README
-/// "Level of detail"): level 0 with EWA renders sum_v f_v (h0 * g)(x - x_v) ~ f * h0 * g, h0
+/// the level-0 field low-passed as the pixel-filtered reference sees it. Derivation
+/// (docs/speed-vs-accuracy.md "Level of detail"): level 0 with EWA renders sum_v f_v (h0 * g)(x - x_v) ~ f * h0 * g, h0
 /// the kernel (per-axis variance k^2 = Kernel::variance(), voxels^2) and g the screen
 /// low-pass (sigma^2, pixels^2), which is what the filtered reference sees of the field
 /// f * h0. The merged level holds the cell means m_c = (f * D_L)(x_c), D_L the discrete box of
@@ -63,7 +63,7 @@ LodFootprint lodFootprint(double kernelVariance, int level, double sigma, double
 constexpr double kLodMinKernel = 0.1;
 
 /// `--lod auto`: the modes where merged levels were measured free in accuracy against the
-/// pixel-filtered reference (README "Level of detail").
+/// pixel-filtered reference (docs/speed-vs-accuracy.md "Level of detail").
 bool lodAutoApplies(RenderMode mode);
 
 /// `--lod auto`: the coarsest level L (at most maxLevel) whose merged footprints (lodFootprint:

@@ -67,7 +67,7 @@ struct Scene::Impl {
                settings.classification == Classification::Pre;
     }
     /// The sheets carry gradient channels: post-classified dvr with shading or edges, and
-    /// iso (always shaded). Computed only then (DESIGN: gradients only when asked for).
+    /// iso (always shaded). Computed only then (docs/design.md: gradients only when asked for).
     bool needsGradients() const {
         if (settings.mode == RenderMode::Iso) return true;
         return settings.mode == RenderMode::Dvr &&

@@ -201,7 +201,7 @@ std::string describeVolume(const Volume& v) {
     line("dimensions:  %d x %d x %d (%zu voxels)", v.dims.x, v.dims.y, v.dims.z, v.voxelCount());
     line("spacing:     %g x %g x %g mm", v.spacing.x, v.spacing.y, v.spacing.z);
     glm::dvec3 extent = glm::dvec3(v.dims) * v.spacing;
-    // World frame: RAS millimetres (splat/DESIGN.md "World frame").
+    // World frame: RAS millimetres (docs/design.md "World frame").
     const glm::dvec3 first = v.worldPosition(glm::dvec3(0.0));
     const glm::dvec3 last = v.worldPosition(glm::dvec3(v.dims) - 1.0);
     line("extent:      %g x %g x %g mm", extent.x, extent.y, extent.z);

@@ -1,6 +1,6 @@
 #pragma once
 // The reference ray caster's continuous fields, f(x) = sum_i d_i h(|S^-1 (x - x_i)|) and, for
-// pre-classification, rho(x) and e(x) likewise (DESIGN: "Reconstructed fields"), evaluated
+// pre-classification, rho(x) and e(x) likewise (docs/design.md "Reconstructed fields"), evaluated
 // exactly (up to the kernel table) at any index-space point:
 //  - the splat list is scattered into a dense per-voxel grid (absent splats are 0), so a
 //    field sample visits only the (2R + 1)^3 lattice points around it;

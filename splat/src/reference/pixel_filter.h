@@ -1,5 +1,5 @@
 #pragma once
-// The pixel-filtered reference (issue 27; README "Aliasing and EWA"): the reference ray
+// The pixel-filtered reference (docs/accuracy.md "Aliasing and EWA"): the reference ray
 // caster's image reconstructed through a Gaussian pixel filter,
 //     I(x, y) = integral g_sigma(u - x, v - y) L(u, v) du dv / integral g_sigma,
 // L the point-sampled image (one ray through each continuous screen point) and g_sigma a

@@ -1,4 +1,4 @@
-// The reference ray caster (splat/DESIGN.md, "The model"): one ray per pixel through the
+// The reference ray caster (docs/design.md "The model"): one ray per pixel through the
 // continuous fields f(x) = b + sum_i (d_i - b) h(|S^-1 (x - x_i)|) (b the volume's background
 // value; the grids hold f - b) and rho, e for pre-classification,
 // integrated with error control.
@@ -40,7 +40,7 @@
 // the halved ones' eps taken to fall 16x (Simpson), is within the bound, and the test is
 // repeated (at most kMaxPanelLevels halvings a panel). The factor 1/16 is calibrated: with it
 // the images are no further from a tight truth than the whole-ray scheme's at its default
-// first step 0.25 (README "Accuracy": ch2 256^2 at 30 degrees, RMSE 2.8e-7 vs 3.0e-7), at ~60% of
+// first step 0.25 (docs/accuracy.md: ch2 256^2 at 30 degrees, RMSE 2.8e-7 vs 3.0e-7), at ~60% of
 // its samples. Early termination as below, at panel granularity, re-checked after refinement.
 //
 //  - dvr: optical depth tau(t) by Simpson/quadratic interpolation of rho at every sample,

@@ -49,7 +49,7 @@ void addSlabSheets(const TileInputs& in, std::uint32_t first, std::uint32_t coun
 const Splatter& imageAlignedSplatter();
 
 /// Index (0, 1, 2) of the volume axis most parallel to the ray direction in index space,
-/// S^-1 view (DESIGN: anisotropic spacing is honoured), and the sign of that component.
+/// S^-1 view (docs/design.md: anisotropic spacing is honoured), and the sign of that component.
 struct SheetAxis {
     int axis, sign;
 };
