@@ -17,6 +17,7 @@
 #include "sparse_util.h"
 #include "splat/bricks.h"
 #include "splat/error.h"
+#include "splat/image_io.h"
 #include "splat/sparse_files.h"
 #include "splat/volume_io.h"
 
@@ -299,4 +300,127 @@ TEST_CASE("zarr: splat info lists the levels; a bad image is one error line", "[
     REQUIRE(e.errLines().size() == 1);
     CHECK(e.errLines()[0].rfind("splat: error: ", 0) == 0);
     CHECK_FALSE(fs::exists(tmp / "x.png"));
+}
+
+TEST_CASE("zarr: the default level is the level of detail the view asks for", "[zarr][lod]") {
+    SPARSE_DATA_OR_SKIP(data);
+    const ZarrImageInfo info = describeZarr((data / "pyramid.zarr").string());
+    REQUIRE(info.levels.size() == 3);
+    // 32^3 voxels of 0.5: the bounding sphere's diameter, 27.7, fits the image, so a level-0
+    // voxel covers 0.5 W / 27.7 pixels (1.155 at W = 64), a level-L one 2^L times as many.
+    auto levelAt = [&](int size, const std::string& lod, RenderMode mode) {
+        RenderSettings s;
+        s.camera.width = s.camera.height = size;
+        s.mode = mode;
+        if (lod == "auto")
+            s.quality.lodAuto = true;
+        else if (lod == "brick")
+            s.quality.lodBrick = true;
+        else
+            s.quality.lod = std::stod(lod);
+        return zarrLevelForView(info, s);
+    };
+    // --lod 2: the first level whose voxel covers 2 pixels, else the coarsest.
+    CHECK(levelAt(256, "2", RenderMode::Dvr) == 0);  // 4.6 pixels
+    CHECK(levelAt(64, "2", RenderMode::Dvr) == 1);   // 1.155, 2.31
+    CHECK(levelAt(32, "2", RenderMode::Dvr) == 2);   // 0.58, 1.155, 2.31
+    CHECK(levelAt(16, "2", RenderMode::Dvr) == 2);   // the coarsest stored level
+    // Off, and the reference ray caster (which always renders the full level): level 0.
+    CHECK(levelAt(16, "0", RenderMode::Dvr) == 0);
+    RenderSettings reference;
+    reference.camera.width = reference.camera.height = 16;
+    reference.quality.lod = 2;
+    reference.renderer = RendererKind::Reference;
+    CHECK(zarrLevelForView(info, reference) == 0);
+    // --lod auto (xray): level 1 at v0 <= 0.472 pixels, level 2 at v0 <= 0.209.
+    CHECK(levelAt(32, "auto", RenderMode::Xray) == 0);  // 0.58
+    CHECK(levelAt(16, "auto", RenderMode::Xray) == 1);  // 0.29
+    CHECK(levelAt(8, "auto", RenderMode::Xray) == 2);   // 0.14
+    CHECK(levelAt(8, "auto", RenderMode::Dvr) == 0);    // auto applies to xray only
+    CHECK(levelAt(8, "brick", RenderMode::Xray) == 0);  // bricks' levels come from level 0
+}
+
+TEST_CASE("zarr: a pyramid renders at its default level like the NIfTI of that level",
+          "[zarr][lod][cli]") {
+    SPARSE_DATA_OR_SKIP(data);
+    const fs::path tmp = testTmpDir("zarr_lod");
+    auto render = [&](const std::vector<std::string>& args, const std::string& name) {
+        std::vector<std::string> all = {"render"};
+        all.insert(all.end(), args.begin(), args.end());
+        for (const std::string& a :
+             std::vector<std::string>{"--mode", "mip", "--azimuth", "30", "--elevation", "20",
+                                      "--threads", "2", "-o", (tmp / name).string()})
+            all.push_back(a);
+        const RunResult r = runProgram(SPLAT_EXE, all);
+        INFO(r.err);
+        REQUIRE(r.status == 0);
+        return readImage((tmp / name).string());
+    };
+    auto same = [](const Image& a, const Image& b) {
+        REQUIRE(a.width == b.width);
+        REQUIRE(a.height == b.height);
+        std::size_t differ = 0;
+        for (std::size_t p = 0; p < a.pixels.size(); ++p) differ += a.pixels[p] != b.pixels[p];
+        return differ == 0;
+    };
+    const std::string zarr = (data / "pyramid.zarr").string();
+    for (const auto& [size, level] : {std::pair<std::string, int>{"64x64", 1}, {"32x32", 2}}) {
+        INFO(size);
+        const std::string nii = (data / ("pyramid_" + std::to_string(level) + ".nii.gz")).string();
+        const Image z = render({zarr, "--lod", "2", "--size", size}, "z.exr");
+        const Image n = render({nii, "--lod", "2", "--size", size}, "n.exr");
+        CHECK(same(z, n));
+        // Not a vacuous check: level 0 of the same file gives another image.
+        const Image z0 = render({zarr, "--lod", "2", "--size", size, "--zarr-level", "0"}, "z0.exr");
+        CHECK_FALSE(same(z, z0));
+    }
+    // Level of detail off: level 0 by default.
+    CHECK(same(render({zarr, "--size", "32x32"}, "off.exr"),
+               render({zarr, "--size", "32x32", "--zarr-level", "0"}, "off0.exr")));
+}
+
+TEST_CASE("zarr: a bad dtype, chunk size or level is one error line, status 1",
+          "[zarr][errors][cli]") {
+    SPARSE_DATA_OR_SKIP(data);
+    const fs::path tmp = testTmpDir("zarr_bad_cli");
+    const fs::path ramp = data / "dtypes" / "u2_le_zlib.zarr";
+    const std::string meta = readTextFile(ramp / ".zarray");
+    std::vector<std::pair<fs::path, std::string>> bad;
+    for (const auto& [name, dtype] : {std::pair<std::string, std::string>{"complex", "\"<c8\""},
+                                      {"unknown", "\"<q3\""}}) {
+        const fs::path d = copyFolder(ramp, tmp / (name + ".zarr"));
+        writeText(d / ".zarray", replaced(meta, "\"<u2\"", dtype));
+        bad.emplace_back(d, name == "complex" ? "complex samples" : "'<q3' is not supported");
+    }
+    {
+        const fs::path d = copyFolder(ramp, tmp / "size.zarr");
+        std::vector<unsigned char> raw(100, 7), packed(256);
+        uLongf size = packed.size();
+        REQUIRE(compress(packed.data(), &size, raw.data(), raw.size()) == Z_OK);
+        std::ofstream(d / "1.1.1", std::ios::binary)
+            .write(reinterpret_cast<const char*>(packed.data()), std::streamsize(size));
+        bad.emplace_back(d, "decompresses to 100 bytes, expected 120");
+    }
+    {
+        const fs::path d = copyFolder(data / "pyramid.zarr", tmp / "levels.zarr");
+        const std::string attrs = readTextFile(d / ".zattrs");
+        writeText(d / ".zattrs", replaced(attrs, "\"scale\": [\n" + std::string(32, ' ') + "1.0,",
+                                          "\"scale\": [\n" + std::string(32, ' ') + "3.0,"));
+        bad.emplace_back(d, "(the levels disagree)");
+    }
+    for (const auto& [folder, expect] : bad)
+        for (const std::string command : {"render", "info"}) {
+            INFO(folder.filename().string() << " " << command);
+            std::vector<std::string> args = {command, folder.string()};
+            if (command == "render")
+                for (const std::string& a :
+                     std::vector<std::string>{"--lod", "2", "-o", (tmp / "x.png").string()})
+                    args.push_back(a);
+            const RunResult r = runProgram(SPLAT_EXE, args);
+            CHECK(r.status == 1);
+            REQUIRE(r.errLines().size() == 1);
+            CHECK(r.errLines()[0].rfind("splat: error: ", 0) == 0);
+            CHECK(r.errLines()[0].find(expect) != std::string::npos);
+            CHECK_FALSE(fs::exists(tmp / "x.png"));
+        }
 }

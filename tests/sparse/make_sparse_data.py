@@ -10,6 +10,10 @@ markers on a background of 3, spacing 0.75, 1.125, 1.25, origin 2, -3, 5) in the
 with the same geometry; the VDB's voxels equal to the background are inactive and the
 Zarr's chunks that hold only the background are not stored (fill_value 3). same.zarr has a
 second level (every other sample, scale doubled).
+OUTDIR/pyramid.zarr: a 3-level pyramid of a 32^3 blob (spacing 0.5, origin 1, 2, 3), each
+level the exact 2x2x2 mean of the one before on coarserGrid's grid (twice the spacing, origin
+moved by half a finer voxel), as splat's level of detail merges voxels; pyramid_1.nii.gz and
+pyramid_2.nii.gz: levels 1 and 2 as NIfTI with the same geometry.
 OUTDIR/dtypes/*.zarr: the integer ramp (i + 2 j + 3 k) % 97 as bare Zarr arrays in every
 dtype, byte order and compressor splat reads, chunks (3, 4, 5) so that edge chunks are
 partial; also Fortran order and '/' as the dimension separator.
@@ -87,6 +91,37 @@ def write_ome(path, levels, scales, translation, axes, compressors, fill):
         "datasets": datasets}]
 
 
+def write_pyramid(out):
+    n, s, origin = 32, 0.5, np.array([1.0, 2.0, 3.0])
+    x, y, z = np.meshgrid(*[np.arange(n, dtype=np.float64)] * 3, indexing="ij")
+    r2 = (x - 13.0) ** 2 + (y - 17.5) ** 2 + (z - 15.0) ** 2
+    levels = [(8.0 * np.exp(-r2 / (2 * 6.0 ** 2)) * (1 + 0.5 * np.sin(x / 2.0))).astype(np.float32)]
+    levels[0][levels[0] < 0.02] = 0.0
+    for _ in range(2):
+        a = levels[-1].astype(np.float64)
+        m = a.shape[0] // 2
+        levels.append(a.reshape(m, 2, m, 2, m, 2).mean(axis=(1, 3, 5)).astype(np.float32))
+    spacings = [s * 2 ** L for L in range(3)]
+    origins = [origin + (2 ** L - 1) / 2.0 * s for L in range(3)]
+    for L in (1, 2):
+        affine = np.diag([spacings[L]] * 3 + [1.0])
+        affine[:3, 3] = origins[L]
+        nib.save(nib.Nifti1Image(levels[L], affine), os.path.join(out, f"pyramid_{L}.nii.gz"))
+    root = zarr.open_group(os.path.join(out, "pyramid.zarr"), mode="w")
+    datasets = []
+    for L, a in enumerate(levels):
+        root.create_dataset(str(L), data=np.ascontiguousarray(a.transpose(2, 1, 0)),
+                            chunks=(8, 8, 8), compressor=numcodecs.Zlib(level=1),
+                            fill_value=0.0, write_empty_chunks=False)
+        datasets.append({"path": str(L), "coordinateTransformations": [
+            {"type": "scale", "scale": [spacings[L]] * 3},
+            {"type": "translation", "translation": list(origins[L][::-1])}]})
+    root.attrs["multiscales"] = [{
+        "version": "0.4", "name": "pyramid",
+        "axes": [{"name": a, "type": "space", "unit": "millimeter"} for a in "zyx"],
+        "datasets": datasets}]
+
+
 def main():
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -121,6 +156,8 @@ def main():
               [SPACING[::-1], [2 * s for s in SPACING[::-1]]], ORIGIN[::-1], "zyx",
               [numcodecs.Blosc(cname="lz4", clevel=5, shuffle=numcodecs.Blosc.SHUFFLE),
                numcodecs.Zlib(level=6)], BACKGROUND)
+
+    write_pyramid(out)
 
     # Every dtype, byte order and compressor.
     k, j, i = np.meshgrid(np.arange(9), np.arange(11), np.arange(13), indexing="ij")

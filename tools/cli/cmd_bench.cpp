@@ -67,6 +67,7 @@ void registerBench(CLI::App& app) {
         if (!a->json.empty()) checkOutputFile(a->json, "--json");  // before the timing
         RenderSettings settings = settingsFromArgs(a->render, RenderUse{});
         loadOptionsFromArgs(a->volume);
+        chooseZarrLevel(a->volume, settings);
         beginRun(*cmd);
         const Volume volume = loadVolumeFromArgs(a->volume);
         settings = withDataDefaults(a->render, settings, volume);

@@ -75,6 +75,7 @@ void registerRender(CLI::App& app) {
         use.imageExt = lowerExtension(args->output);
         RenderSettings settings = settingsFromArgs(args->render, use);
         loadOptionsFromArgs(args->volume);  // malformed volume options: usage errors, now
+        chooseZarrLevel(args->volume, settings);
         if (args->bricks < 0 || args->bricks > 4096)
             throw UsageError("--bricks must be between 0 and 4096");
         if (args->brickComposite != "exact" && args->brickComposite != "fast")

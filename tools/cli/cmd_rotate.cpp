@@ -507,6 +507,7 @@ void registerRotate(CLI::App& app) {
         use.imageExt = "." + a->format;
         RenderSettings settings = settingsFromArgs(a->render, use);
         loadOptionsFromArgs(a->volume);
+        chooseZarrLevel(a->volume, settings);
         // Bricks, or frames in parallel (docs/parallel.md, chooseSequenceBricks).
         const SequenceBricks choice =
             chooseSequenceBricks(a->volume, settings, a->brick.bricks, a->brick.rankMemory);

@@ -5,7 +5,9 @@
 #include <sstream>
 
 #include "diagnostics.h"
+#include "parallel.h"
 #include "scene_file.h"
+#include "splat/sparse_files.h"
 
 namespace splat::cli {
 
@@ -20,6 +22,18 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args) {
 
 LoadOptions loadOptionsFromArgs(const VolumeArgs& args) {
     return asOptionUsage([&] { return loadOptionsFrom(args.values); });
+}
+
+void chooseZarrLevel(VolumeArgs& args, const RenderSettings& settings) {
+    if (!args.values.text("zarr-level").empty() || !isZarrFolder(args.spec)) return;
+    const ZarrImageInfo info = describeZarr(args.spec);
+    const int level = zarrLevelForView(info, settings);
+    if (level == 0) return;
+    args.values.set("zarr-level", std::to_string(level));
+    if (!workerProcess())
+        std::printf("reading OME-Zarr level %d of %zu, the level of detail of this view "
+                    "(--zarr-level picks another)\n",
+                    level, info.levels.size());
 }
 
 Volume loadVolumeFromArgs(const VolumeArgs& args) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "splat/options.h"
+#include "splat/settings.h"
 #include "splat/volume_io.h"
 
 namespace splat::cli {
@@ -22,6 +23,11 @@ void addVolumeOptions(CLI::App& cmd, VolumeArgs& args);
 
 /// Parses the options (UsageError on malformed ones).
 LoadOptions loadOptionsFromArgs(const VolumeArgs& args);
+
+/// An OME-Zarr VOLUME without --zarr-level is read at the level that splat's level-of-detail
+/// rule picks for the view of `settings` (zarrLevelForView, docs/input-files.md "Choosing a
+/// level"): sets --zarr-level to it when it is not level 0. Other volumes: nothing.
+void chooseZarrLevel(VolumeArgs& args, const RenderSettings& settings);
 
 /// Parses the options and loads the volume; throws splat::Error on bad input (OptionError,
 /// a usage error, for a --time past the file's last step). Prints the

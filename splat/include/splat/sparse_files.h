@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "splat/settings.h"
+
 namespace splat {
 
 /// True when this splat was built with OpenVDB (CMake option SPLAT_OPENVDB).
@@ -52,5 +54,13 @@ bool isZarrFolder(const std::string& path);
 /// Reads an OME-Zarr image's metadata (no chunks); throws splat::Error with one line for a
 /// folder that is not one or whose levels disagree.
 ZarrImageInfo describeZarr(const std::string& folder);
+
+/// The level of `image` that splat's level-of-detail rule picks for the view of `settings`
+/// (docs/input-files.md "Choosing a level"): the file's pyramid stands for the one the
+/// splatters would build. With `--lod PIXELS` the first level whose voxel covers at least
+/// PIXELS pixels (else the coarsest); with `--lod auto` lodAutoLevel's level in the modes it
+/// applies to; level 0 with level of detail off, with `--lod brick` and for the reference
+/// ray caster. The camera is the one the renderer places for level 0.
+int zarrLevelForView(const ZarrImageInfo& image, const RenderSettings& settings);
 
 }  // namespace splat

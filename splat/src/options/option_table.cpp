@@ -172,7 +172,9 @@ std::vector<OptionSpec> makeTable() {
          "grid; `splat info FILE.vdb` lists them)",
          kVol, kVolume, L},
         {"zarr-level", T::Text, "",
-         "OME-Zarr: the resolution level, 0 the finest (default 0; `splat info` lists them)",
+         "OME-Zarr: the resolution level, 0 the finest (default: render, rotate and bench the "
+         "level the --lod rule picks for the view, docs/input-files.md \"Choosing a level\"; "
+         "other commands 0; `splat info` lists them)",
          kVol, kVolume, L},
         {"channel", T::Text, "", "OME-Zarr: the channel of a 4D or 5D image (default 0)", kVol,
          kVolume, L},
