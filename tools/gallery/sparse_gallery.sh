@@ -38,7 +38,7 @@ for octave in range(5):
         noise += 0.55 ** octave * np.sin(k[0] * x + k[1] * y + k[2] * z + rng.uniform(0, 6.3))
 c = (n - 1) / 2.0
 r = np.sqrt((x - c) ** 2 + (y - c) ** 2 + ((z - c) * 1.4) ** 2) / 44.0
-density = np.clip(noise / 3.0 + 1.0 - 1.6 * r ** 2, 0.0, None).astype(np.float32)
+density = np.clip(noise / 2.5 + 1.0 - 1.3 * r ** 2, 0.0, None).astype(np.float32)
 g = vdb.FloatGrid(background=0.0)
 g.copyFromArray(density, ijk=(0, 0, 0), tolerance=0.0)
 g.name = "density"
@@ -58,6 +58,8 @@ for L in range(3):
     datasets.append({"path": str(L), "coordinateTransformations": [
         {"type": "scale", "scale": list(s[::-1])},
         {"type": "translation", "translation": list(o[::-1])}]})
+    if L == 2:
+        break
     m = [d // 2 for d in a.shape]
     a = a.astype(np.float64).reshape(m[0], 2, m[1], 2, m[2], 2).mean(axis=(1, 3, 5)).astype(
         np.float32)
@@ -86,15 +88,21 @@ cat > $tmp/cloud.json <<'JSON'
             [1, 1, 1, 1, 0.6]]}
 JSON
 $S render $tmp/cloud.vdb --tf $tmp/cloud.json --shade --azimuth 30 --elevation 15 \
-    --background 0.08,0.12,0.25 --size 320x320 -o $G/vdb_cloud.png
+    --background 0.05,0.08,0.2 --pixel-size 0.42 --size 320x320 -o $G/vdb_cloud.png
 # ch2's levels: the same view of each level, side by side.
 for L in 0 1 2; do
-    $S render $tmp/ch2.zarr --zarr-level $L --tf mri-head --azimuth 30 --elevation 10 \
+    $S render $tmp/ch2.zarr --zarr-level $L --tf mri-head --shade --azimuth 150 --elevation 10 \
         --size 220x220 -o $tmp/ch2_level$L.png
 done
 oiiotool $tmp/ch2_level0.png $tmp/ch2_level1.png $tmp/ch2_level2.png --mosaic 3x1 \
     -o $G/zarr_levels.png
 # The time series: one frame per step, the camera fixed.
-$S rotate $tmp/blob4d.nii.gz --time-steps 0:11 --mode mip --azimuth 20 --elevation 25 \
-    --size 160x160 -o $tmp/series --gif $G/time_series.gif
+cat > $tmp/blob.json <<'JSON'
+{"domain": "normalized", "unit_distance": 1.0,
+ "points": [[0, 0, 0, 0, 0], [0.2, 0.9, 0.4, 0.1, 0.0], [0.45, 1.0, 0.7, 0.2, 0.15],
+            [1, 1, 1, 0.8, 0.9]]}
+JSON
+$S rotate $tmp/blob4d.nii.gz --time-steps 0:11 --tf $tmp/blob.json --shade --azimuth 20 \
+    --elevation 25 --background 0.05,0.05,0.1 --pixel-size 0.3 --size 160x160 \
+    -o $tmp/series --gif $G/time_series.gif
 ls -l $G/vdb_cloud.png $G/zarr_levels.png $G/time_series.gif
