@@ -371,7 +371,8 @@ TEST_CASE("zarr: a pyramid renders at its default level like the NIfTI of that l
         const Image n = render({nii, "--lod", "2", "--size", size}, "n.exr");
         CHECK(same(z, n));
         // Not a vacuous check: level 0 of the same file gives another image.
-        const Image z0 = render({zarr, "--lod", "2", "--size", size, "--zarr-level", "0"}, "z0.exr");
+        const Image z0 =
+            render({zarr, "--lod", "2", "--size", size, "--zarr-level", "0"}, "z0.exr");
         CHECK_FALSE(same(z, z0));
     }
     // Level of detail off: level 0 by default.
@@ -386,8 +387,8 @@ TEST_CASE("zarr: a bad dtype, chunk size or level is one error line, status 1",
     const fs::path ramp = data / "dtypes" / "u2_le_zlib.zarr";
     const std::string meta = readTextFile(ramp / ".zarray");
     std::vector<std::pair<fs::path, std::string>> bad;
-    for (const auto& [name, dtype] : {std::pair<std::string, std::string>{"complex", "\"<c8\""},
-                                      {"unknown", "\"<q3\""}}) {
+    for (const auto& [name, dtype] :
+         {std::pair<std::string, std::string>{"complex", "\"<c8\""}, {"unknown", "\"<q3\""}}) {
         const fs::path d = copyFolder(ramp, tmp / (name + ".zarr"));
         writeText(d / ".zarray", replaced(meta, "\"<u2\"", dtype));
         bad.emplace_back(d, name == "complex" ? "complex samples" : "'<q3' is not supported");

@@ -31,9 +31,10 @@ void chooseZarrLevel(VolumeArgs& args, const RenderSettings& settings) {
     if (level == 0) return;
     args.values.set("zarr-level", std::to_string(level));
     if (!workerProcess())
-        std::printf("reading OME-Zarr level %d of %zu, the level of detail of this view "
-                    "(--zarr-level picks another)\n",
-                    level, info.levels.size());
+        std::printf(
+            "reading OME-Zarr level %d of %zu, the level of detail of this view "
+            "(--zarr-level picks another)\n",
+            level, info.levels.size());
 }
 
 Volume loadVolumeFromArgs(const VolumeArgs& args) {
