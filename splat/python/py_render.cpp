@@ -3,6 +3,7 @@
 #include "py_common.h"
 #include "splat/render.h"
 #include "splat/sequence.h"
+#include "splat/sparse_files.h"
 
 namespace splat::python {
 
@@ -91,6 +92,13 @@ void bindRender(py::module_& m) {
         py::arg("volume"), py::arg("options"), py::arg("tf_json"), py::arg("progress"),
         py::arg("return_stats"));
     m.def("_render_options", &renderOptionTable);
+    m.def(
+        "_zarr_level",
+        [](const std::string& path, const Keywords& options, const std::string& tfJson) {
+            const RenderSettings s = parseRenderSettings(options, tfJson, nullptr, true);
+            return zarrLevelForView(describeZarr(path), s);
+        },
+        py::arg("path"), py::arg("options"), py::arg("tf_json"));
     m.def(
         "_option_specs",
         [] {

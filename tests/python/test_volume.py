@@ -1,10 +1,12 @@
 # splat.Volume from NumPy arrays: index order, zero-copy wrapping, the documented conversions,
 # every bad-array case; splat.load and splat.from_nibabel against each other.
+import subprocess
+
 import numpy as np
 import pytest
 
 import splat
-from conftest import CH2, same_bits
+from conftest import CH2, SRC, same_bits
 
 
 def test_index_order_is_zyx_and_spacing_xyz():
@@ -181,3 +183,23 @@ def test_time_step_of_a_4d_nifti_equals_nibabels(tmp):
         assert np.array_equal(v.array, data[..., t].T.astype(np.float32))
     with pytest.raises(splat.InputError, match="time step 7 is out of range"):
         splat.load(str(path), time=7)
+
+
+def test_zarr_level_is_the_level_of_detail_of_the_view(tmp):
+    # tests/sparse/make_sparse_data.py writes pyramid.zarr (32^3 voxels of 0.5, levels 1 and
+    # 2 the exact 2x2x2 means) and pyramid_1.nii.gz (level 1 as NIfTI).
+    p = subprocess.run(["/usr/bin/python3", str(SRC / "tests" / "sparse" / "make_sparse_data.py"),
+                        str(tmp)], capture_output=True, text=True)
+    if p.returncode == 77:
+        pytest.skip(p.stderr.strip())
+    assert p.returncode == 0, p.stderr
+    zarr = str(tmp / "pyramid.zarr")
+    # --lod 2: the first level whose voxel covers 2 pixels (a level-0 voxel: 0.018 W pixels).
+    levels = [splat.zarr_level(zarr, size=f"{n}x{n}", lod=2) for n in (256, 64, 32, 16)]
+    assert levels == [0, 1, 2, 2]
+    assert splat.zarr_level(zarr, size="16x16") == 0  # level of detail off
+    assert splat.zarr_level(zarr, size="16x16", lod="auto", mode="xray") == 1
+    v = splat.load(zarr, zarr_level=splat.zarr_level(zarr, size="64x64", lod=2))
+    n = splat.load(str(tmp / "pyramid_1.nii.gz"))
+    assert v.dims == n.dims and v.spacing == n.spacing and v.origin == n.origin
+    assert np.array_equal(v.array, n.array)

@@ -32,7 +32,7 @@ __all__ = [
     "flip_map", "from_nibabel", "iso_surface", "list_dicom_series", "load", "load_gaussians",
     "load_options", "popping", "read_image", "render", "render_gaussians", "render_options",
     "rotate", "study", "study_knobs", "synthetic", "synthetic_names", "write_heatmap",
-    "write_image",
+    "write_image", "zarr_level",
 ]
 
 # Options taking "WxH" / "XxYxZ" text; every other sequence is joined with commas.
@@ -122,6 +122,15 @@ Loads every format the CLI reads: .nii/.nii.gz (NIfTI-1/2, ANALYZE), .nrrd/.nhdr
 Options (the CLI's volume options):
 {_option_doc([t for t in _splat._load_options() if t[0] != 'volume'])}
 """
+
+
+def zarr_level(path: str, **options) -> int:
+    """The level of the OME-Zarr image `path` that splat's level-of-detail rule picks for the
+    view of `options` (render's keywords: size, lod, mode, renderer, camera ...), as
+    `splat render` reads by default (docs/input-files.md "Choosing a level"):
+    load(path, zarr_level=zarr_level(path, **options)) reads only that level's chunks."""
+    argv, tf_json = _argv(options)
+    return _splat._zarr_level(str(path), argv, tf_json)
 
 
 def synthetic(name: str, size: int | None = None) -> Volume:
