@@ -375,6 +375,16 @@ TEST_CASE("zarr: a pyramid renders at its default level like the NIfTI of that l
             render({zarr, "--lod", "2", "--size", size, "--zarr-level", "0"}, "z0.exr");
         CHECK_FALSE(same(z, z0));
     }
+    // rotate and bench choose the same way, and say which level they read.
+    const RunResult rotate =
+        runProgram(SPLAT_EXE, {"rotate", zarr, "--lod", "2", "--size", "32x32", "--frames", "1",
+                               "-o", (tmp / "turn").string()});
+    CHECK(rotate.status == 0);
+    CHECK(rotate.out.find("reading OME-Zarr level 2 of 3") != std::string::npos);
+    const RunResult bench =
+        runProgram(SPLAT_EXE, {"bench", zarr, "--lod", "2", "--size", "64x64", "--repeats", "1"});
+    CHECK(bench.status == 0);
+    CHECK(bench.out.find("reading OME-Zarr level 1 of 3") != std::string::npos);
     // Level of detail off: level 0 by default.
     CHECK(same(render({zarr, "--size", "32x32"}, "off.exr"),
                render({zarr, "--size", "32x32", "--zarr-level", "0"}, "off0.exr")));
