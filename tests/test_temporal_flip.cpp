@@ -9,13 +9,13 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "cli_util.h"
 #include "splat/depth.h"
 #include "splat/gaussians.h"
 #include "splat/popping.h"
 #include "splat/scene.h"
 #include "splat/synthetic.h"
 #include "splat/warp.h"
-#include "cli_util.h"
 
 using namespace splat;
 
@@ -70,9 +70,8 @@ double planeWarpError(int size, Projection projection, std::size_t* valid = null
     const Volume geometry = scene.geometry();
     WarpOptions wo;
     wo.border = size / 16;
-    const WarpedFrame w =
-        warpFrame(ia, gaussianReferenceDepth(scene, a), Camera(a, geometry), ib,
-                  gaussianReferenceDepth(scene, b), Camera(b, geometry), wo);
+    const WarpedFrame w = warpFrame(ia, gaussianReferenceDepth(scene, a), Camera(a, geometry), ib,
+                                    gaussianReferenceDepth(scene, b), Camera(b, geometry), wo);
     if (valid) *valid = w.validCount;
     return warpError(ib, w);
 }
@@ -134,7 +133,8 @@ TEST_CASE("temporal flip: the median-opacity depth", "[temporal]") {
         CHECK(t < tStar);
         CHECK(-std::expm1(-tau) == Approx(0.45).epsilon(1e-4));
         // Symmetric about the centre: mirrored pixels have the same depth.
-        for (int x = 0; x < 33; ++x) CHECK(gd.at(x, 16).r == Approx(gd.at(32 - x, 16).r).margin(1e-5));
+        for (int x = 0; x < 33; ++x)
+            CHECK(gd.at(x, 16).r == Approx(gd.at(32 - x, 16).r).margin(1e-5));
     }
     // A thin plane's depth is the plane's, whatever its opacity: the ray meets y = 0 at
     // t = -origin.y / dir.y.
@@ -270,10 +270,9 @@ TEST_CASE("temporal flip: 3dgs's FLIP_1 where two Gaussians swap is far above th
 TEST_CASE("temporal flip: splat popping prints and reports FLIP_1 and FLIP_7", "[temporal][cli]") {
     const std::filesystem::path dir = test::testTmpDir("temporal_flip_cli");
     std::filesystem::remove_all(dir);
-    const std::vector<std::string> base = {"popping", "synthetic:blob:16", "--size", "32x32",
-                                           "--from",  "0",                 "--to",   "8",
-                                           "--step",  "1",                 "--refine", "0",
-                                           "-q"};
+    const std::vector<std::string> base = {
+        "popping", "synthetic:blob:16", "--size", "32x32", "--from", "0", "--to", "8", "--step",
+        "1",       "--refine",          "0",      "-q"};
     std::vector<std::string> args = base;
     args.insert(args.end(), {"--report", (dir / "on").string()});
     const test::RunResult on = test::runSplat(args);
@@ -288,7 +287,8 @@ TEST_CASE("temporal flip: splat popping prints and reports FLIP_1 and FLIP_7", "
     args.insert(args.end(), {"--no-warp-flip", "--report", (dir / "off").string()});
     const test::RunResult off = test::runSplat(args);
     REQUIRE(off.status == 0);
-    const nlohmann::json k = nlohmann::json::parse(test::readTextFile(dir / "off" / "summary.json"));
+    const nlohmann::json k =
+        nlohmann::json::parse(test::readTextFile(dir / "off" / "summary.json"));
     CHECK(k["renderers"]["reference"]["flip_warp_1"].is_null());
     CHECK(k["options"]["warp_flip"] == false);
 }

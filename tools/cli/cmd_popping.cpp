@@ -43,8 +43,8 @@ std::string warpedColumn(double v) {
 }
 
 void printSummary(const PoppingResult& r) {
-    std::printf("%-10s %12s %12s %10s %8s %10s %10s %12s\n", "renderer", "spike ratio",
-                "median T", "flicker", "events", "FLIP1 warp", "FLIP7 warp", "ms/frame");
+    std::printf("%-10s %12s %12s %10s %8s %10s %10s %12s\n", "renderer", "spike ratio", "median T",
+                "flicker", "events", "FLIP1 warp", "FLIP7 warp", "ms/frame");
     for (const RendererSeries& s : r.series) {
         int events = 0;
         for (const PoppingEvent& e : r.events) events += e.renderer == s.renderer;

@@ -393,7 +393,8 @@ std::string metricsCsv(const PoppingResult& r) {
         for (std::size_t n = 0; n < intervals; ++n)
             s << "axis-sheet," << n << ',' << csvNumber(r.angles[n]) << ','
               << csvNumber(r.angles[n + 1]) << ",," << csvNumber(at(r.crossJump, n)) << ",,,,"
-              << csvNumber(at(r.crossJump, n)) << ',' << (isEvent(r, nullptr, n) ? 1 : 0) << ",,,\n";
+              << csvNumber(at(r.crossJump, n)) << ',' << (isEvent(r, nullptr, n) ? 1 : 0)
+              << ",,,\n";
     return s.str();
 }
 
@@ -541,8 +542,8 @@ std::string summarySection(const PoppingResult& r) {
           << td(n ? "<span class=\"event-yes\">" + std::to_string(n) + "</span>" : "0")
           << td(formatNumber(median(x.e), 4)) << td(formatNumber(x.threshold, 4))
           << td(formatNumber(warped(x.flipWarp1Mean), 4))
-          << td(formatNumber(warped(x.flipWarp7Mean), 4)) << td(formatNumber(x.msPerFrame, 4)) << td(formatNumber(x.totalMs / 1000.0, 4))
-          << "</tr>\n";
+          << td(formatNumber(warped(x.flipWarp7Mean), 4)) << td(formatNumber(x.msPerFrame, 4))
+          << td(formatNumber(x.totalMs / 1000.0, 4)) << "</tr>\n";
     }
     h << "</table>\n<p class=\"note\">Spike ratio: the largest detection signal over its median. "
          "Flicker ratio: median T over the reference's. Median error: median e (RMS against "

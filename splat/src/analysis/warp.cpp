@@ -48,8 +48,7 @@ bool sampleVisible(const Image& earlier, const Image& depth, const Camera& camer
             const glm::vec4& d = depth.at(x, y);
             if (d.a == 0) return false;
             const Ray ray = camera.ray(x + 0.5, y + 0.5);
-            if (std::abs(glm::dot(p - ray.origin, ray.dir) - double(d.r)) > tolerance)
-                return false;
+            if (std::abs(glm::dot(p - ray.origin, ray.dir) - double(d.r)) > tolerance) return false;
             sum += w * glm::dvec4(earlier.at(x, y));
         }
     out = glm::vec4(sum);

@@ -2,12 +2,13 @@
 // ray the optical depth accumulated from the ray's start (t = 0, as the reference integrates)
 // is the closed form tau(t) = sum_i A_i (erf(s_i (t - t*_i)) - erf(-s_i t*_i)), monotone in
 // t, so t_1/2 is found by bisection.
+#include "splat/depth.h"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "renderers.h"
-#include "splat/depth.h"
 
 namespace splat {
 

@@ -172,8 +172,8 @@ std::vector<OptionSpec> makeTable() {
          "grid; `splat info FILE.vdb` lists them)",
          kVol, kVolume, L},
         {"zarr-level", T::Text, "",
-         "OME-Zarr: the resolution level, 0 the finest (default 0; `splat info` lists them)",
-         kVol, kVolume, L},
+         "OME-Zarr: the resolution level, 0 the finest (default 0; `splat info` lists them)", kVol,
+         kVolume, L},
         {"channel", T::Text, "", "OME-Zarr: the channel of a 4D or 5D image (default 0)", kVol,
          kVolume, L},
         // ---- rendering

@@ -1,9 +1,11 @@
 // The median-opacity depth of a volume Scene's reference (splat/depth.h): each pixel ray is
 // clipped to the volume's box widened by the kernel radius and marched at half the smallest
-// spacing (stopping once the optical depth exceeds 20) through the reference's extinction field rho(x) (pre-classified: the
-// kernel sum of the splats' rho_i; post-classified: the transfer function's extinction of
-// f(x)); the optical depth is integrated by the trapezoid rule and t_1/2 interpolated
-// linearly within the step where it is crossed.
+// spacing (stopping once the optical depth exceeds 20) through the reference's extinction field
+// rho(x) (pre-classified: the kernel sum of the splats' rho_i; post-classified: the transfer
+// function's extinction of f(x)); the optical depth is integrated by the trapezoid rule and t_1/2
+// interpolated linearly within the step where it is crossed.
+#include "splat/depth.h"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -14,7 +16,6 @@
 
 #include "model/scene_impl.h"
 #include "reference/field.h"
-#include "splat/depth.h"
 
 namespace splat {
 
@@ -53,8 +54,7 @@ class DepthField {
 };
 
 /// [t0, t1] of the ray inside the box (t0 >= 0), or t0 > t1 where it misses.
-void clipToBox(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi, double& t0,
-               double& t1) {
+void clipToBox(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi, double& t0, double& t1) {
     t0 = 0;
     t1 = INFINITY;
     for (int a = 0; a < 3; ++a) {
@@ -77,8 +77,8 @@ double medianOpacityDepth(const std::vector<double>& rho, double t0, double dt) 
     const double total = rho.empty() ? 0.0 : -std::expm1(-tau.back());
     if (!(total >= kDepthMinOpacity)) return -1;
     const double tauHalf = -std::log1p(-0.5 * total);
-    const std::size_t n = std::size_t(std::lower_bound(tau.begin(), tau.end(), tauHalf) -
-                                      tau.begin());
+    const std::size_t n =
+        std::size_t(std::lower_bound(tau.begin(), tau.end(), tauHalf) - tau.begin());
     if (n == 0) return t0;
     const double f = (tauHalf - tau[n - 1]) / (tau[n] - tau[n - 1]);
     return t0 + (double(n - 1) + f) * dt;
