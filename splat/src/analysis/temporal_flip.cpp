@@ -26,7 +26,11 @@ double meanOfValid(const std::vector<double>& v) {
 TemporalFlip::TemporalFlip(const PoppingOptions& options, const Volume& geometry,
                            const Scene* scene)
     : options_(options), geometry_(geometry), scene_(scene) {
-    enabled_ = options.flip && options.warpFlip && (scene || options.depthFrame);
+    // mip and xray have no depth (splat/depth.h): nothing to warp with.
+    const bool depth = scene ? scene->settings().mode == RenderMode::Dvr ||
+                                   scene->settings().mode == RenderMode::Iso
+                             : bool(options.depthFrame);
+    enabled_ = options.flip && options.warpFlip && depth;
 }
 
 void TemporalFlip::addView(std::size_t n, const CameraParams& camera,
