@@ -341,6 +341,14 @@ TEST_CASE("temporal flip: splat popping prints and reports FLIP_1 and FLIP_7", "
     CHECK(j["renderers"]["reference"]["flip_warp_1"].get<double>() < 0.01);
     CHECK(j["renderers"]["reference"]["flip_warp_7"].is_number());
     CHECK(j["options"]["warp_flip"] == true);
+    // The report's plot of FLIP_1, and the values in metrics.csv (row 1: axis, interval 0).
+    const std::string html = test::readTextFile(dir / "on" / "report.html");
+    CHECK(html.find("ꟻLIP₁ of frames warped with the exact flow") != std::string::npos);
+    const std::string csv = test::readTextFile(dir / "on" / "metrics.csv");
+    const std::string row =
+        csv.substr(csv.find('\n') + 1, csv.find('\n', csv.find('\n') + 1) - csv.find('\n') - 1);
+    CHECK(row.rfind("axis,0,", 0) == 0);
+    CHECK(row.substr(row.size() - 2) != ",,");  // flipWarp1 and flipWarp7 measured
     args = base;
     args.insert(args.end(), {"--no-warp-flip", "--report", (dir / "off").string()});
     const test::RunResult off = test::runSplat(args);
@@ -349,4 +357,6 @@ TEST_CASE("temporal flip: splat popping prints and reports FLIP_1 and FLIP_7", "
         nlohmann::json::parse(test::readTextFile(dir / "off" / "summary.json"));
     CHECK(k["renderers"]["reference"]["flip_warp_1"].is_null());
     CHECK(k["options"]["warp_flip"] == false);
+    CHECK(test::readTextFile(dir / "off" / "report.html").find("ꟻLIP₁ of frames warped") ==
+          std::string::npos);
 }
