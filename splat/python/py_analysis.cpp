@@ -31,6 +31,14 @@ py::dict seriesDict(const RendererSeries& s) {
     d["flip_T"] = doubles(s.flipT);
     d["e"] = doubles(s.e);
     d["flip_ref"] = doubles(s.flipRef);
+    // StopThePop's temporal FLIP (splat/warp.h): per pair, -1 where no pixel is valid; the
+    // means None when not measured.
+    d["flip_warp_1"] = doubles(s.flipWarp1);
+    d["flip_warp_7"] = doubles(s.flipWarp7);
+    d["flip_warp_1_mean"] =
+        s.flipWarp1Mean >= 0 ? py::object(py::float_(s.flipWarp1Mean)) : py::none();
+    d["flip_warp_7_mean"] =
+        s.flipWarp7Mean >= 0 ? py::object(py::float_(s.flipWarp7Mean)) : py::none();
     d["sheet_axis"] = ints(s.sheetAxis);
     d["sheet_sign"] = ints(s.sheetSign);
     d["signal"] = doubles(s.signal);
@@ -131,7 +139,9 @@ void bindAnalysis(py::module_& m) {
             },
             "{renderer: {'T', 'J', 'flip_T' (per interval), 'e', 'flip_ref', 'sheet_axis', "
             "'sheet_sign' (per view), 'signal', and the numbers 'threshold', 'spike_ratio', "
-            "'median_T', 'flicker_ratio', 'ms_per_frame', ...}}")
+            "'median_T', 'flicker_ratio', 'ms_per_frame', 'flip_warp_1', 'flip_warp_7' "
+            "(StopThePop's temporal FLIP per frame pair) and their means "
+            "'flip_warp_1_mean', 'flip_warp_7_mean' (None when not measured), ...}}")
         .def_property_readonly(
             "cross_jump", [](const PoppingResult& r) { return doubles(r.crossJump); },
             "C per interval (axis and sheet both present).")

@@ -35,14 +35,23 @@ struct PoppingCommand {
     bool quiet = false, resume = false;
 };
 
+/// A temporal FLIP mean for the table: "-" when not measured (RendererSeries::flipWarp1Mean).
+std::string warpedColumn(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.4f", v);
+    return v >= 0 ? buf : "-";
+}
+
 void printSummary(const PoppingResult& r) {
-    std::printf("%-10s %12s %12s %10s %8s %12s\n", "renderer", "spike ratio", "median T", "flicker",
-                "events", "ms/frame");
+    std::printf("%-10s %12s %12s %10s %8s %10s %10s %12s\n", "renderer", "spike ratio", "median T",
+                "flicker", "events", "FLIP1 warp", "FLIP7 warp", "ms/frame");
     for (const RendererSeries& s : r.series) {
         int events = 0;
         for (const PoppingEvent& e : r.events) events += e.renderer == s.renderer;
-        std::printf("%-10s %12.2f %12.3g %10.2f %8d %12.1f\n", toString(s.renderer), s.spikeRatio,
-                    s.medianT, s.flickerRatio, events, s.msPerFrame);
+        std::printf("%-10s %12.2f %12.3g %10.2f %8d %10s %10s %12.1f\n", toString(s.renderer),
+                    s.spikeRatio, s.medianT, s.flickerRatio, events,
+                    warpedColumn(s.flipWarp1Mean).c_str(), warpedColumn(s.flipWarp7Mean).c_str(),
+                    s.msPerFrame);
     }
     for (const RendererSeries& s : r.series) {
         std::size_t exact = 0;

@@ -1,6 +1,7 @@
 #pragma once
 // The sweep options of `splat popping` (--from, --to, --step, --sweep, --path, --frames,
-// --renderers, --refine, --threshold-k, --threshold-floor, --ppd, --no-flip, --truth),
+// --renderers, --refine, --threshold-k, --threshold-floor, --ppd, --no-flip, --no-warp-flip,
+// --truth),
 // registered from the library's option table (splat/options.h), where the Python module's
 // splat.popping reads the same keywords.
 #include <CLI/CLI.hpp>

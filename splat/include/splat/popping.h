@@ -9,6 +9,10 @@
 //                             (cheap detection without the reference)
 //   perceptual       FLIP1_X(n) = mean LDR-FLIP between consecutive frames, and mean
 //                             LDR-FLIP against the reference (Andersson et al. 2020)
+//   temporal FLIP    FLIP_k,X(n) = StopThePop's measure (splat/warp.h): mean LDR-FLIP between
+//                             frame n + k and frame n warped to view n + k with the exact flow
+//                             of the cameras and the reference's depth (splat/depth.h),
+//                             occluded pixels and a border masked; k = 1 and 7
 // RMS is over all pixels and the RGB channels of the images composited over the background.
 // An event is an interval whose detection signal (J_X with a reference, else C for the
 // axis-aligned splatter and T_X otherwise) exceeds the sweep's robust threshold
@@ -29,6 +33,7 @@
 #include "splat/scene.h"
 #include "splat/sequence.h"
 #include "splat/settings.h"
+#include "splat/warp.h"
 
 namespace splat {
 
@@ -57,6 +62,14 @@ struct PoppingOptions {
     int refine = 10;              ///< bisection levels around each event (0: none)
     double pixelsPerDegree = 67;  ///< LDR-FLIP viewing condition
     bool flip = true;             ///< compute the perceptual columns
+    /// Compute StopThePop's temporal FLIP_1 and FLIP_7 (with `flip`): one reference depth
+    /// per view and two warps per renderer and view, and frame t - 7 kept per renderer.
+    bool warpFlip = true;
+    WarpOptions warp;  ///< the warp's border and occlusion tolerance
+    /// The reference's depth at a view (splat/depth.h) where frames come from renderFrame,
+    /// e.g. gaussianReferenceDepth of a Gaussian scene; unset, such an analysis has no
+    /// temporal FLIP. The Scene overloads take referenceDepth of the Scene.
+    std::function<Image(const CameraParams&)> depthFrame;
     int thumbnail = 160;          ///< longest side of the animation frames kept, pixels
     /// Frames rendered at once, each on one thread (0: one per thread for images up to
     /// 256 x 256 and up to 1M splats, else 1: one frame at a time on every thread). The
@@ -118,6 +131,12 @@ struct RendererSeries {
     RendererKind renderer = RendererKind::Axis;
     /// Per interval n (angles.size() - 1 entries).
     std::vector<double> T, J, flipT;
+    /// StopThePop's FLIP_1 per interval n (frame n warped to n + 1) and FLIP_7 per pair
+    /// (n, n + 7) (angles.size() - 7 entries; none for sweeps of fewer than 8 views); -1 where
+    /// no pixel is valid. Empty when not measured (PoppingOptions::warpFlip, no depth).
+    std::vector<double> flipWarp1, flipWarp7;
+    /// Their means over the pairs with valid pixels; -1 when not measured.
+    double flipWarp1Mean = -1, flipWarp7Mean = -1;
     /// Per view n (angles.size() entries): error against the reference and its mean FLIP.
     std::vector<double> e, flipRef;
     std::vector<int> sheetAxis, sheetSign;  ///< per view (axis-aligned; else -1, 0)

@@ -13,6 +13,7 @@
 
 #include "frame/stopwatch.h"
 #include "analysis/median.h"
+#include "analysis/temporal_flip.h"
 #include "frame_journal.h"
 #include "splat/flip.h"
 #include "splat/image_io.h"
@@ -71,7 +72,8 @@ class Analyzer {
           positions_(std::move(positions)),
           predicted_(std::move(predicted)),
           cameraAt_(std::move(cameraAt)),
-          options_(options) {
+          options_(options),
+          temporal_(options, geometry, scene) {
         kinds_ = options.renderers;
         if (kinds_.empty()) throw Error("popping: no renderer to analyse");
         if (!scene_ && !options.renderFrame) throw Error("popping: no Scene and no renderFrame");
@@ -144,6 +146,7 @@ class Analyzer {
                     peak = std::max({peak, double(std::abs(p.r)), double(std::abs(p.g)),
                                      double(std::abs(p.b))});
             measureView(r, v, cur, prev, frameMs);
+            measureWarped(r, v, cur);
             prev = std::move(cur);
             next = v + 1;
         };
@@ -176,6 +179,7 @@ class Analyzer {
             const double mx = *std::max_element(s.signal.begin(), s.signal.end());
             s.spikeRatio = s.medianSignal > 0 ? mx / s.medianSignal : (mx > 0 ? INFINITY : 1.0);
         }
+        temporal_.finish(r.series);
         if (ref_ >= 0)
             for (RendererSeries& s : r.series)
                 s.flickerRatio =
@@ -222,6 +226,15 @@ class Analyzer {
         if (n > 0 && axis_ >= 0 && sheet_ >= 0)
             r.crossJump.push_back(rmsDiff(cur.images[axis_], cur.images[sheet_],
                                           &prev.images[axis_], &prev.images[sheet_]));
+    }
+
+    /// StopThePop's FLIP_1 and FLIP_7 of view n (splat/warp.h), on the frames as FLIP sees
+    /// them.
+    void measureWarped(PoppingResult& r, std::size_t n, const View& cur) {
+        if (!temporal_.enabled()) return;
+        std::vector<Image> shown;
+        for (const Image& im : cur.images) shown.push_back(display(im));
+        temporal_.addView(n, cameraAt_(r.angles[n]), shown, r.series);
     }
 
   private:
@@ -412,6 +425,7 @@ class Analyzer {
     std::mutex progressMutex_;
     float windowScale_ = 1.0f;
     std::atomic<bool> cancelled_{false};
+    analysis::TemporalFlip temporal_;
 };
 
 }  // namespace

@@ -2,8 +2,10 @@
 // summary.json in one folder.
 //
 // metrics.csv columns: renderer, interval, angle_from, angle_to, T, J, flipT, e, flipRef,
-// signal, is_event, truth. One row per renderer and interval (e and flipRef at angle_from); a
-// value that was not measured (no reference, no FLIP) is an empty cell. truth: the reference
+// signal, is_event, truth, flipWarp1, flipWarp7. One row per renderer and interval (e and
+// flipRef at angle_from; flipWarp1 the interval's StopThePop FLIP_1, flipWarp7 the FLIP_7 of
+// views n and n + 7); a value that was not measured (no reference, no FLIP, no valid pixel,
+// fewer than 8 views) is an empty cell. truth: the reference
 // J, e and flipRef are against, "point" (one ray per pixel centre) or "filtered SIGMA" (the
 // pixel-filtered reference, PoppingResult::truthFilter); empty without a reference. When the cross
 // jump C was measured, rows with renderer "axis-sheet" follow: C in the J and signal columns,
@@ -55,6 +57,10 @@ constexpr const char* kFiles[] = {"report.html", "metrics.csv", "summary.json"};
 // ---- small helpers -----------------------------------------------------------------
 
 double at(const std::vector<double>& v, std::size_t i) { return i < v.size() ? v[i] : kNaN; }
+
+/// A temporal FLIP value (splat/popping.h RendererSeries::flipWarp1): -1 (not measured) as NaN.
+double warped(double v) { return v >= 0 ? v : kNaN; }
+double warpedAt(const std::vector<double>& v, std::size_t i) { return warped(at(v, i)); }
 
 double median(std::vector<double> v) { return analysis::finiteMedian(std::move(v)); }
 
@@ -256,6 +262,9 @@ json optionsJson(const PoppingOptions& o) {
     j["refine"] = o.refine;
     j["pixels_per_degree"] = o.pixelsPerDegree;
     j["flip"] = o.flip;
+    j["warp_flip"] = o.warpFlip;
+    j["warp_border"] = o.warp.border;
+    j["warp_depth_tolerance"] = o.warp.depthTolerance;
     j["thumbnail"] = o.thumbnail;
     j["truth"] = toString(o.truth);
     return j;
@@ -323,6 +332,9 @@ json summaryJson(const PoppingResult& r) {
         o["spike_ratio"] = number(s.spikeRatio);
         o["median_T"] = number(s.medianT);
         o["flicker_ratio"] = number(s.flickerRatio);
+        // StopThePop's temporal FLIP_1 and FLIP_7 (null when not measured).
+        o["flip_warp_1"] = number(warped(s.flipWarp1Mean));
+        o["flip_warp_7"] = number(warped(s.flipWarp7Mean));
         o["threshold"] = number(s.threshold);
         o["median_error"] = number(median(s.e));
         o["ms_per_frame"] = number(s.msPerFrame);
@@ -362,7 +374,8 @@ json summaryJson(const PoppingResult& r) {
 
 std::string metricsCsv(const PoppingResult& r) {
     std::ostringstream s;
-    s << "renderer,interval,angle_from,angle_to,T,J,flipT,e,flipRef,signal,is_event,truth\n";
+    s << "renderer,interval,angle_from,angle_to,T,J,flipT,e,flipRef,signal,is_event,truth,"
+         "flipWarp1,flipWarp7\n";
     const std::string truth = !r.find(RendererKind::Reference) ? ""
                               : r.truthFilter > 0 ? "filtered " + csvNumber(r.truthFilter)
                                                   : "point";
@@ -374,12 +387,14 @@ std::string metricsCsv(const PoppingResult& r) {
               << csvNumber(at(x.J, n)) << ',' << csvNumber(at(x.flipT, n)) << ','
               << csvNumber(at(x.e, n)) << ',' << csvNumber(at(x.flipRef, n)) << ','
               << csvNumber(at(x.signal, n)) << ',' << (isEvent(r, &x.renderer, n) ? 1 : 0) << ','
-              << truth << '\n';
+              << truth << ',' << csvNumber(warpedAt(x.flipWarp1, n)) << ','
+              << csvNumber(warpedAt(x.flipWarp7, n)) << '\n';
     if (!r.crossJump.empty())
         for (std::size_t n = 0; n < intervals; ++n)
             s << "axis-sheet," << n << ',' << csvNumber(r.angles[n]) << ','
               << csvNumber(r.angles[n + 1]) << ",," << csvNumber(at(r.crossJump, n)) << ",,,,"
-              << csvNumber(at(r.crossJump, n)) << ',' << (isEvent(r, nullptr, n) ? 1 : 0) << ",\n";
+              << csvNumber(at(r.crossJump, n)) << ',' << (isEvent(r, nullptr, n) ? 1 : 0)
+              << ",,,\n";
     return s.str();
 }
 
@@ -516,7 +531,8 @@ std::string summarySection(const PoppingResult& r) {
     std::ostringstream h;
     h << "<h2>Summary</h2>\n<table>\n<tr>" << th("renderer", true) << th("spike ratio")
       << th("median T") << th("flicker ratio") << th("events") << th("median error")
-      << th("threshold") << th("ms / frame") << th("total s") << "</tr>\n";
+      << th("threshold") << th("ꟻLIP₁ warped") << th("ꟻLIP₇ warped") << th("ms / frame")
+      << th("total s") << "</tr>\n";
     for (const RendererSeries& x : r.series) {
         const auto n = std::count_if(r.events.begin(), r.events.end(), [&](const PoppingEvent& e) {
             return e.renderer == x.renderer;
@@ -525,13 +541,17 @@ std::string summarySection(const PoppingResult& r) {
           << td(formatNumber(x.medianT, 4)) << td(formatNumber(x.flickerRatio, 4))
           << td(n ? "<span class=\"event-yes\">" + std::to_string(n) + "</span>" : "0")
           << td(formatNumber(median(x.e), 4)) << td(formatNumber(x.threshold, 4))
-          << td(formatNumber(x.msPerFrame, 4)) << td(formatNumber(x.totalMs / 1000.0, 4))
-          << "</tr>\n";
+          << td(formatNumber(warped(x.flipWarp1Mean), 4))
+          << td(formatNumber(warped(x.flipWarp7Mean), 4)) << td(formatNumber(x.msPerFrame, 4))
+          << td(formatNumber(x.totalMs / 1000.0, 4)) << "</tr>\n";
     }
     h << "</table>\n<p class=\"note\">Spike ratio: the largest detection signal over its median. "
          "Flicker ratio: median T over the reference's. Median error: median e (RMS against "
          "the reference) over the views. An event is an interval whose signal exceeds the "
-         "threshold.</p>\n";
+         "threshold. ꟻLIP<sub>k</sub> warped: StopThePop's temporal measure, the mean LDR-ꟻLIP "
+         "between frame t + k and frame t warped to view t + k with the exact flow of the "
+         "cameras and the reference's depth, occluded pixels and a border masked "
+         "(docs/popping.md); ꟻLIP₇ needs at least 8 views.</p>\n";
     return h.str();
 }
 
@@ -598,6 +618,7 @@ std::string plotsSection(const PoppingResult& r) {
     report::LinePlot pE = makePlot("Error e against the reference", "e (RMS)");
     report::LinePlot pF = makePlot("ꟻLIP between consecutive frames", "mean ꟻLIP");
     report::LinePlot pR = makePlot("ꟻLIP against the reference", "mean ꟻLIP");
+    report::LinePlot pW = makePlot("ꟻLIP₁ of frames warped with the exact flow", "mean ꟻLIP₁");
     for (std::size_t i = 0; i < r.series.size(); ++i) {
         const RendererSeries& x = r.series[i];
         add(pT, x, i, mid, x.T);
@@ -607,6 +628,9 @@ std::string plotsSection(const PoppingResult& r) {
             add(pR, x, i, r.angles, x.flipRef);
         }
         add(pF, x, i, mid, x.flipT);
+        std::vector<double> w1;
+        for (double v : x.flipWarp1) w1.push_back(warped(v));
+        add(pW, x, i, mid, w1);
     }
     if (!r.crossJump.empty())
         pJ.series.push_back({"C axis−sheet", "#9467bd", mid, r.crossJump, mid.size() < 40, true});
@@ -639,6 +663,10 @@ std::string plotsSection(const PoppingResult& r) {
     h << figure(pE, "e<sub>X</sub>(θ) = RMS(I<sub>X</sub>(θ) − I<sub>ref</sub>(θ)) per view.");
     h << figure(pF, "Mean LDR-ꟻLIP between consecutive frames (perceived change per step).");
     h << figure(pR, "Mean LDR-ꟻLIP against the reference per view.");
+    if (!pW.series.empty())
+        h << figure(pW,
+                    "StopThePop's ꟻLIP₁: mean LDR-ꟻLIP between frame n + 1 and frame n warped to "
+                    "view n + 1 (exact flow, reference depth), over the pixels the warp holds.");
     return h.str();
 }
 

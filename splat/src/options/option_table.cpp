@@ -329,6 +329,10 @@ std::vector<OptionSpec> makeTable() {
         {"threshold-floor", T::Real, "2", "... and at least FLOOR * median", kSw, kSweep, W},
         {"ppd", T::Real, "67", "LDR-FLIP pixels per degree", kSw, kSweep, W},
         {"no-flip", T::Flag, "", "skip the perceptual (LDR-FLIP) columns", kSw, kSweep, W},
+        {"no-warp-flip", T::Flag, "",
+         "skip StopThePop's temporal FLIP_1 and FLIP_7 (frames warped with the exact flow of "
+         "the cameras and the reference's depth)",
+         kSw, kSweep, W},
         {"truth", T::Text, "auto",
          "the reference the splatters are judged against: point (one ray per pixel "
          "centre) | filtered (through the pixel filter, --pixel-filter or 0.5) | auto "

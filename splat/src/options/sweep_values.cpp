@@ -62,6 +62,7 @@ void poppingFrom(const OptionValues& v, const RenderSettings& settings, Sweep& s
         o.floorRatio = floor;
         o.pixelsPerDegree = ppd;
         o.flip = !v.flag("no-flip");
+        o.warpFlip = !v.flag("no-warp-flip");
     } catch (const OptionError&) {
         throw;
     } catch (const Error& e) {
