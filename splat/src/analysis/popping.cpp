@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <numeric>
 
@@ -193,9 +194,31 @@ class Analyzer {
             std::lock_guard<std::mutex> lock(progressMutex_);
             totalUnits_ = done_ + found.size() * std::size_t(options_.refine + 2) * kinds_.size();
         }
-        for (const auto& [k, n] : found) r.events.push_back(event(r, k, n));
+        refineEvents(r, found);
         r.totalMs = msSince(start);
         return r;
+    }
+
+    /// The events of `found` (renderer, interval) into r.events, in that order, refined
+    /// interval by interval: every renderer's event on one interval bisects through the same
+    /// views while its choices agree, and neighbouring intervals share their common end, so a
+    /// view is rendered once for all of them (held until the next interval starts).
+    void refineEvents(PoppingResult& r,
+                      const std::vector<std::pair<std::size_t, std::size_t>>& found) {
+        std::vector<std::size_t> order(found.size());
+        std::iota(order.begin(), order.end(), std::size_t(0));
+        std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+            return found[a].second < found[b].second;
+        });
+        r.events.resize(found.size());
+        for (const std::size_t i : order) {
+            const std::size_t n = found[i].second;
+            const double lo = std::min(r.angles[n], r.angles[n + 1]),
+                         hi = std::max(r.angles[n], r.angles[n + 1]);
+            std::erase_if(views_, [&](const auto& kv) { return kv.first < lo || kv.first > hi; });
+            r.events[i] = event(r, found[i].first, n);
+        }
+        views_.clear();
     }
 
     void measureView(PoppingResult& r, std::size_t n, const View& cur, const View& prev,
@@ -289,13 +312,13 @@ class Analyzer {
             if (s >= ev.angleFrom && s <= ev.angleTo) ev.predicted = true;
         // Proof of discontinuity: bisect towards the half where the measure is larger.
         double a = ev.angleFrom, b = ev.angleTo;
-        View va = renderView(a), vb = renderView(b);
+        View va = viewAt(a), vb = viewAt(b);
         ev.frames.before = va.images;
         ev.frames.after = vb.images;
         ev.refinement.push_back(step(va, vb, a, b - a));
         for (int level = 0; level < options_.refine; ++level) {
             const double m = 0.5 * (a + b);
-            View vm = renderView(m);
+            View vm = viewAt(m);
             if (measure(k, va, vm) >= measure(k, vm, vb)) {
                 b = m;
                 vb = std::move(vm);
@@ -335,6 +358,18 @@ class Analyzer {
         std::snprintf(name, sizeof name, "%s_%016llx.frame", toString(kinds_[k]),
                       static_cast<unsigned long long>(bits));
         return std::filesystem::path(options_.frameJournal) / name;
+    }
+
+    /// A refinement view: the one already rendered at `angle` for another event (views_),
+    /// else renderView's. Frames are deterministic, so the images are the same either way;
+    /// a reused view still counts its frames as done.
+    View viewAt(double angle) {
+        const auto it = views_.find(angle);
+        if (it == views_.end()) return views_.emplace(angle, renderView(angle)).first->second;
+        for (std::size_t k = 0; k < kinds_.size(); ++k)
+            report(std::string(toString(kinds_[k])) + " at " + std::to_string(angle));
+        if (cancelled_) throw Cancelled();
+        return it->second;
     }
 
     /// Every renderer's frame of one view (refinement, and sweep views in the journal):
@@ -426,6 +461,7 @@ class Analyzer {
     float windowScale_ = 1.0f;
     std::atomic<bool> cancelled_{false};
     analysis::TemporalFlip temporal_;
+    std::map<double, View> views_;  ///< refinement views of the interval in hand (viewAt)
 };
 
 }  // namespace
