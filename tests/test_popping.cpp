@@ -233,3 +233,38 @@ TEST_CASE("popping: rounding is no event on a blob or a sphere (the precision fl
         for (double j : sheet.signal) CHECK(j < sheet.threshold);
     }
 }
+
+TEST_CASE("popping: events on one interval are refined through views rendered once",
+          "[popping]") {
+    // Frames by hand: every renderer's image is a ramp in the azimuth, the splatters' jump by
+    // 0.5 past 45.2 degrees, so both splatters have their event on [45, 45.5] and bisect
+    // through the same views; each view is rendered once for both.
+    const Volume geometry = makeSynthetic("phantom", 8);
+    RenderSettings s;
+    s.camera.width = s.camera.height = 8;
+    Sweep sweep;
+    sweep.base = s.camera;
+    PoppingOptions o;
+    o.refine = 4;
+    int frames = 0;
+    o.renderFrame = [&frames](const RenderSettings& f, RenderStats*) {
+        ++frames;
+        float v = 0.01f * float(f.camera.azimuthDeg);
+        if (f.renderer != RendererKind::Reference && f.camera.azimuthDeg > 45.2) v += 0.5f;
+        Image im(f.camera.width, f.camera.height);
+        for (glm::vec4& p : im.pixels) p = glm::vec4(v, v, v, 1.0f);
+        return im;
+    };
+    const PoppingResult r = analyzePopping(geometry, s, sweep, o);
+    REQUIRE(r.events.size() == 2);
+    for (const PoppingEvent& e : r.events) {
+        CHECK(e.renderer != RendererKind::Reference);
+        CHECK(e.angleFrom == 45.0);
+        CHECK(e.angleTo == 45.5);
+        CHECK(std::abs(e.refinedAngle - 45.2) <= e.refinedWidth);
+        CHECK(e.refinedJump == Approx(0.5).epsilon(1e-3));
+    }
+    CHECK(r.events[0].refinedAngle == r.events[1].refinedAngle);
+    // 21 sweep views and refine + 2 refinement views, each by the three renderers.
+    CHECK(frames == 21 * 3 + (o.refine + 2) * 3);
+}
