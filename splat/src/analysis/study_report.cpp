@@ -217,6 +217,10 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
     // CSV: one row per setting.
     std::vector<std::string> knobNames;
     for (const auto& k : r.options.sweeps) knobNames.push_back(k.name);
+    // The quality presets measured beside the sweep (StudyOptions::presets): their own column.
+    const bool presets = std::any_of(r.points.begin(), r.points.end(), isPresetPoint);
+    if (presets && std::find(knobNames.begin(), knobNames.end(), "quality") == knobNames.end())
+        knobNames.push_back("quality");
     std::ostringstream csv;
     for (const auto& k : knobNames) csv << k << ',';
     csv << "ms_median,ms_min,ms_max,ms_mad,peak_mib,splats,footprint_pixels,"
