@@ -29,9 +29,9 @@ RenderSettings settingsOf(const std::vector<std::pair<std::string, std::string>>
 bool sameQuality(const Quality& a, const Quality& b) {
     return a.slab == b.slab && a.earlyTermination == b.earlyTermination &&
            a.referenceStep == b.referenceStep && a.referenceTolerance == b.referenceTolerance &&
-           a.factorisedSheets == b.factorisedSheets && a.tileSize == b.tileSize &&
-           a.lod == b.lod && a.lodAuto == b.lodAuto && a.lodBrick == b.lodBrick &&
-           a.ewa == b.ewa && a.pixelFilter == b.pixelFilter;
+           a.factorisedSheets == b.factorisedSheets && a.tileSize == b.tileSize && a.lod == b.lod &&
+           a.lodAuto == b.lodAuto && a.lodBrick == b.lodBrick && a.ewa == b.ewa &&
+           a.pixelFilter == b.pixelFilter;
 }
 
 }  // namespace
@@ -109,7 +109,8 @@ TEST_CASE("options: the quality presets order the error against the reference",
     for (RendererKind renderer : {RendererKind::Axis, RendererKind::Sheet}) {
         double error[3];
         int at = 0;
-        for (QualityPreset p : {QualityPreset::Exact, QualityPreset::Default, QualityPreset::Fast}) {
+        for (QualityPreset p :
+             {QualityPreset::Exact, QualityPreset::Default, QualityPreset::Fast}) {
             RenderSettings s = base;
             s.renderer = renderer;
             applyQualityPreset(s, p);

@@ -77,11 +77,12 @@ void registerStudy(CLI::App& app) {
     addVolumeOptions(*cmd, a->volume);
     addRenderOptions(*cmd, a->render, false);
     const std::string st = "Study", out = "Output";
-    addOption(*cmd, "--sweep", a->sweeps,
-              "KNOB=V1,V2,... (repeatable): renderer, quality, slab, early-termination, size, order, "
-              "classify, kernel, sigma, radius, footprint-res, slab-radial-res, slab-depth-res, "
-              "poly-tol, lod, ewa, pixel-filter",
-              st);
+    addOption(
+        *cmd, "--sweep", a->sweeps,
+        "KNOB=V1,V2,... (repeatable): renderer, quality, slab, early-termination, size, order, "
+        "classify, kernel, sigma, radius, footprint-res, slab-radial-res, slab-depth-res, "
+        "poly-tol, lod, ewa, pixel-filter",
+        st);
     addOption(*cmd, "--repeats", a->repeats, "timed frames per setting and view", st);
     addOption(*cmd, "--warmup", a->warmup, "untimed frames before them", st);
     addOption(*cmd, "--views", a->views, "views AZ[:EL],... (default: the camera options)", st);

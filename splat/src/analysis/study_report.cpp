@@ -95,13 +95,13 @@ bool isPresetPoint(const StudyPoint& p) {
 std::string svgMark(const StudyPoint& p, double x, double y) {
     std::ostringstream s;
     if (isPresetPoint(p))
-        s << "<polygon points='" << x << ',' << y - 7 << ' ' << x + 7 << ',' << y << ' ' << x
-          << ',' << y + 7 << ' ' << x - 7 << ',' << y << "' fill='#2ca02c' stroke='black'>";
+        s << "<polygon points='" << x << ',' << y - 7 << ' ' << x + 7 << ',' << y << ' ' << x << ','
+          << y + 7 << ' ' << x - 7 << ',' << y << "' fill='#2ca02c' stroke='black'>";
     else
-        s << "<circle cx='" << x << "' cy='" << y << "' r='" << (p.pareto ? 5 : 3.5)
-          << "' fill='" << (p.pareto ? "#d62728" : "#1f77b4") << "'>";
-    s << "<title>" << xmlEscape(p.label()) << ": " << num(p.msMedian) << " ms, rmse "
-      << num(p.rmse) << "</title>" << (isPresetPoint(p) ? "</polygon>" : "</circle>") << '\n';
+        s << "<circle cx='" << x << "' cy='" << y << "' r='" << (p.pareto ? 5 : 3.5) << "' fill='"
+          << (p.pareto ? "#d62728" : "#1f77b4") << "'>";
+    s << "<title>" << xmlEscape(p.label()) << ": " << num(p.msMedian) << " ms, rmse " << num(p.rmse)
+      << "</title>" << (isPresetPoint(p) ? "</polygon>" : "</circle>") << '\n';
     return s.str();
 }
 
@@ -183,8 +183,13 @@ std::vector<unsigned char> plotPng(const StudyResult& r, const std::filesystem::
         if (!(p.msMedian > 0)) continue;
         const bool preset = isPresetPoint(p);
         const int x = int(ax.px(p.msMedian)), y = int(ax.py(p.rmse)),
-                  h = preset ? 5 : p.pareto ? 4 : 3;
-        IBA::render_box(buf, x - h, y - h, x + h, y + h, preset ? green : p.pareto ? red : blue,
+                  h = preset     ? 5
+                      : p.pareto ? 4
+                                 : 3;
+        IBA::render_box(buf, x - h, y - h, x + h, y + h,
+                        preset     ? green
+                        : p.pareto ? red
+                                   : blue,
                         true);
         if (preset) IBA::render_box(buf, x - h, y - h, x + h, y + h, black);
         if (p.pareto || preset) label(x + 7, y - 5, p.label(), 10);  // others: see study.csv
