@@ -50,7 +50,7 @@ TEST_CASE("mpi: study on 2 ranks measures what one process measures", "[.mpi]") 
                                         "--repeats", "1",
                                         "--warmup",  "0",
                                         "--report",  (dir / report).string(),
-                                        "-q"};
+                                        "--no-presets", "-q"};
     };
     fs::remove_all(dir / "one");
     fs::remove_all(dir / "np2");

@@ -15,6 +15,9 @@ packages=(build-essential cmake pkg-config libglm-dev libopenimageio-dev openima
 # (docs/building.md; Debian ships IceT only inside ParaView: paraview-dev, ~100 MB to
 # download, ~700 MB on disk). CI asks for it (.ci/run); a newcomer's setup does not.
 if [ "${SPLAT_WITH_ICET:-0}" = 1 ]; then packages+=(paraview-dev); fi
+# SPLAT_WITH_VTK=1 also installs VTK's Python bindings for the optional side-by-side benchmark
+# (tools/bench/vs_vtk.py, docs/performance.md); without them it is skipped.
+if [ "${SPLAT_WITH_VTK:-0}" = 1 ]; then packages+=(python3-vtk9); fi
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

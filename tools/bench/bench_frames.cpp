@@ -126,7 +126,9 @@ int renderRotation(const std::string& spec, const std::string& tf,
     splat::RenderSettings s = splat::renderSettingsFrom(
         values, splat::RenderUse{},
         [](const std::string& line) { std::cerr << "bench_frames: warning: " << line << '\n'; });
-    s.quality.factorisedSheets = factorised;
+    // Given, it wins over the frame design a --quality preset chose.
+    if (app.get_option("--factorised-sheets")->count() > 0)
+        s.quality.factorisedSheets = factorised;
     frames = std::max(1, frames);
     const double elevation = s.camera.elevationDeg;
     const bool warmup = warmupFlag != 0;

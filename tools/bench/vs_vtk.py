@@ -257,19 +257,22 @@ class Bench:
     def compare(self, a, b, size):
         return run_json([f"{self.bin}/bench_frames", "compare", a, b, str(size), str(size)])
 
-    def config(self, name, size, threads, renderer="axis", slab=1.0, vtk_step=1.0, lod="0"):
-        """One row: splat (renderer, slab, level of detail) and VTK (vtk_step voxels) on
-        `name` at size^2."""
+    def config(self, name, size, threads, renderer="axis", slab=1.0, vtk_step=1.0, lod="0",
+               quality="default"):
+        """One row: splat (renderer, slab, level of detail, --quality preset) and VTK
+        (vtk_step voxels) on `name` at size^2."""
         a = self.args
         spec, mha, info = self.volume(name, VOLUMES[name])
         frames, save = a.frames, a.error_frames
-        tag = f"{name}_{size}_{threads}_{renderer}_{slab}_{vtk_step}_{lod}".replace(":", "_")
+        tag = f"{name}_{size}_{threads}_{renderer}_{slab}_{vtk_step}_{lod}_{quality}".replace(
+            ":", "_")
+        preset = [] if quality == "default" else ["--quality", quality]
         splat_ms, vtk_ms, splat_runs = [], [], []
         vtk = Vtk(mha, info, size, threads)
         cameras = None
         for rnd in range(a.rounds):
             run = self.splat(spec, renderer, size, threads, frames, save if rnd == 0 else [],
-                             self.path(tag, "splat"), slab, lod)
+                             self.path(tag, "splat"), slab, lod, extra=preset)
             splat_runs.append(run)
             splat_ms += [f["ms"] for f in run["frames"]]
             cameras = run["frames"]
@@ -322,7 +325,7 @@ class Bench:
                  for s in ("project_ms", "order_ms", "bin_ms", "tiles_ms")}
         row = {
             "volume": name, "size": size, "threads": threads, "renderer": renderer,
-            "slab": slab, "lod": lod, "vtk_step": vtk_step, "frames": frames, "rounds": a.rounds,
+            "slab": slab, "lod": lod, "quality": quality, "vtk_step": vtk_step, "frames": frames, "rounds": a.rounds,
             "splat_ms": statistics.median(splat_ms), "vtk_ms": statistics.median(vtk_ms),
             "splat_rmse_frames": save if err_splat else [],
             "splat_rmse": statistics.mean(e["rmse"] for e in err_splat) if err_splat else None,
@@ -624,13 +627,18 @@ def refine_metaimage(src, dst, factor):
 def label(r):
     """A row's splat renderer as the tables name it."""
     rend = r["renderer"] if r["renderer"] == "axis" else f"{r['renderer']} slab {r['slab']:g}"
+    if r.get("quality", "default") != "default":  # the preset sets the slab itself
+        rend = f"{r['renderer']} --quality {r['quality']}"
     return rend + (f" lod {r['lod']}" if str(r.get("lod", "0")) != "0" else "")
 
 
-def plan(quick, lod_auto):
-    """(volume, size, threads, renderer, slab, VTK step, level of detail) per row."""
+def plan(quick, lod_auto, presets_only=False):
+    """(volume, size, threads, renderer, slab, VTK step, level of detail[, --quality]) per
+    row."""
     if quick:
-        return [("ch2", 256, 2, "axis", 1.0, 1.0, "0")]
+        return [("ch2", 256, 2, "axis", 1.0, 1.0, "0"), ("ch2", 256, 2, "axis", 1.0, 1.0, "0", "fast")]
+    if presets_only:
+        return [r for s in (256, 512) for r in preset_rows(s)]
     rows = [("ch2", s, 2, "axis", 1.0, 1.0) for s in (256, 512, 1024)]
     rows += [("ch2", 512, 2, "axis", 1.0, 0.5), ("ch2", 512, 2, "axis", 1.0, 0.25),
              ("ch2", 512, 2, "sheet", 1.0, 0.25),
@@ -642,7 +650,13 @@ def plan(quick, lod_auto):
     rows += [(v, s, 2, "axis", 1.0, 1.0, "1") for v, s in LOD_ROWS]
     if lod_auto:
         rows += [(v, s, 2, "axis", 1.0, 1.0, "auto") for v, s in LOD_AUTO_ROWS]
+    rows += [r for s in (256, 512) for r in preset_rows(s)[1:]]
     return rows
+
+
+def preset_rows(size):
+    """The --quality rows of ch2 at size^2: today's default and the fast preset, axis."""
+    return [("ch2", size, 2, "axis", 1.0, 1.0, "0"), ("ch2", size, 2, "axis", 1.0, 1.0, "0", "fast")]
 
 
 def fmt_rate(x):
@@ -860,6 +874,8 @@ def main():
     p.add_argument("--error-max-size", type=int, default=512,
                    help="largest image side whose splat error is measured (the reference ray "
                         "caster is slow; default 512)")
+    p.add_argument("--presets-only", action="store_true",
+                   help="only the --quality rows (ch2 at 256² and 512², default and fast)")
     p.add_argument("--no-sweep", action="store_true",
                    help="skip the popping sweep (ch2 0-90 degrees at 256^2, minutes)")
     p.add_argument("--no-filtered", action="store_true",
@@ -903,7 +919,8 @@ def main():
         bench.lod_auto = bench.supports_lod_auto()
         fills = [part("fill limit", bench.fill)]
         rows = part("splat and VTK", lambda: [bench.config(*row)
-                                              for row in plan(args.quick, bench.lod_auto)])
+                                              for row in plan(args.quick, bench.lod_auto,
+                                                              args.presets_only)])
         result = {"transfer_function": TF, "elevation": ELEVATION, "frames": args.frames,
                   "rounds": args.rounds, "error_frames": args.error_frames,
                   "error_max_size": args.error_max_size, "vtk_fine_step": VTK_FINE_STEP,

@@ -31,7 +31,7 @@ struct StudyCommand {
     int repeats = 5, warmup = 1;
     double truthStep = 0.125, truthTolerance = 1e-5, ppd = 67;
     std::string truth = "auto";
-    bool convergence = false, quiet = false, resume = false;
+    bool convergence = false, quiet = false, resume = false, noPresets = false;
 };
 
 std::vector<glm::dvec2> parseViews(const std::string& text) {
@@ -77,11 +77,12 @@ void registerStudy(CLI::App& app) {
     addVolumeOptions(*cmd, a->volume);
     addRenderOptions(*cmd, a->render, false);
     const std::string st = "Study", out = "Output";
-    addOption(*cmd, "--sweep", a->sweeps,
-              "KNOB=V1,V2,... (repeatable): renderer, slab, early-termination, size, order, "
-              "classify, kernel, sigma, radius, footprint-res, slab-radial-res, slab-depth-res, "
-              "poly-tol, lod, ewa, pixel-filter",
-              st);
+    addOption(
+        *cmd, "--sweep", a->sweeps,
+        "KNOB=V1,V2,... (repeatable): renderer, quality, slab, early-termination, size, order, "
+        "classify, kernel, sigma, radius, footprint-res, slab-radial-res, slab-depth-res, "
+        "poly-tol, lod, ewa, pixel-filter",
+        st);
     addOption(*cmd, "--repeats", a->repeats, "timed frames per setting and view", st);
     addOption(*cmd, "--warmup", a->warmup, "untimed frames before them", st);
     addOption(*cmd, "--views", a->views, "views AZ[:EL],... (default: the camera options)", st);
@@ -95,6 +96,10 @@ void registerStudy(CLI::App& app) {
               "voxel, or a pixel filter); default auto",
               st);
     addOption(*cmd, "--ppd", a->ppd, "LDR-FLIP pixels per degree", st);
+    addFlag(*cmd, "--no-presets", a->noPresets,
+            "do not measure the three --quality presets beside the sweep (by default they are "
+            "points of their own, marked on the plot)",
+            st);
     addFlag(*cmd, "--convergence", a->convergence,
             "also fit the observed convergence orders (slab, reference step, pixel size)", st);
     addOption(*cmd, "--report", a->report,
@@ -134,6 +139,7 @@ void registerStudy(CLI::App& app) {
         o.referenceStep = a->truthStep;
         o.referenceTolerance = a->truthTolerance;
         o.pixelsPerDegree = a->ppd;
+        o.presets = !a->noPresets;
         if (workerProcess())  // under mpirun: render the references rank 0 asks for (parallel.h)
             return serveFrames([&] {
                 auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));

@@ -168,6 +168,24 @@ std::pair<double, bool> parseIsoLevel(const std::string& text);
 /// "1,2,3" -> {1, 2, 3}; throws OptionError naming `what` (also for NaN and infinities).
 std::vector<double> parseNumbers(const std::string& text, const std::string& what);
 
+// ---- the quality preset ---------------------------------------------------------------
+
+/// `--quality`: one knob that sets the others (docs/speed-vs-accuracy.md "Quality presets").
+/// Fast: the speed a user who accepts VTK's accuracy gets; Default: the option table's
+/// defaults (today's images, bit for bit); Exact: the converged end of every knob.
+enum class QualityPreset { Fast, Default, Exact };
+const char* toString(QualityPreset);
+/// "fast" | "default" | "exact"; throws OptionError listing them otherwise.
+QualityPreset parseQualityPreset(std::string_view name);
+/// The options a preset sets, by long name (the knobs of applyQualityPreset that have one).
+const std::vector<std::string_view>& qualityPresetOptions();
+/// Sets every knob the preset decides, except the options named in `keep` (those given
+/// beside `--quality`: on the command line, as Python keywords, or in a scene file with a
+/// value other than the default), which stay as they are in `s`. The one place that says
+/// what each preset is.
+void applyQualityPreset(RenderSettings& s, QualityPreset preset,
+                        const std::vector<std::string_view>& keep = {});
+
 // ---- volume options ------------------------------------------------------------------
 
 /// "3" -> 3: a time step, an integer from 0; throws OptionError naming `what` otherwise.

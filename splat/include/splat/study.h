@@ -9,7 +9,8 @@
 // the pixel size shrink.
 //
 // Knobs (names as on the command line, `--sweep NAME=V1,V2,...`):
-//   per frame (one Scene serves them):  renderer, slab, early-termination, size (WxH or N),
+//   per frame (one Scene serves them):  renderer, quality (fast|default|exact: the preset's
+//                                       knobs), slab, early-termination, size (WxH or N),
 //                                       order, lod, ewa (off|on|auto), pixel-filter (the
 //                                       reference is filtered through it too)
 //   per Scene (a new Scene per value):  classify, kernel, sigma, radius, footprint-res,
@@ -63,6 +64,10 @@ struct StudyOptions {
     /// e.g. xray below a pixel per voxel, or a pixel filter given), else the point-sampled
     /// one; point always at the pixel centres; filtered always through the pixel filter.
     Truth truth = Truth::Auto;
+    /// Also measure the three quality presets (`--quality`, splat/options.h) on the base
+    /// settings, as the points quality=fast, quality=default and quality=exact (the report's
+    /// plot marks them), unless a sweep varies quality itself.
+    bool presets = false;
 };
 
 /// One setting of the study.

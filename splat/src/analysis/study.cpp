@@ -306,6 +306,14 @@ std::vector<Combo> studyCombinations(const RenderSettings& base,
     return combos;
 }
 
+/// The quality presets as points of their own (StudyOptions::presets), after the sweep's.
+void appendPresetCombinations(std::vector<Combo>& combos, const std::vector<StudyKnob>& sweeps) {
+    for (const StudyKnob& k : sweeps)
+        if (k.name == "quality") return;
+    for (QualityPreset p : {QualityPreset::Fast, QualityPreset::Default, QualityPreset::Exact})
+        combos.push_back({{"quality", toString(p)}});
+}
+
 /// The study's views: the base camera, or one per (azimuth, elevation) asked for.
 std::vector<CameraParams> studyViews(const RenderSettings& base, const StudyOptions& options) {
     if (options.views.empty()) return {base.camera};
@@ -491,6 +499,7 @@ RenderSettings frameOf(const Scene& scene, const RenderSettings& s) {
     frame.threads = s.threads;
     frame.quality.slab = s.quality.slab;
     frame.quality.earlyTermination = s.quality.earlyTermination;
+    frame.quality.factorisedSheets = s.quality.factorisedSheets;
     frame.quality.referenceStep = s.quality.referenceStep;
     frame.quality.referenceTolerance = s.quality.referenceTolerance;
     frame.quality.tileSize = s.quality.tileSize;
@@ -613,7 +622,8 @@ StudyResult runStudy(std::shared_ptr<const Volume> volume, const RenderSettings&
     result.flipAvailable = true;
 #endif
     for (const auto& k : options.sweeps) (void)parseKnob(k.name + "=" + k.values.front());
-    const std::vector<Combo> combos = studyCombinations(base, options.sweeps);
+    std::vector<Combo> combos = studyCombinations(base, options.sweeps);
+    if (options.presets) appendPresetCombinations(combos, options.sweeps);
     const std::vector<CameraParams> views = studyViews(base, options);
     Progress progress(options.progress,
                       combos.size() * views.size() * std::size_t(options.repeats + options.warmup));

@@ -84,6 +84,27 @@ std::vector<const StudyPoint*> frontOf(const std::vector<StudyPoint>& pts) {
     return f;
 }
 
+/// A point of a quality preset (`--quality`), marked on the plot and always named.
+bool isPresetPoint(const StudyPoint& p) {
+    for (const auto& [knob, value] : p.knobs)
+        if (knob == "quality") return true;
+    return false;
+}
+
+/// The SVG mark of a point: a green diamond for a preset, else a dot (red on the front).
+std::string svgMark(const StudyPoint& p, double x, double y) {
+    std::ostringstream s;
+    if (isPresetPoint(p))
+        s << "<polygon points='" << x << ',' << y - 7 << ' ' << x + 7 << ',' << y << ' ' << x << ','
+          << y + 7 << ' ' << x - 7 << ',' << y << "' fill='#2ca02c' stroke='black'>";
+    else
+        s << "<circle cx='" << x << "' cy='" << y << "' r='" << (p.pareto ? 5 : 3.5) << "' fill='"
+          << (p.pareto ? "#d62728" : "#1f77b4") << "'>";
+    s << "<title>" << xmlEscape(p.label()) << ": " << num(p.msMedian) << " ms, rmse " << num(p.rmse)
+      << "</title>" << (isPresetPoint(p) ? "</polygon>" : "</circle>") << '\n';
+    return s.str();
+}
+
 std::string svgPlot(const StudyResult& r) {
     const Axes ax = Axes::of(r.points);
     std::ostringstream s;
@@ -118,10 +139,8 @@ std::string svgPlot(const StudyResult& r) {
     for (const auto& p : r.points) {
         if (!(p.msMedian > 0)) continue;
         const double x = ax.px(p.msMedian), y = ax.py(p.rmse);
-        s << "<circle cx='" << x << "' cy='" << y << "' r='" << (p.pareto ? 5 : 3.5) << "' fill='"
-          << (p.pareto ? "#d62728" : "#1f77b4") << "'><title>" << xmlEscape(p.label()) << ": "
-          << num(p.msMedian) << " ms, rmse " << num(p.rmse) << "</title></circle>\n";
-        if (p.pareto)  // the others are named by their tooltips and in study.csv
+        s << svgMark(p, x, y);
+        if (p.pareto || isPresetPoint(p))  // the others: named by tooltips and in study.csv
             s << "<text x='" << x + 7 << "' y='" << y - 5 << "' font-size='10' fill='#444'>"
               << xmlEscape(p.label()) << "</text>\n";
     }
@@ -134,7 +153,8 @@ std::vector<unsigned char> plotPng(const StudyResult& r, const std::filesystem::
     const Axes ax = Axes::of(r.points);
     OIIO::ImageBuf buf(OIIO::ImageSpec(int(ax.width), int(ax.height), 3, OIIO::TypeDesc::UINT8));
     const float white[] = {1, 1, 1}, grid[] = {0.87f, 0.87f, 0.87f}, black[] = {0, 0, 0};
-    const float red[] = {0.84f, 0.15f, 0.16f}, blue[] = {0.12f, 0.47f, 0.71f};
+    const float red[] = {0.84f, 0.15f, 0.16f}, blue[] = {0.12f, 0.47f, 0.71f},
+                green[] = {0.17f, 0.63f, 0.17f};
     IBA::fill(buf, white);
     const std::string font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
     const bool text = std::filesystem::exists(font);
@@ -161,9 +181,18 @@ std::vector<unsigned char> plotPng(const StudyResult& r, const std::filesystem::
                          int(ax.px(front[i + 1]->msMedian)), int(ax.py(front[i + 1]->rmse)), red);
     for (const auto& p : r.points) {
         if (!(p.msMedian > 0)) continue;
-        const int x = int(ax.px(p.msMedian)), y = int(ax.py(p.rmse)), h = p.pareto ? 4 : 3;
-        IBA::render_box(buf, x - h, y - h, x + h, y + h, p.pareto ? red : blue, true);
-        if (p.pareto) label(x + 7, y - 5, p.label(), 10);  // the others: see study.csv
+        const bool preset = isPresetPoint(p);
+        const int x = int(ax.px(p.msMedian)), y = int(ax.py(p.rmse)),
+                  h = preset     ? 5
+                      : p.pareto ? 4
+                                 : 3;
+        IBA::render_box(buf, x - h, y - h, x + h, y + h,
+                        preset     ? green
+                        : p.pareto ? red
+                                   : blue,
+                        true);
+        if (preset) IBA::render_box(buf, x - h, y - h, x + h, y + h, black);
+        if (p.pareto || preset) label(x + 7, y - 5, p.label(), 10);  // others: see study.csv
     }
     // Encoded in memory; written with the other report files by the checked atomic writer.
     std::vector<float> px(std::size_t(ax.width) * std::size_t(ax.height) * 3);
@@ -193,6 +222,10 @@ void writeStudyReport(const StudyResult& r, const std::string& dir,
     // CSV: one row per setting.
     std::vector<std::string> knobNames;
     for (const auto& k : r.options.sweeps) knobNames.push_back(k.name);
+    // The quality presets measured beside the sweep (StudyOptions::presets): their own column.
+    const bool presets = std::any_of(r.points.begin(), r.points.end(), isPresetPoint);
+    if (presets && std::find(knobNames.begin(), knobNames.end(), "quality") == knobNames.end())
+        knobNames.push_back("quality");
     std::ostringstream csv;
     for (const auto& k : knobNames) csv << k << ',';
     csv << "ms_median,ms_min,ms_max,ms_mad,peak_mib,splats,footprint_pixels,"

@@ -222,6 +222,11 @@ std::vector<OptionSpec> makeTable() {
         {"background", T::Text, "0,0,0,0", "background R,G,B[,A] in [0, 1]", kRen, kFrame, R},
         {"shade", T::Flag, "", "Blinn-Phong shading from the density gradient (dvr, iso)", kRen,
          kScene, R, P::None, ignoredShade},
+        {"quality", T::Text, "default",
+         "fast | default | exact: sets early-termination, slab, ref-step, ref-tolerance and "
+         "the axis-aligned frame design together (fast: about VTK's accuracy; exact: the "
+         "converged end); those options given beside it win",
+         kQ, kFrame, R},
         {"slab", T::Real, "1", "sheet renderer: slab thickness, voxels", kQ, kFrame, R, P::None,
          ignoredSlab},
         {"early-termination", T::Real, "0.00390625",
@@ -364,6 +369,7 @@ const OptionSpec* findOption(std::string_view name) {
 
 const std::vector<std::string_view>& studyKnobs() {
     static const std::vector<std::string_view> knobs = {"renderer",
+                                                        "quality",
                                                         "slab",
                                                         "early-termination",
                                                         "size",

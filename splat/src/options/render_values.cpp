@@ -169,6 +169,21 @@ void parseQuality(const OptionValues& v, RenderSettings& s) {
     q.polynomialTolerance = tolerance;
 }
 
+// An option given beside --quality wins: on the command line or as a Python keyword, or in a
+// scene file with a value other than its default (written scenes hold every option).
+bool givenBesidePreset(const OptionValues& v, std::string_view name) {
+    return v.has(name) && v.given(name) && !(v.fromScene(name) && !v.differsFromDefault(name));
+}
+
+void applyQualityChoice(const OptionValues& v, RenderSettings& s) {
+    QualityPreset preset = QualityPreset::Default;
+    if (v.has("quality")) preset = parseQualityPreset(v.text("quality"));
+    std::vector<std::string_view> keep;
+    for (std::string_view name : qualityPresetOptions())
+        if (givenBesidePreset(v, name)) keep.push_back(name);
+    applyQualityPreset(s, preset, keep);
+}
+
 void parseShading(const OptionValues& v, RenderSettings& s) {
     Shading& sh = s.shading;
     const double ambient = v.real("ambient"), diffuse = v.real("diffuse"),
@@ -384,6 +399,7 @@ RenderSettings parseRenderOptions(const OptionValues& v) {
     parseCamera(v, s);
     parseKernelAndColours(v, s);
     parseQuality(v, s);
+    applyQualityChoice(v, s);
     parseShading(v, s);
     parseEdgesAndClipping(v, s);
     checkLabelsAndOutput(v);
@@ -413,6 +429,8 @@ void applyOption(RenderSettings& s, std::string_view name, const std::string& te
         s.kernelSigma = p.kernelSigma;
     else if (name == "radius")
         s.kernelRadius = p.kernelRadius;
+    else if (name == "quality")
+        applyQualityPreset(s, parseQualityPreset(text));
     else if (name == "slab")
         q.slab = pq.slab;
     else if (name == "early-termination")
