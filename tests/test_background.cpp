@@ -225,7 +225,7 @@ TEST_CASE("background: clipping and level of detail cut and merge to b", "[backg
         INFO(name(r) << " lod");
         RenderSettings s = settingsFor(r, RenderMode::Mip);
         s.camera.width = s.camera.height = 12;  // voxels smaller than pixels: a coarser level
-        s.quality.lod = 4;
+        s.quality.lod = LevelOfDetail::threshold(4);
         RenderStats st;
         const Image a = render(hu, s, &st);
         CHECK(st.lodLevel > 0);

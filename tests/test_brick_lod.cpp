@@ -105,7 +105,7 @@ TEST_CASE("brick lod: smooth bricks go coarse, detailed bricks stay fine, within
         }
     // The frame mixes the two levels: the splats of level 0 are those of the level-0 bricks.
     RenderSettings f = s;
-    f.quality.lodBrick = true;
+    f.quality.lod = LevelOfDetail::perBrick();
     RenderStats st;
     const Image mixed = scene.render(f, &st);
     REQUIRE(st.lodLevelSplats.size() == 2);
@@ -150,7 +150,7 @@ TEST_CASE("brick lod: where every brick takes one level the frame is that level'
     // part is copied): the same image as a frame of that level alone.
     const Volume v = halfConstantHalfNoise(1.0f, 0.0f, 0.0f);
     RenderSettings s = xrayView(3.0, 36);
-    s.quality.lodBrick = true;
+    s.quality.lod = LevelOfDetail::perBrick();
     const Scene scene(v, s);
     const Camera camera(s.camera, v);
     const Scene::Impl& impl = scene.impl();
@@ -209,7 +209,7 @@ TEST_CASE("brick lod: perspective, near bricks fine and far bricks coarse", "[lo
     // The whole rule (detail and seams) may keep the far blob finer; the frame stays the
     // full splatter's.
     RenderSettings f = s;
-    f.quality.lodBrick = true;
+    f.quality.lod = LevelOfDetail::perBrick();
     RenderStats st;
     const Image mixed = scene.render(f, &st);
     REQUIRE(!st.lodLevelSplats.empty());
@@ -239,7 +239,7 @@ TEST_CASE("brick lod: a background value b != 0 (a CT in HU): background bricks 
     // renders the same image.
     const Volume air = blobAndNoise(-1000.0f), up = blobAndNoise(0.0f);
     RenderSettings s = xrayView(3.0, 40);
-    s.quality.lodBrick = true;
+    s.quality.lod = LevelOfDetail::perBrick();
     const Scene a(air, s), b(up, s);
     const BrickDetail& d = a.impl().brickDetail();
     CHECK(d.occupied[d.brick(50, 16, 16)] == 0);  // air: no splat
@@ -255,7 +255,7 @@ TEST_CASE("brick lod: a background value b != 0 (a CT in HU): background bricks 
     CHECK(compareImages(ia, ib).maxAbs <= 1e-3 * peak);
     // Mass kept against full resolution (with EWA, as the merged levels are low-passed).
     RenderSettings full = s;
-    full.quality.lodBrick = false;
+    full.quality.lod = LevelOfDetail{};
     full.quality.ewa = Ewa::On;
     const Image i0 = a.render(full);
     CHECK(imageSum(ia) == Approx(imageSum(i0)).epsilon(1e-4));
@@ -270,7 +270,7 @@ TEST_CASE("brick lod: a seam through the field costs what the seam rule keeps ou
     // the mass is the same.
     const Volume v = halfConstantHalfNoise(1.0f, 0.0f, 0.0f);
     RenderSettings s = xrayView(3.0, 36);
-    s.quality.lodBrick = true;
+    s.quality.lod = LevelOfDetail::perBrick();
     const Scene scene(v, s);
     const Scene::Impl& impl = scene.impl();
     const BrickDetail& d = impl.brickDetail();
@@ -287,7 +287,7 @@ TEST_CASE("brick lod: a seam through the field costs what the seam rule keeps ou
     // A frame merging under a tenth of level 0 is level 0 (no copy of the rest).
     CHECK(impl.lodParts(one).size() == 1);
     RenderSettings e = s;
-    e.quality.lodBrick = false;
+    e.quality.lod = LevelOfDetail{};
     e.quality.ewa = Ewa::On;
     const Image at1 = renderFrame(at1Part, s, nullptr, nullptr),
                 at0 = renderFrame(at0Part, e, nullptr, nullptr);

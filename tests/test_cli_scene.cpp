@@ -242,3 +242,31 @@ TEST_CASE("iso levels: absolute levels and fractions of the range ending in n", 
     CHECK(samePixels(render("", "d.exr"), render("100", "h.exr")));
     CHECK(!samePixels(render("0.4n", "n2.exr"), render("0.4", "abs.exr")));
 }
+
+TEST_CASE("a scene file as VOLUME, and a Gaussian scene as a scene's input", "[cli][scene]") {
+    const fs::path dir = testTmpDir("scene_gaussians");
+    const fs::path a = dir / "a.png", b = dir / "b.png", c = dir / "c.png";
+    const fs::path scene = dir / "g.json";
+    REQUIRE(runSplat({"render", "gaussians:pop", "--size", "24x16", "--azimuth", "20", "-o",
+                      a.string(), "--write-scene", scene.string()})
+                .status == 0);
+    std::ifstream in(scene);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    // A generated input names no file: written as given, not made absolute.
+    CHECK(j["volume"]["path"] == "gaussians:pop");
+    const RunResult r = runSplat({"render", "--scene", scene.string(), "-o", b.string()});
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(samePixels(a, b));
+    // `splat render scene.json` is `splat render --scene scene.json`.
+    const RunResult s = runSplat({"render", scene.string(), "-o", c.string()});
+    INFO(s.err);
+    REQUIRE(s.status == 0);
+    CHECK(samePixels(a, c));
+    // A scene without "volume" still says what is missing.
+    const fs::path empty = dir / "empty.json";
+    std::ofstream(empty) << R"({"command": "render", "size": "8x8"})";
+    const RunResult e = runSplat({"render", empty.string(), "-o", c.string()});
+    CHECK(e.status == 2);
+    CHECK(e.err.find("needs VOLUME") != std::string::npos);
+}

@@ -173,7 +173,7 @@ TEST_CASE("lod: the 2x level of a 5x3x7 volume averages each cell, odd edges inc
             f.camera.pixelSize = pixel;
             f.camera.azimuthDeg = 33;
             f.camera.elevationDeg = 21;
-            f.quality.lod = 64;
+            f.quality.lod = LevelOfDetail::threshold(64);
             RenderStats st;
             const Image im = scene.render(f, &st);
             CHECK(st.lodLevel >= 1);
@@ -208,7 +208,7 @@ TEST_CASE("lod: X-ray of a constant box keeps its line integrals and its mass", 
         f.camera.azimuthDeg = az;
         RenderStats st0, st1;
         const Image x0 = scene.render(f, &st0);
-        f.quality.lod = 1.5;
+        f.quality.lod = LevelOfDetail::threshold(1.5);
         const Image x1 = scene.render(f, &st1);
         REQUIRE(st0.lodLevel == 0);
         REQUIRE(st1.lodLevel == 1);
@@ -261,7 +261,7 @@ TEST_CASE("lod: dvr of a constant semi-transparent box through the 2x level", "[
     RenderStats st0, st1;
     const Image i0 = scene.render(s, &st0);
     RenderSettings f = s;
-    f.quality.lod = 1.5;
+    f.quality.lod = LevelOfDetail::threshold(1.5);
     const Image i1 = scene.render(f, &st1);
     REQUIRE(st1.lodLevel == 1);
     const Camera cam(s.camera, v);
@@ -305,7 +305,8 @@ TEST_CASE("lod: X-ray and MIP at level 1 are the full splatter of the box-filter
             s.camera.azimuthDeg = 27;
             s.camera.elevationDeg = 14;
             RenderSettings f = s;
-            f.quality.lod = 1;  // 32^3 at 40^2: a voxel covers 0.72 pixels
+            f.quality.lod =
+                LevelOfDetail::threshold(1);  // 32^3 at 40^2: a voxel covers 0.72 pixels
             RenderStats st;
             const Image lod = Scene(v, s).render(f, &st);
             REQUIRE(st.lodLevel == 1);
@@ -334,7 +335,7 @@ TEST_CASE("lod: a level is used only while a voxel covers fewer pixels than the 
             CHECK(off.lodLevel == 0);
             CHECK(off.lodSplats == off.splats);
             for (double lod : {0.5, 1.0, 2.0, 4.0, 64.0}) {
-                f.quality.lod = lod;
+                f.quality.lod = LevelOfDetail::threshold(lod);
                 RenderStats st;
                 const Image im = scene.render(f, &st);
                 // Smallest L with (1 / pixel) 2^L >= lod, at most the 1^3 level (5 for 32^3).
@@ -363,7 +364,7 @@ TEST_CASE("lod: a level is used only while a voxel covers fewer pixels than the 
         48.0 / (2.0 * std::tan(M_PI / 12) * pc.focal) * pc.focal / (pc.focal - pc.boundingRadius);
     REQUIRE(near == Approx(1.13).epsilon(0.01));
     for (const auto& [lod, expected] : {std::pair{1.0, 0}, {1.2, 1}, {2.2, 1}, {2.3, 2}}) {
-        p.quality.lod = lod;
+        p.quality.lod = LevelOfDetail::threshold(lod);
         RenderStats st;
         scene.render(p, &st);
         INFO("perspective, lod " << lod);
@@ -371,7 +372,7 @@ TEST_CASE("lod: a level is used only while a voxel covers fewer pixels than the 
     }
     // The eye inside the volume: every voxel may be large; the full level (the exact path).
     p.camera.distance = 5;
-    p.quality.lod = 64;
+    p.quality.lod = LevelOfDetail::threshold(64);
     RenderStats inside;
     scene.render(p, &inside);
     CHECK(inside.lodLevel == 0);
@@ -382,17 +383,17 @@ TEST_CASE("lod: a level is used only while a voxel covers fewer pixels than the 
     r.camera.width = r.camera.height = 12;
     RenderStats a, b;
     const Image ra = scene.render(r, &a);
-    r.quality.lod = 64;
+    r.quality.lod = LevelOfDetail::threshold(64);
     const Image rb = scene.render(r, &b);
     CHECK(ra.pixels == rb.pixels);
     CHECK(b.lodLevel == 0);
     // Out of range: an error, not a silent clamp.
     RenderSettings bad = s;
-    bad.quality.lod = -1;
+    bad.quality.lod = LevelOfDetail::threshold(-1);
     CHECK_THROWS_AS(scene.render(bad), Error);
-    bad.quality.lod = NAN;
+    bad.quality.lod = LevelOfDetail::threshold(NAN);
     CHECK_THROWS_AS(scene.render(bad), Error);
-    bad.quality.lod = 65;
+    bad.quality.lod = LevelOfDetail::threshold(65);
     CHECK_THROWS_AS(scene.render(bad), Error);
 }
 
@@ -409,7 +410,7 @@ TEST_CASE("lod: dvr at level 1 against the reference (the measured cost of the k
     const Image ref = scene.render(r);
     RenderSettings f = s;
     const double full = compareImages(scene.render(f), ref).rmse;
-    f.quality.lod = 1;
+    f.quality.lod = LevelOfDetail::threshold(1);
     RenderStats st;
     const double lod = compareImages(scene.render(f, &st), ref).rmse;
     REQUIRE(st.lodLevel == 1);
@@ -570,13 +571,12 @@ TEST_CASE("lod auto: X-ray of a Gaussian blob at level 1 is the filtered closed 
         const double e0 = worst(scene.render(f, &st0), sum0);
         REQUIRE(st0.lodLevel == 0);
         f.quality.ewa = Ewa::Off;  // auto low-passes a merged level itself
-        f.quality.lodAuto = true;
+        f.quality.lod = LevelOfDetail::automatic();
         const double e1 = worst(scene.render(f, &st1), sum1);
         REQUIRE(st1.lodLevel == 1);
         CHECK(st1.ewaSigma == sigma);
         // Numeric --lod at level 1: the doubled kernel, variance 4 + 0.25 instead of 1 - 0.25.
-        f.quality.lodAuto = false;
-        f.quality.lod = 1;
+        f.quality.lod = LevelOfDetail::threshold(1);
         f.quality.ewa = Ewa::On;
         const double eOld = worst(scene.render(f, &stOld), sumOld);
         REQUIRE(stOld.lodLevel == 1);
@@ -622,7 +622,7 @@ TEST_CASE("lod auto: a constant slab at level 1 equals full resolution inside", 
         f.quality.ewa = Ewa::On;
         const Image i0 = scene.render(f);
         f.quality.ewa = Ewa::Off;
-        f.quality.lodAuto = true;
+        f.quality.lod = LevelOfDetail::automatic();
         RenderStats st;
         const Image i1 = scene.render(f, &st);
         REQUIRE(st.lodLevel == 1);
@@ -676,7 +676,7 @@ TEST_CASE("lod auto: deterministic, thread-count invariant, and lod 0 where it k
                     if (fov > 0) f.camera.distance = 8.0 * 32 * pixel;
                     f.threads = 1;
                     const Image off = scene.render(f);
-                    f.quality.lodAuto = true;
+                    f.quality.lod = LevelOfDetail::automatic();
                     RenderStats st1, st3, again;
                     const Image one = scene.render(f, &st1);
                     f.threads = 3;

@@ -9,6 +9,7 @@
 
 #include "cli_util.h"
 #include "splat/options.h"
+#include "splat/scene_file.h"
 
 using namespace splat;
 using namespace splat::test;
@@ -162,11 +163,24 @@ TEST_CASE("flag, scene key and library accept and refuse the same values alike",
             fromScene.insert(fromScene.end(), {"--scene", scene});
             const RunResult a = runSplat(flag), b = runSplat(fromScene);
             INFO(a.err << b.err);
+            // The library's reading of the scene file (what Python's splat.load_scene and
+            // splat.render_scene call) says what the command line's --scene says.
+            std::string sceneVerdict;
+            try {
+                const SceneFile file = readSceneFile(scene);
+                REQUIRE(file.entries.size() == 1);
+                REQUIRE(file.entries[0].texts.size() == 1);
+                sceneVerdict = libraryVerdict(o, file.entries[0].texts[0]);
+            } catch (const Error& e) {
+                sceneVerdict = e.what();
+            }
             if (verdict.empty()) {
                 CHECK(a.status == 0);
                 CHECK(b.status == 0);
+                CHECK(sceneVerdict.empty());
                 continue;
             }
+            CHECK(lastErrorLine(b) == "splat: error: " + sceneVerdict);
             ++refused;
             CHECK(a.status == b.status);
             CHECK(a.status != 0);

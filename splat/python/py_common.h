@@ -109,6 +109,17 @@ OptionTableRows renderOptionTable();
 Volume loadWithOptions(const std::string& spec, const Keywords& keywords);
 OptionTableRows loadOptionTable();
 OptionTableRows poppingOptionTable();
+/// A scene file read by the library (splat/scene_file.h): its command; (keyword, texts, object
+/// JSON) per option of the table and "volume"; the keys of other commands.
+using SceneRows =
+    std::tuple<std::string,
+               std::vector<std::tuple<std::string, std::vector<std::string>, std::string>>,
+               std::vector<std::string>>;
+SceneRows readScene(const std::string& path);
+/// Writes a scene file: "volume", and every option of `command`'s sets at the keywords' values
+/// (checked as the flags are) or its default; `tfJson`: an inline transfer function.
+void writeScene(const std::string& path, const std::string& command, const std::string& volume,
+                const Keywords& keywords, const std::string& tfJson);
 
 /// The project's JSON text of a transfer function (py_transfer.cpp).
 std::string transferJson(const TransferFunction& tf);

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "py_common.h"
+#include "splat/scene_file.h"
 
 namespace splat::python {
 
@@ -81,5 +82,54 @@ Volume loadWithOptions(const std::string& spec, const Keywords& keywords) {
 OptionTableRows loadOptionTable() { return tableOf(kVolumeOptions); }
 
 OptionTableRows poppingOptionTable() { return tableOf(kSweepOptions); }
+
+SceneRows readScene(const std::string& path) {
+    SceneFile scene;
+    try {
+        scene = readSceneFile(path);
+    } catch (const OptionError&) {
+        throw;
+    } catch (const Error& e) {
+        rethrowFileError(e, path, true);
+    }
+    SceneRows rows;
+    std::get<0>(rows) = scene.command;
+    for (const SceneEntry& e : scene.entries)
+        std::get<1>(rows).emplace_back(e.key == "volume" ? e.key : keywordOf(e.key), e.texts,
+                                       e.object);
+    std::get<2>(rows) = scene.otherKeys;
+    return rows;
+}
+
+void writeScene(const std::string& path, const std::string& command, const std::string& volume,
+                const Keywords& keywords, const std::string& tfJson) {
+    const unsigned sets = command == "render"    ? kVolumeOptions | kRenderOptions | kImageOptions
+                          : command == "popping" ? kVolumeOptions | kRenderOptions | kSweepOptions
+                                                 : kVolumeOptions | kRenderOptions;
+    const OptionValues values = valuesOf(sets, keywords);
+    std::vector<std::pair<std::string, std::string>> scene;
+    scene.emplace_back("volume", sceneValueJson("volume", *tableSceneKey("volume"), {volume}));
+    for (const OptionSpec* spec : values.specs()) {
+        const std::string name(spec->name);
+        if (name == "tf" && !tfJson.empty()) {
+            scene.emplace_back(name, tfJson);
+            continue;
+        }
+        const SceneKey how = *tableSceneKey(name);
+        std::vector<std::string> texts;
+        if (spec->type == OptionType::TextList)
+            texts = values.list(name);
+        else if (spec->type == OptionType::Flag)
+            texts = {values.flag(name) ? "true" : "false"};
+        else
+            texts = {values.text(name)};
+        scene.emplace_back(name, sceneValueJson(name, how, texts));
+    }
+    try {
+        writeSceneFile(path, command, scene);
+    } catch (const Error& e) {
+        rethrowFileError(e, path, false);
+    }
+}
 
 }  // namespace splat::python

@@ -92,6 +92,11 @@ void bindRender(py::module_& m) {
         py::arg("volume"), py::arg("options"), py::arg("tf_json"), py::arg("progress"),
         py::arg("return_stats"));
     m.def("_render_options", &renderOptionTable);
+    m.def("_read_scene", &readScene, py::arg("path"),
+          "A scene file read by the library: (command, [(keyword, texts, object_json)], "
+          "other_keys).");
+    m.def("_write_scene", &writeScene, py::arg("path"), py::arg("command"), py::arg("volume"),
+          py::arg("options"), py::arg("tf_json"), "Writes a scene file by the library.");
     m.def(
         "_zarr_level",
         [](const std::string& path, const Keywords& options, const std::string& tfJson) {

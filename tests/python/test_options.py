@@ -1,10 +1,13 @@
-# The option table (splat/options.h) from Python: every keyword accepts and refuses the values
-# its command-line flag does, with the same one-line message; and the extension links the
-# library alone (no MPI, no IceT, no command-line code).
+# The option table (splat/options.h) from Python: every keyword and every scene-file key read
+# through the extension accepts and refuses the values its command-line flag does, with the same
+# one-line message; and the extension links the library alone (no MPI, no IceT, no command-line
+# code).
+import json
 import shutil
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import splat
@@ -58,6 +61,50 @@ def test_keywords_accept_and_refuse_like_the_flags(cli, tmp):
             assert p.returncode != 0, where
             assert p.stderr.strip().splitlines()[-1] == "splat: error: " + error, where
     assert refused > 40
+
+
+def test_scene_keys_read_by_the_extension_say_what_the_command_line_says(cli, tmp):
+    out = tmp / "x.exr"
+    scene = tmp / "scene.json"
+    refused = 0
+    for name, kind, default, option_set, is_path in _splat._option_specs():
+        if option_set not in ("volume", "render"):
+            continue
+        for value in trial_values(kind, default, is_path):
+            keys = {"command": "render", "volume": SPEC, name: value}
+            if name != "size":
+                keys["size"] = "8x8"
+            scene.write_text(json.dumps(keys))
+            try:
+                splat.render_scene(scene)
+                continue  # accepted: tests/test_options.cpp runs the library's reading
+                # against the command line's
+            except splat.Error as e:
+                error = str(e)
+            p = cli("render", "--scene", scene, "-o", out, check=False)
+            where = f"{name}: {value!r}: {p.stderr}"
+            refused += 1
+            assert p.returncode != 0, where
+            assert p.stderr.strip().splitlines()[-1] == "splat: error: " + error, where
+    assert refused > 40
+
+
+def test_scenes_written_from_python_read_back(tmp):
+    path = tmp / "view.json"
+    splat.save_scene(path, SPEC, size=(16, 12), azimuth=30, shade=True, tf="ct-bone")
+    written = json.loads(path.read_text())
+    assert written["command"] == "render"
+    assert written["volume"]["path"] == SPEC
+    assert written["size"] == [16, 12] and written["azimuth"] == 30 and written["shade"] is True
+    scene = splat.load_scene(path)
+    assert scene["volume"] == SPEC and scene["size"] == "16x12" and scene["shade"] is True
+    image = splat.render_scene(path)
+    direct = splat.render(splat.load(SPEC), size=(16, 12), azimuth=30, shade=True, tf="ct-bone")
+    assert np.array_equal(image, direct)
+    # Keywords override the scene's keys, as flags do.
+    assert splat.render_scene(path, size=(8, 8)).shape == (8, 8, 4)
+    with pytest.raises(splat.InputError, match="--slab"):
+        splat.save_scene(path, SPEC, slab="abc")
 
 
 def test_the_extension_links_no_mpi_icet_or_command_line():

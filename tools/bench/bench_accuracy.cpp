@@ -275,10 +275,9 @@ int main(int argc, char** argv) {
                 RenderSettings s = base;
                 s.renderer = c.kind;
                 s.quality.slab = c.slab;
-                s.quality.lod = c.lod;
-                s.quality.lodAuto = c.lodAuto;
-                s.quality.lodBrick = c.lod == -1.0;
-                if (s.quality.lodBrick) s.quality.lod = 0;
+                s.quality.lod = c.lodAuto       ? LevelOfDetail::automatic()
+                                : c.lod == -1.0 ? LevelOfDetail::perBrick()
+                                                : LevelOfDetail::threshold(c.lod);
                 s.quality.ewa = c.ewa;
                 s.camera.azimuthDeg = az;
                 const Renderer renderer(volume, s);

@@ -165,7 +165,8 @@ int renderRotation(const std::string& spec, const std::string& tf,
     const splat::SplatList& sp = scene.splats();
     json << "{\"renderer\": \"" << splat::toString(s.renderer) << "\", \"size\": " << size
          << ", \"threads\": " << s.threads << ", \"slab\": " << s.quality.slab
-         << ", \"mode\": \"" << splat::toString(s.mode) << "\", \"lod\": " << s.quality.lod
+         << ", \"mode\": \"" << splat::toString(s.mode)
+         << "\", \"lod\": " << s.quality.lod.pixels
          << ", \"ewa\": \"" << splat::toString(s.quality.ewa)
          << "\", \"pixel_filter\": " << s.quality.pixelFilter << ", \"scene_ms\": " << sceneMs
          << ", \"splats\": " << sp.size() << ", \"splat_bytes\": " << sp.bytes()

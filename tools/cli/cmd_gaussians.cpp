@@ -25,6 +25,12 @@ RenderSettings gaussianViewOf(const RenderArgs& a) {
     return asOptionUsage([&] { return parseRenderOptions(values); });
 }
 
+/// Whether the run sets `key` itself: a flag, or a scene's value other than the default (a
+/// written scene holds every option, at its default when the run left it unset).
+bool setByRun(const CLI::App& cmd, const RenderArgs& args, const std::string& key) {
+    return given(cmd, key) && (!fromScene(cmd, key) || args.values.differsFromDefault(key));
+}
+
 }  // namespace
 
 void printGaussianInfo(const std::string& spec) {
@@ -54,11 +60,11 @@ void renderGaussianFile(const CLI::App& cmd, const RenderArgs& args, const std::
     const RenderSettings view = gaussianViewOf(args);
     GaussianRenderOptions o;
     o.renderer = asUsage([&] {
-        return parseGaussianRenderer(given(cmd, "renderer") ? args.values.text("renderer")
-                                                            : "3dgs");
+        return parseGaussianRenderer(setByRun(cmd, args, "renderer") ? args.values.text("renderer")
+                                                                     : "3dgs");
     });
     o.threads = view.threads;
-    o.slab = given(cmd, "slab") ? view.quality.slab : 0;
+    o.slab = setByRun(cmd, args, "slab") ? view.quality.slab : 0;
     o.tolerance = view.quality.referenceTolerance;
     CameraParams camera = view.camera;
     const GaussianScene scene = openGaussians(spec);

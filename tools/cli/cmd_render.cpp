@@ -18,6 +18,19 @@
 namespace splat::cli {
 
 namespace {
+
+/// The --lod value as the level-of-detail lines print it.
+std::string lodText(const LevelOfDetail& lod) {
+    switch (lod.kind) {
+        case LevelOfDetail::Kind::Auto:
+            return "auto";
+        case LevelOfDetail::Kind::Brick:
+            return "brick";
+        default:
+            return std::to_string(lod.pixels);
+    }
+}
+
 struct RenderCommand {
     VolumeArgs volume;
     RenderArgs render;
@@ -143,16 +156,11 @@ void registerRender(CLI::App& app) {
         if (stats.lodLevel > 0 && levelsUsed > 1)
             std::printf("level of detail %d: %zu splats, a level per brick (%s) (--lod %s)\n",
                         stats.lodLevel, stats.lodSplats, perLevel.c_str(),
-                        settings.quality.lodAuto    ? "auto"
-                        : settings.quality.lodBrick ? "brick"
-                                                    : std::to_string(settings.quality.lod).c_str());
+                        lodText(settings.quality.lod).c_str());
         else if (stats.lodLevel > 0)
             std::printf("level of detail %d: %zu splats of %dx%dx%d voxels each (--lod %s)\n",
                         stats.lodLevel, stats.lodSplats, 1 << stats.lodLevel, 1 << stats.lodLevel,
-                        1 << stats.lodLevel,
-                        settings.quality.lodAuto    ? "auto"
-                        : settings.quality.lodBrick ? "brick"
-                                                    : std::to_string(settings.quality.lod).c_str());
+                        1 << stats.lodLevel, lodText(settings.quality.lod).c_str());
         finishRun(*cmd);
     });
 }

@@ -484,6 +484,213 @@ void writeGifAndContactSheet(const RotateCommand& a, std::vector<Image>& shown,
     }
 }
 
+/// What the steps of one rotate run share.
+struct RotateRun {
+    RenderSettings settings;
+    SequenceBricks bricks;  ///< bricks > 0: a bricked sequence
+    std::unique_ptr<BrickGroup> group;
+    bool leader = true;       ///< rank 0 (or the only process): prepares and writes the outputs
+    bool keepImages = false;  ///< frames kept in memory for the GIF and contact sheet
+    std::string ffmpeg;
+    CameraPath path;
+    nlohmann::json manifest;
+    std::vector<bool> keep;  ///< frames already in the folder (--resume)
+    std::shared_ptr<const Volume> volume;
+    std::optional<Scene> scene;
+    std::optional<WriteOptions> display;
+    std::vector<Image> shown;
+    double totalMs = 0;
+    std::size_t rendered = 0;
+
+    bool bricked() const { return bricks.bricks > 0; }
+};
+
+/// The settings, once everything that can be refused without reading the volume is refused.
+RenderSettings checkedSettings(CLI::App& cmd, RotateCommand& a) {
+    prepareCommand(cmd, {"volume", "output"});
+    checkRotateArgs(cmd, a);
+    checkSequenceBrickOptions(cmd, a.brick);
+    RenderUse use;
+    use.imageExt = "." + a.format;
+    RenderSettings settings = settingsFromArgs(a.render, use);
+    loadOptionsFromArgs(a.volume);
+    chooseZarrLevel(a.volume, settings);
+    return settings;
+}
+
+/// Bricks, or frames in parallel (docs/parallel.md, chooseSequenceBricks), with the warnings
+/// and refusals of that choice.
+void chooseBricks(const CLI::App& cmd, RotateCommand& a, RotateRun& run) {
+    run.bricks = chooseSequenceBricks(a.volume, run.settings, a.brick.bricks, a.brick.rankMemory);
+    if (run.bricked() && !a.timeSteps.empty())
+        throw UsageError("--time-steps renders without bricks (no --bricks or --rank-memory)");
+    if (run.bricked() && !run.bricks.alone && !workerProcess())
+        warn(a.volume.spec +
+             ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, "
+             "an ANALYZE pair): every rank loads the whole volume once and keeps its brick");
+    if (given(cmd, "brick-composite") && !fromScene(cmd, "brick-composite") &&
+        (!run.bricked() || run.settings.renderer != RendererKind::Sheet) && !workerProcess())
+        warn(
+            "--brick-composite applies to bricked sequences (--bricks, or mpirun when the "
+            "volume does not fit one process) of --renderer sheet: ignored");
+}
+
+/// The views: a time series' camera turns only when --from/--to (or --path) say so.
+CameraPath cameraPath(const CLI::App& cmd, const RotateCommand& a, const RenderSettings& settings) {
+    const bool fixedCamera =
+        !a.timeSteps.empty() && a.path.empty() && !given(cmd, "from") && !given(cmd, "to");
+    return fixedCamera
+               ? CameraPath{std::vector<CameraParams>(std::size_t(a.frames), settings.camera)}
+               : rotatePath(cmd, a, settings);
+}
+
+/// The extra outputs' programs, folders and memory, refused before anything is rendered.
+void checkExtraOutputs(const RotateCommand& a, RotateRun& run) {
+    if (!a.mp4.empty()) {
+        run.ffmpeg = findProgram("ffmpeg");
+        if (run.ffmpeg.empty())
+            throw Error(
+                "--mp4 needs the ffmpeg program, which is not installed "
+                "(Debian: apt-get install ffmpeg)");
+    }
+    checkExtraOutput(a.gif, "--gif");
+    checkExtraOutput(a.contact, "--contact-sheet");
+    checkExtraOutput(a.mp4, "--mp4");
+    const CameraParams& c = run.settings.camera;
+    if (run.keepImages && double(a.frames) * c.width * c.height > double(1 << 28))
+        throw Error("--gif/--contact-sheet with " + std::to_string(a.frames) + " frames of " +
+                    a.render.size() +
+                    " would not fit in memory; use fewer frames or a smaller --size");
+}
+
+/// Rank 0's preparation: outputs checked, the folder's kept frames, the run fixed, the scene
+/// loaded (without bricks), the output folder created.
+void prepareOutputs(const CLI::App& cmd, RotateCommand& a, RotateRun& run) {
+    checkExtraOutputs(a, run);
+    run.keep =
+        prepareFolder(a, run.manifest, run.settings.camera.width, run.settings.camera.height);
+    beginRun(cmd);
+    if (!run.bricked()) {
+        run.volume = std::make_shared<const Volume>(loadVolumeFromArgs(a.volume));
+        run.settings = withDataDefaults(a.render, run.settings, *run.volume);
+        run.scene.emplace(run.volume, run.settings);
+    }
+    if (!a.timeSteps.empty() && a.frames > 1) {
+        // The last step is loaded once up front: a step past the file's last is a usage
+        // error before any frame is rendered.
+        VolumeArgs last = a.volume;
+        last.values.set("time", std::to_string(a.firstStep + a.frames - 1));
+        (void)loadVolumeFrom(last.spec, last.values);
+    }
+    std::error_code ec;
+    fs::create_directories(a.outDir, ec);
+    if (!fs::is_directory(a.outDir)) throw Error(a.outDir + ": cannot create output folder");
+    run.display = resumedWindow(a);
+}
+
+/// Rank 0 prepares the outputs; a bricked run's other ranks learn whether it could, and which
+/// frames are kept (--resume), before rendering with it.
+void prepareRun(const CLI::App& cmd, RotateCommand& a, RotateRun& run) {
+    std::string failure;
+    try {
+        if (run.leader) prepareOutputs(cmd, a, run);
+    } catch (const std::exception& e) {
+        if (!run.bricked()) throw;
+        failure = e.what();
+    }
+    if (run.bricked()) {
+        run.group->agree(failure);
+        std::vector<unsigned char> kept(run.keep.begin(), run.keep.end());
+        run.group->broadcast(kept);
+        run.keep.assign(kept.begin(), kept.end());
+    }
+}
+
+/// One finished frame (rank 0): written, and kept for the GIF and contact sheet.
+void emitFrame(const RotateCommand& a, RotateRun& run, std::size_t view, const Image& image,
+               double ms) {
+    if (!run.display) {
+        run.display = displayOptions(a.render, run.settings, image);
+        if (run.display->mapping == DisplayMapping::Window)
+            run.manifest["window"] = {run.display->windowLow, run.display->windowHigh};
+        writeTextAtomic(fs::path(a.outDir) / kManifest, run.manifest.dump(2) + "\n");
+    }
+    writeImage(frameFile(a, view), image, *run.display);
+    run.totalMs += ms;
+    ++run.rendered;
+    if (run.keepImages) run.shown[view] = toDisplay(image, *run.display);
+}
+
+/// The frames not kept: bricked, one per time step, or through the sequence engine.
+void renderFrames(const RotateCommand& a, RotateRun& run, ProgressReporter& progress) {
+    run.shown.resize(run.keepImages ? std::size_t(a.frames) : 0);
+    SequenceOptions so;
+    so.parallelFrames = a.parallelFrames;
+    so.skip = [&](std::size_t v) { return run.keep[v]; };
+    so.progress = [&](std::size_t d, std::size_t t, const std::string& w) {
+        return progress(d, t, w);
+    };
+    const auto emit = [&](std::size_t view, const Image& image, double ms) {
+        emitFrame(a, run, view, image, ms);
+    };
+    try {
+        if (run.bricked())
+            renderBrickedFrames(a, *run.bricks.geometry, run.settings, run.bricks.bricks,
+                                *run.group, run.path, run.keep, progress, emit);
+        else if (!a.timeSteps.empty())
+            renderTimeSteps(a, run.volume, run.settings, run.path, run.keep, progress, emit);
+        else
+            renderSequence(
+                *run.scene, {run.settings.renderer}, run.path, so,
+                [&](SequenceFrame&& f) { emit(f.view, f.images[0], f.stats[0].milliseconds); });
+    } catch (const Cancelled&) {
+        progress.finish();
+        throw Error("interrupted after " + std::to_string(run.rendered) +
+                    " new frames; the frames written are complete (--resume finishes them)");
+    }
+}
+
+/// Rank 0's last step: the manifest of a run that rendered nothing, the GIF, contact sheet and
+/// MP4, and the summary line.
+void finishOutputs(const CLI::App& cmd, const RotateCommand& a, RotateRun& run) {
+    if (run.rendered == 0 && !fs::exists(fs::path(a.outDir) / kManifest))
+        writeTextAtomic(fs::path(a.outDir) / kManifest, run.manifest.dump(2) + "\n");
+    if (run.keepImages) writeGifAndContactSheet(a, run.shown, run.keep, run.display);
+    if (!a.mp4.empty()) writeMp4(a, run.ffmpeg);
+    std::printf("wrote %zu frames to %s (%zu kept)%s%s%s%s%s%s (%.1f ms per frame)\n", run.rendered,
+                a.outDir.c_str(), std::size_t(a.frames) - run.rendered, a.gif.empty() ? "" : ", ",
+                a.gif.c_str(), a.contact.empty() ? "" : ", ", a.contact.c_str(),
+                a.mp4.empty() ? "" : ", ", a.mp4.c_str(),
+                run.rendered ? run.totalMs / double(run.rendered) : 0.0);
+    finishRun(cmd);
+}
+
+/// The rotate command: everything that can be refused is refused before anything is rendered
+/// or created; then the outputs are prepared, the frames rendered and the extras written.
+void runRotate(CLI::App& cmd, RotateCommand& a) {
+    RotateRun run;
+    run.settings = checkedSettings(cmd, a);
+    chooseBricks(cmd, a, run);
+    if (!run.bricked() && workerProcess())  // under mpirun: render the frames rank 0 asks for
+        return serveFrames([&] {
+            auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a.volume));
+            return Scene(v, withDataDefaults(a.render, run.settings, *v));
+        });
+    run.leader = !workerProcess();
+    if (run.bricked()) run.group = brickGroup(a.brick.compositor);
+    run.keepImages = !a.gif.empty() || !a.contact.empty();
+    run.path = cameraPath(cmd, a, run.settings);
+    run.manifest = manifestOf(a, run.settings);
+    run.keep.assign(std::size_t(a.frames), false);
+    prepareRun(cmd, a, run);
+    installInterruptHandler();
+    ProgressReporter progress("frames", a.quiet || !run.leader);
+    renderFrames(a, run, progress);
+    if (!run.leader) return;
+    progress.finish();
+    finishOutputs(cmd, a, run);
+}
+
 }  // namespace
 
 void registerRotate(CLI::App& app) {
@@ -498,160 +705,7 @@ void registerRotate(CLI::App& app) {
         "  splat rotate synthetic:phantom:64 --sweep elevation --from -30 --to 30 --frames 13 -o "
         "tilt\n"
         "  splat rotate ch2.nii.gz --path path.json --frames 120 -o fly --mp4 fly.mp4 --fps 30");
-    cmd->callback([a, cmd] {
-        // Everything that can be refused is refused before anything is rendered or created.
-        prepareCommand(*cmd, {"volume", "output"});
-        checkRotateArgs(*cmd, *a);
-        checkSequenceBrickOptions(*cmd, a->brick);
-        RenderUse use;
-        use.imageExt = "." + a->format;
-        RenderSettings settings = settingsFromArgs(a->render, use);
-        loadOptionsFromArgs(a->volume);
-        chooseZarrLevel(a->volume, settings);
-        // Bricks, or frames in parallel (docs/parallel.md, chooseSequenceBricks).
-        const SequenceBricks choice =
-            chooseSequenceBricks(a->volume, settings, a->brick.bricks, a->brick.rankMemory);
-        const int bricks = choice.bricks;
-        const std::optional<Volume>& geometry = choice.geometry;
-        const bool alone = choice.alone;
-        const bool bricked = bricks > 0;
-        if (bricked && !a->timeSteps.empty())
-            throw UsageError("--time-steps renders without bricks (no --bricks or --rank-memory)");
-        // A time series' camera turns only when --from/--to (or --path) say so.
-        const bool fixedCamera =
-            !a->timeSteps.empty() && a->path.empty() && !given(*cmd, "from") && !given(*cmd, "to");
-        if (bricked && !alone && !workerProcess())
-            warn(a->volume.spec +
-                 ": its samples are not read by brick (DICOM, a slice folder, NRRD text or hex, "
-                 "an ANALYZE pair): every rank loads the whole volume once and keeps its brick");
-        if (given(*cmd, "brick-composite") && !fromScene(*cmd, "brick-composite") &&
-            (!bricked || settings.renderer != RendererKind::Sheet) && !workerProcess())
-            warn(
-                "--brick-composite applies to bricked sequences (--bricks, or mpirun when the "
-                "volume does not fit one process) of --renderer sheet: ignored");
-        if (!bricked && workerProcess())  // under mpirun: render the frames rank 0 asks for
-            return serveFrames([&] {
-                auto v = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
-                return Scene(v, withDataDefaults(a->render, settings, *v));
-            });
-        // Rank 0 prepares the outputs; a bricked run's other ranks learn whether it could,
-        // and which frames are kept (--resume), before rendering with it.
-        const bool leader = !workerProcess();
-        const std::unique_ptr<BrickGroup> group =
-            bricked ? brickGroup(a->brick.compositor) : nullptr;
-        std::string ffmpeg;
-        const bool keepImages = !a->gif.empty() || !a->contact.empty();
-        const CameraPath path =
-            fixedCamera
-                ? CameraPath{std::vector<CameraParams>(std::size_t(a->frames), settings.camera)}
-                : rotatePath(*cmd, *a, settings);
-        nlohmann::json manifest = manifestOf(*a, settings);
-        std::vector<bool> keep(std::size_t(a->frames), false);
-        std::shared_ptr<const Volume> volume;
-        std::optional<Scene> scene;
-        std::optional<WriteOptions> display;
-        std::string failure;
-        try {
-            if (leader) {
-                if (!a->mp4.empty()) {
-                    ffmpeg = findProgram("ffmpeg");
-                    if (ffmpeg.empty())
-                        throw Error(
-                            "--mp4 needs the ffmpeg program, which is not installed "
-                            "(Debian: apt-get install ffmpeg)");
-                }
-                checkExtraOutput(a->gif, "--gif");
-                checkExtraOutput(a->contact, "--contact-sheet");
-                checkExtraOutput(a->mp4, "--mp4");
-                if (keepImages &&
-                    double(a->frames) * settings.camera.width * settings.camera.height >
-                        double(1 << 28))
-                    throw Error("--gif/--contact-sheet with " + std::to_string(a->frames) +
-                                " frames of " + a->render.size() +
-                                " would not fit in memory; use fewer frames or a smaller --size");
-                keep = prepareFolder(*a, manifest, settings.camera.width, settings.camera.height);
-                beginRun(*cmd);
-                if (!bricked) {
-                    volume = std::make_shared<const Volume>(loadVolumeFromArgs(a->volume));
-                    settings = withDataDefaults(a->render, settings, *volume);
-                    scene.emplace(volume, settings);
-                }
-                if (!a->timeSteps.empty() && a->frames > 1) {
-                    // The last step is loaded once up front: a step past the file's last is a
-                    // usage error before any frame is rendered.
-                    VolumeArgs last = a->volume;
-                    last.values.set("time", std::to_string(a->firstStep + a->frames - 1));
-                    (void)loadVolumeFrom(last.spec, last.values);
-                }
-                std::error_code ec;
-                fs::create_directories(a->outDir, ec);
-                if (!fs::is_directory(a->outDir))
-                    throw Error(a->outDir + ": cannot create output folder");
-
-                display = resumedWindow(*a);
-            }
-        } catch (const std::exception& e) {
-            if (!bricked) throw;
-            failure = e.what();
-        }
-        if (bricked) {
-            group->agree(failure);
-            std::vector<unsigned char> kept(keep.begin(), keep.end());
-            group->broadcast(kept);
-            keep.assign(kept.begin(), kept.end());
-        }
-        std::vector<Image> shown(keepImages ? std::size_t(a->frames) : 0);
-        double totalMs = 0;
-        std::size_t rendered = 0;
-        installInterruptHandler();
-        ProgressReporter progress("frames", a->quiet || !leader);
-        SequenceOptions so;
-        so.parallelFrames = a->parallelFrames;
-        so.skip = [&](std::size_t v) { return keep[v]; };
-        so.progress = [&](std::size_t d, std::size_t t, const std::string& w) {
-            return progress(d, t, w);
-        };
-        // One finished frame (rank 0): written, and kept for the GIF and contact sheet.
-        const auto emit = [&](std::size_t view, const Image& image, double ms) {
-            if (!display) {
-                display = displayOptions(a->render, settings, image);
-                if (display->mapping == DisplayMapping::Window)
-                    manifest["window"] = {display->windowLow, display->windowHigh};
-                writeTextAtomic(fs::path(a->outDir) / kManifest, manifest.dump(2) + "\n");
-            }
-            writeImage(frameFile(*a, view), image, *display);
-            totalMs += ms;
-            ++rendered;
-            if (keepImages) shown[view] = toDisplay(image, *display);
-        };
-        try {
-            if (bricked)
-                renderBrickedFrames(*a, *geometry, settings, bricks, *group, path, keep, progress,
-                                    emit);
-            else if (!a->timeSteps.empty())
-                renderTimeSteps(*a, volume, settings, path, keep, progress, emit);
-            else
-                renderSequence(*scene, {settings.renderer}, path, so, [&](SequenceFrame&& f) {
-                    emit(f.view, f.images[0], f.stats[0].milliseconds);
-                });
-        } catch (const Cancelled&) {
-            progress.finish();
-            throw Error("interrupted after " + std::to_string(rendered) +
-                        " new frames; the frames written are complete (--resume finishes them)");
-        }
-        if (!leader) return;
-        progress.finish();
-        if (rendered == 0 && !fs::exists(fs::path(a->outDir) / kManifest))
-            writeTextAtomic(fs::path(a->outDir) / kManifest, manifest.dump(2) + "\n");
-        if (keepImages) writeGifAndContactSheet(*a, shown, keep, display);
-        if (!a->mp4.empty()) writeMp4(*a, ffmpeg);
-        std::printf("wrote %zu frames to %s (%zu kept)%s%s%s%s%s%s (%.1f ms per frame)\n", rendered,
-                    a->outDir.c_str(), std::size_t(a->frames) - rendered,
-                    a->gif.empty() ? "" : ", ", a->gif.c_str(), a->contact.empty() ? "" : ", ",
-                    a->contact.c_str(), a->mp4.empty() ? "" : ", ", a->mp4.c_str(),
-                    rendered ? totalMs / double(rendered) : 0.0);
-        finishRun(*cmd);
-    });
+    cmd->callback([a, cmd] { runRotate(*cmd, *a); });
 }
 
 }  // namespace splat::cli

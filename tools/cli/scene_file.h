@@ -1,12 +1,13 @@
 #pragma once
 // Options of a subcommand, remembered so that a scene file can hold every one of them
 // (docs/command-line.md "Scene files", docs/decisions.md): a scene key is an option's long name
-// without dashes ("pixel-size", "output"; "volume" for the VOLUME argument). Reading a
-// scene feeds each key to its option through CLI11's own conversion, so a scene accepts
-// exactly what the command line accepts (typed JSON numbers, arrays and booleans, or the
-// command line's strings); a flag given on the command line overrides its key. Writing a
-// scene (--write-scene, and the metadata of every image) records every option's value as
-// the command ran, paths absolute.
+// without dashes ("pixel-size", "output"; "volume" for the VOLUME argument). The library reads
+// and writes scene files (splat/scene_file.h): reading turns each key's value into the
+// option's text, checked by the option table, and feeds it to its option through CLI11's own
+// conversion, so a scene accepts exactly what the command line accepts; a flag given on the
+// command line overrides its key. Writing a scene (--write-scene, and the metadata of every
+// image) records every option's value as the command ran, paths absolute. A VOLUME ending in
+// .json is a scene file (`splat render scene.json`).
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <initializer_list>
@@ -17,13 +18,14 @@
 
 #include "splat/image_io.h"
 #include "splat/options.h"
+#include "splat/scene_file.h"
 
 namespace splat::cli {
 
-/// How a scene file's value becomes the option's text.
-enum class ValueKind { Flag, Integer, Unsigned, Real, Text, TextList };
+/// How a scene file's value becomes the option's text (splat/scene_file.h).
+using ValueKind = OptionType;
 /// Paths are resolved against the scene file's folder and written absolute.
-enum class PathKind { None, Input, Output };
+using PathKind = OptionPath;
 
 namespace detail {
 void recordOption(CLI::App& cmd, CLI::Option* opt, ValueKind kind, PathKind path,

@@ -100,6 +100,47 @@ struct Clipping {
     bool keeps(const glm::dvec3& x) const;
 };
 
+/// Level of detail of the splatters (`--lod`, docs/speed-vs-accuracy.md "Level of detail"): one
+/// of off, a pixel threshold, auto or brick. The reference ray caster ignores it.
+struct LevelOfDetail {
+    enum class Kind {
+        /// Always the full-resolution splat list.
+        Off,
+        /// While a voxel of the level in use covers fewer than `pixels` pixels (its largest
+        /// spacing over the pixel size; perspective: at the volume's nearest depth), the
+        /// splatters use the next level, 2x2x2 voxels merged into one splat of twice the size
+        /// (Laur & Hanrahan).
+        Pixels,
+        /// A level chosen per view from the error it adds (`--lod auto`): in the modes where
+        /// it was measured free in accuracy against the pixel-filtered reference
+        /// (lodAutoApplies, model/level_of_detail.h), the coarsest level whose merged splats,
+        /// low-passed to what the filtered reference sees (the level-0 kernel plus the pixel
+        /// filter, less the pyramid's box), still sum to a constant on their grid; a pixel or
+        /// more per voxel keeps level 0 (bit-identical to off).
+        Auto,
+        /// A level per brick and view (`--lod brick`, model/brick_lod.h): in the modes of
+        /// Auto, a level per brick of 16^3 voxels, the coarsest the projected voxel size at the
+        /// brick allows (lodAutoLevel) whose dropped detail and whose seams with finer
+        /// neighbours stay within a tolerance of the field, each level splatted as Auto splats
+        /// it; the frame sums a frame per level (X-ray).
+        Brick,
+    };
+    Kind kind = Kind::Off;
+    /// The threshold of Pixels, pixels per voxel, 0..64 (0 for the other kinds).
+    double pixels = 0;
+
+    /// Pixels with threshold `pixels` (0: Off).
+    static LevelOfDetail threshold(double pixels) {
+        return {pixels > 0 ? Kind::Pixels : Kind::Off, pixels};
+    }
+    static LevelOfDetail automatic() { return {Kind::Auto, 0}; }
+    static LevelOfDetail perBrick() { return {Kind::Brick, 0}; }
+    bool off() const { return kind == Kind::Off; }
+    /// Auto or Brick: the merged levels are low-passed to what the filtered reference sees.
+    bool filtered() const { return kind == Kind::Auto || kind == Kind::Brick; }
+    bool operator==(const LevelOfDetail&) const = default;
+};
+
 /// Every knob that trades speed for accuracy.
 struct Quality {
     /// Image-aligned slab thickness, voxels (one voxel = the smallest spacing).
@@ -118,25 +159,8 @@ struct Quality {
     double referenceStep = 0.25, referenceTolerance = 1e-4;
     /// Screen tile edge, pixels (8..64): each tile owns its sheets and compositing.
     int tileSize = 32;
-    /// Level of detail (splatters): while a voxel of the level in use covers fewer than
-    /// `lod` pixels (its largest spacing over the pixel size; perspective: at the volume's
-    /// nearest depth), the splatters use the next level, 2x2x2 voxels merged into one splat
-    /// of twice the size (Laur & Hanrahan). 0 = off: always the full-resolution list.
-    /// 0..64. Ignored when lodAuto is set.
-    double lod = 0;
-    /// Level of detail chosen per view from the error it adds (`--lod auto`,
-    /// docs/speed-vs-accuracy.md "Level of detail"): in the modes where it was measured free in
-    /// accuracy against the pixel-filtered reference (lodAutoApplies, model/level_of_detail.h), the
-    /// coarsest level whose merged splats, low-passed to what the filtered reference sees (the
-    /// level-0 kernel plus the pixel filter, less the pyramid's box), still sum to a constant on
-    /// their grid; a pixel or more per voxel keeps level 0 (bit-identical to lod 0).
-    bool lodAuto = false;
-    /// Level of detail per brick and view (`--lod brick`, model/brick_lod.h): in the
-    /// modes of lodAuto, a level per brick of 16^3 voxels, the coarsest the projected voxel size
-    /// at the brick allows (lodAutoLevel) whose dropped detail and whose seams with finer
-    /// neighbours stay within a tolerance of the field, each level splatted as lodAuto splats
-    /// it; the frame sums a frame per level (X-ray). Ignored when lodAuto is set.
-    bool lodBrick = false;
+    /// Level of detail of the splatters: off, a pixel threshold, auto or brick.
+    LevelOfDetail lod;
     /// Pixel filter, a Gaussian of this standard deviation in pixels truncated at 4 sigma
     /// (docs/accuracy.md "Aliasing and EWA"). Reference ray caster: 0 samples each pixel at its
     /// centre; > 0 supersamples s x s rays per pixel (s = 2, 4, 8, 16) and filters, doubling s

@@ -13,6 +13,7 @@ within a tile on Ctrl-C (KeyboardInterrupt), writing nothing.
 """
 from __future__ import annotations
 
+import json
 import numbers
 import warnings
 
@@ -30,9 +31,9 @@ __all__ = [
     "Cancelled", "Error", "FileError", "Gaussians", "InputError", "Mesh", "PoppingResult",
     "Scene", "StudyResult", "TransferFunction", "Volume", "compare", "default_window",
     "flip_map", "from_nibabel", "iso_surface", "list_dicom_series", "load", "load_gaussians",
-    "load_options", "popping", "read_image", "render", "render_gaussians", "render_options",
-    "rotate", "study", "study_knobs", "synthetic", "synthetic_names", "write_heatmap",
-    "write_image", "zarr_level",
+    "load_options", "load_scene", "popping", "read_image", "render", "render_gaussians",
+    "render_options", "render_scene", "rotate", "save_scene", "study", "study_knobs",
+    "synthetic", "synthetic_names", "write_heatmap", "write_image", "zarr_level",
 ]
 
 # Options taking "WxH" / "XxYxZ" text; every other sequence is joined with commas.
@@ -74,6 +75,9 @@ def _argv(options: dict) -> tuple[list[tuple[str, str]], str]:
     tf_json = ""
     for key, value in options.items():
         if value is None:
+            continue
+        if key == "tf" and isinstance(value, dict):  # a scene file's inline transfer function
+            tf_json = json.dumps(value)
             continue
         if key == "tf" and not isinstance(value, str):
             tf = value if isinstance(value, TransferFunction) else TransferFunction(value)
@@ -172,6 +176,64 @@ progress: callable(done, total, what) -> bool|None; False stops (splat.Cancelled
 Options (the CLI's render options):
 {_RENDER_DOC}
 """
+
+
+def load_scene(path: str) -> dict:
+    """A scene file (docs/command-line.md "Scene files"), read by the library as `splat render
+    --scene FILE` reads it, as keyword arguments: {"volume": spec, keyword: value, ...} (values
+    as the option's text, relative paths resolved against the file's folder, an inline
+    transfer function as a dict); a value its option refuses raises splat.InputError with the
+    command line's line. Keys of the command line's own options (output, frames, ...) are no
+    keywords: left out with a warning."""
+    command, rows, others = _splat._read_scene(str(path))
+    del command
+    out: dict = {}
+    for key, texts, obj in rows:
+        if obj:
+            out[key] = json.loads(obj)
+        elif texts == ["true"] or texts == ["false"]:
+            out[key] = texts[0] == "true"
+        elif len(texts) == 1:
+            out[key] = texts[0]
+        elif texts:
+            out[key] = list(texts)
+    if others:
+        warnings.warn(f"{path}: keys of the command line's own options, ignored: "
+                      + ", ".join(others), stacklevel=2)
+    return out
+
+
+def _scene_keywords(path: str, overrides: dict) -> tuple[str, dict, dict]:
+    """A scene file's volume, load keywords and render keywords, with `overrides` applied."""
+    scene = load_scene(path)
+    scene.update(overrides)
+    volume = scene.pop("volume", None)
+    if not volume:
+        raise InputError(f'{path}: no "volume" (the volume or Gaussian scene to render)')
+    loads = {k: scene.pop(k) for k in load_options() if k in scene}
+    keywords = set(render_options())
+    return volume, loads, {k: v for k, v in scene.items() if k in keywords}
+
+
+def render_scene(path: str, *, progress=None, return_stats: bool = False, **overrides):
+    """render_scene(path, **overrides): the frame `splat render --scene FILE` draws: the scene's
+    volume loaded with its volume options and rendered with its render options (the options
+    of the written image, such as window, concern files only); keyword arguments override the
+    scene's, as flags do. A scene of a Gaussian scene: splat.render_gaussians."""
+    volume, loads, keywords = _scene_keywords(path, overrides)
+    if volume.endswith(".ply") or volume.startswith("gaussians:"):
+        raise InputError(f"{path}: '{volume}' is a Gaussian scene: render it with "
+                         "splat.render_gaussians(splat.load_gaussians(...)) or `splat render`")
+    return render(load(volume, **loads), progress=progress, return_stats=return_stats,
+                  **keywords)
+
+
+def save_scene(path: str, volume: str, *, command: str = "render", **options) -> None:
+    """Writes a scene file by the library, as `--write-scene` does: "volume" (made absolute)
+    and every option of `command` (render, popping, ...) at the given keyword's value or its
+    default. Values are checked as the flags are (splat.InputError)."""
+    argv, tf_json = _argv(options)
+    _splat._write_scene(str(path), command, str(volume), argv, tf_json)
 
 
 class Scene:

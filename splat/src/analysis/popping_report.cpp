@@ -248,7 +248,7 @@ json settingsJson(const RenderSettings& s) {
                     {"reference_step", q.referenceStep},
                     {"reference_tolerance", q.referenceTolerance},
                     {"tile_size", q.tileSize},
-                    {"lod", q.lod},
+                    {"lod", q.lod.pixels},
                     {"pixel_filter", q.pixelFilter},
                     {"ewa", toString(q.ewa)}};
     return j;

@@ -504,8 +504,6 @@ RenderSettings frameOf(const Scene& scene, const RenderSettings& s) {
     frame.quality.referenceTolerance = s.quality.referenceTolerance;
     frame.quality.tileSize = s.quality.tileSize;
     frame.quality.lod = s.quality.lod;
-    frame.quality.lodAuto = s.quality.lodAuto;
-    frame.quality.lodBrick = s.quality.lodBrick;
     frame.quality.ewa = s.quality.ewa;
     frame.quality.pixelFilter = s.quality.pixelFilter;
     frame.quality.pixelFilterTolerance = s.quality.pixelFilterTolerance;

@@ -130,57 +130,59 @@ std::vector<double> niceTicks(double lo, double hi, int target) {
     return out;
 }
 
-std::string LinePlot::svg() const {
-    std::ostringstream s;
-    const double w = width, h = height;
-    Axis xa, ya;
-    xa.log = logX;
-    ya.log = logY;
-    xa.p0 = kLeft;
-    xa.p1 = w - kRight;
-    ya.p0 = h - kBottom;
-    ya.p1 = kTop;
+namespace {
 
+/// The axes of `plot`, fitted to its drawable points, bands, markers and fixed x range; false
+/// when no point can be drawn.
+bool fitAxes(const LinePlot& plot, Axis& xa, Axis& ya) {
+    xa.log = plot.logX;
+    ya.log = plot.logY;
+    xa.p0 = kLeft;
+    xa.p1 = plot.width - kRight;
+    ya.p0 = plot.height - kBottom;
+    ya.p1 = kTop;
     std::vector<double> xs, ys;
-    for (const PlotSeries& ps : series)
+    for (const PlotSeries& ps : plot.series)
         for (std::size_t i = 0; i < std::min(ps.x.size(), ps.y.size()); ++i)
             if (xa.drawable(ps.x[i]) && ya.drawable(ps.y[i])) {
                 xs.push_back(ps.x[i]);
                 ys.push_back(ps.y[i]);
             }
     const bool any = !xs.empty();
-    for (const PlotBand& b : bands) {
+    for (const PlotBand& b : plot.bands) {
         xs.push_back(b.from);
         xs.push_back(b.to);
     }
-    for (const PlotMarker& m : markers) xs.push_back(m.x);
+    for (const PlotMarker& m : plot.markers) xs.push_back(m.x);
+    const bool fixedRange = std::isfinite(plot.xFrom) && std::isfinite(plot.xTo) &&
+                            plot.xFrom < plot.xTo && (!plot.logX || plot.xFrom > 0);
+    if (fixedRange) {
+        xs.push_back(plot.xFrom);
+        xs.push_back(plot.xTo);
+    }
+    if (!any || !fitRange(xa, xs, false) || !fitRange(ya, ys, !plot.logY)) return false;
+    if (fixedRange) {
+        xa.lo = plot.xFrom;
+        xa.hi = plot.xTo;
+    }
+    return true;
+}
 
-    s << "<svg class=\"plot\" role=\"img\" width=\"" << width << "\" height=\"" << height
-      << "\" viewBox=\"0 0 " << width << ' ' << height << "\" aria-label=\"" << escapeHtml(title)
-      << "\">\n";
-    s << "<rect x=\"0\" y=\"0\" width=\"" << width << "\" height=\"" << height
+/// The svg element, its white background and the title.
+void writeHeader(std::ostringstream& s, const LinePlot& plot) {
+    s << "<svg class=\"plot\" role=\"img\" width=\"" << plot.width << "\" height=\"" << plot.height
+      << "\" viewBox=\"0 0 " << plot.width << ' ' << plot.height << "\" aria-label=\""
+      << escapeHtml(plot.title) << "\">\n";
+    s << "<rect x=\"0\" y=\"0\" width=\"" << plot.width << "\" height=\"" << plot.height
       << "\" fill=\"#fff\"/>\n";
-    s << "<text x=\"" << num(kLeft) << "\" y=\"18\" class=\"plot-title\">" << escapeHtml(title)
+    s << "<text x=\"" << num(kLeft) << "\" y=\"18\" class=\"plot-title\">" << escapeHtml(plot.title)
       << "</text>\n";
-    if (std::isfinite(xFrom) && std::isfinite(xTo) && xFrom < xTo && (!logX || xFrom > 0)) {
-        xs.push_back(xFrom);
-        xs.push_back(xTo);
-    }
-    const bool fixedX = xs.size() >= 2 && std::isfinite(xFrom) && std::isfinite(xTo) &&
-                        xFrom < xTo && (!logX || xFrom > 0);
-    if (!any || !fitRange(xa, xs, false) || !fitRange(ya, ys, !logY)) {
-        s << "<text x=\"" << num(w / 2) << "\" y=\"" << num(h / 2)
-          << "\" text-anchor=\"middle\" class=\"plot-empty\">no data</text>\n</svg>\n";
-        return s.str();
-    }
-    if (fixedX) {
-        xa.lo = xFrom;
-        xa.hi = xTo;
-    }
+}
 
-    // Bands and markers, clipped to the plot area.
+/// Bands (events), clipped to the plot area, at least 2 pixels wide.
+void writeBands(std::ostringstream& s, const LinePlot& plot, const Axis& xa, const Axis& ya) {
     const double top = ya.p1, bottom = ya.p0;
-    for (const PlotBand& b : bands) {
+    for (const PlotBand& b : plot.bands) {
         if (!xa.drawable(b.from) || !xa.drawable(b.to)) continue;
         double x0 = std::clamp(xa.map(std::min(b.from, b.to)), xa.p0, xa.p1);
         double x1 = std::clamp(xa.map(std::max(b.from, b.to)), xa.p0, xa.p1);
@@ -194,7 +196,11 @@ std::string LinePlot::svg() const {
           << "\" fill=\"#f4a261\" fill-opacity=\"0.28\"><title>" << escapeHtml(b.label)
           << "</title></rect>\n";
     }
-    // Grid and ticks.
+}
+
+/// Grid lines, ticks and their labels, the frame and the axis labels.
+void writeAxes(std::ostringstream& s, const LinePlot& plot, const Axis& xa, const Axis& ya) {
+    const double top = ya.p1, bottom = ya.p0;
     s << "<g class=\"axes\" font-size=\"11\" fill=\"#333\">\n";
     for (double v : xa.ticks()) {
         const double x = xa.map(v);
@@ -218,57 +224,65 @@ std::string LinePlot::svg() const {
     }
     s << "<rect x=\"" << num(xa.p0) << "\" y=\"" << num(top) << "\" width=\"" << num(xa.p1 - xa.p0)
       << "\" height=\"" << num(bottom - top) << "\" fill=\"none\" stroke=\"#333\"/>\n";
-    s << "<text x=\"" << num(0.5 * (xa.p0 + xa.p1)) << "\" y=\"" << num(h - 8)
-      << "\" text-anchor=\"middle\" font-size=\"12\">" << escapeHtml(xLabel)
-      << (logX ? " (log)" : "") << "</text>\n";
+    s << "<text x=\"" << num(0.5 * (xa.p0 + xa.p1)) << "\" y=\"" << num(plot.height - 8)
+      << "\" text-anchor=\"middle\" font-size=\"12\">" << escapeHtml(plot.xLabel)
+      << (plot.logX ? " (log)" : "") << "</text>\n";
     s << "<text transform=\"translate(14," << num(0.5 * (top + bottom))
-      << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"12\">" << escapeHtml(yLabel)
-      << (logY ? " (log)" : "") << "</text>\n";
+      << ") rotate(-90)\" text-anchor=\"middle\" font-size=\"12\">" << escapeHtml(plot.yLabel)
+      << (plot.logY ? " (log)" : "") << "</text>\n";
     s << "</g>\n";
-    for (const PlotMarker& m : markers) {
+}
+
+/// Markers (predicted switches): dashed vertical lines inside the plot area.
+void writeMarkers(std::ostringstream& s, const LinePlot& plot, const Axis& xa, const Axis& ya) {
+    for (const PlotMarker& m : plot.markers) {
         if (!xa.drawable(m.x)) continue;
         const double x = xa.map(m.x);
         if (x < xa.p0 - 0.5 || x > xa.p1 + 0.5) continue;
-        s << "<line class=\"marker\" x1=\"" << num(x) << "\" y1=\"" << num(top) << "\" x2=\""
-          << num(x) << "\" y2=\"" << num(bottom)
+        s << "<line class=\"marker\" x1=\"" << num(x) << "\" y1=\"" << num(ya.p1) << "\" x2=\""
+          << num(x) << "\" y2=\"" << num(ya.p0)
           << "\" stroke=\"#555\" stroke-width=\"1.2\" stroke-dasharray=\"5 4\"><title>"
           << escapeHtml(m.label) << "</title></line>\n";
     }
-    // Series: polylines broken at points that cannot be drawn.
-    for (const PlotSeries& ps : series) {
-        s << "<g class=\"series\" stroke=\"" << escapeHtml(ps.color) << "\" fill=\"none\""
-          << (ps.dashed ? " stroke-dasharray=\"6 3\"" : "") << ">"
-          << "<title>" << escapeHtml(ps.name) << "</title>\n";
-        std::string points;
-        std::vector<std::pair<double, double>> dots;
-        auto flush = [&] {
-            if (!points.empty())
-                s << "<polyline stroke-width=\"1.6\" stroke-linejoin=\"round\" points=\"" << points
-                  << "\"/>\n";
-            points.clear();
-        };
-        for (std::size_t i = 0; i < std::min(ps.x.size(), ps.y.size()); ++i) {
-            if (!xa.drawable(ps.x[i]) || !ya.drawable(ps.y[i])) {
-                flush();
-                continue;
-            }
-            const double x = xa.map(ps.x[i]), y = ya.map(ps.y[i]);
-            if (!points.empty()) points += ' ';
-            points += num(x) + ',' + num(y);
-            dots.emplace_back(x, y);
+}
+
+/// One series: polylines broken at points that cannot be drawn, and its dots.
+void writeSeries(std::ostringstream& s, const PlotSeries& ps, const Axis& xa, const Axis& ya) {
+    s << "<g class=\"series\" stroke=\"" << escapeHtml(ps.color) << "\" fill=\"none\""
+      << (ps.dashed ? " stroke-dasharray=\"6 3\"" : "") << ">"
+      << "<title>" << escapeHtml(ps.name) << "</title>\n";
+    std::string points;
+    std::vector<std::pair<double, double>> dots;
+    auto flush = [&] {
+        if (!points.empty())
+            s << "<polyline stroke-width=\"1.6\" stroke-linejoin=\"round\" points=\"" << points
+              << "\"/>\n";
+        points.clear();
+    };
+    for (std::size_t i = 0; i < std::min(ps.x.size(), ps.y.size()); ++i) {
+        if (!xa.drawable(ps.x[i]) || !ya.drawable(ps.y[i])) {
+            flush();
+            continue;
         }
-        flush();
-        if (ps.markers || dots.size() == 1)
-            for (auto [x, y] : dots)
-                s << "<circle cx=\"" << num(x) << "\" cy=\"" << num(y) << "\" r=\"2.6\" fill=\""
-                  << escapeHtml(ps.color) << "\"/>";
-        s << "</g>\n";
+        const double x = xa.map(ps.x[i]), y = ya.map(ps.y[i]);
+        if (!points.empty()) points += ' ';
+        points += num(x) + ',' + num(y);
+        dots.emplace_back(x, y);
     }
-    // Legend.
+    flush();
+    if (ps.markers || dots.size() == 1)
+        for (auto [x, y] : dots)
+            s << "<circle cx=\"" << num(x) << "\" cy=\"" << num(y) << "\" r=\"2.6\" fill=\""
+              << escapeHtml(ps.color) << "\"/>";
+    s << "</g>\n";
+}
+
+/// The legend right of the plot area: the series, then the bands and markers if any.
+void writeLegend(std::ostringstream& s, const LinePlot& plot, const Axis& xa, const Axis& ya) {
     s << "<g class=\"legend\" font-size=\"12\" fill=\"#222\">\n";
-    double ly = top + 6;
+    double ly = ya.p1 + 6;
     const double lx = xa.p1 + 14;
-    for (const PlotSeries& ps : series) {
+    for (const PlotSeries& ps : plot.series) {
         s << "<line x1=\"" << num(lx) << "\" y1=\"" << num(ly) << "\" x2=\"" << num(lx + 22)
           << "\" y2=\"" << num(ly) << "\" stroke=\"" << escapeHtml(ps.color)
           << "\" stroke-width=\"2.5\"" << (ps.dashed ? " stroke-dasharray=\"6 3\"" : "")
@@ -276,19 +290,38 @@ std::string LinePlot::svg() const {
           << escapeHtml(ps.name) << "</text>\n";
         ly += 18;
     }
-    if (!bands.empty()) {
+    if (!plot.bands.empty()) {
         s << "<rect x=\"" << num(lx) << "\" y=\"" << num(ly - 6) << "\" width=\"22\" height=\"12\""
           << " fill=\"#f4a261\" fill-opacity=\"0.35\"/><text x=\"" << num(lx + 28) << "\" y=\""
-          << num(ly + 4) << "\">" << escapeHtml(bandLegend) << "</text>\n";
+          << num(ly + 4) << "\">" << escapeHtml(plot.bandLegend) << "</text>\n";
         ly += 18;
     }
-    if (!markers.empty()) {
+    if (!plot.markers.empty()) {
         s << "<line x1=\"" << num(lx) << "\" y1=\"" << num(ly) << "\" x2=\"" << num(lx + 22)
           << "\" y2=\"" << num(ly) << "\" stroke=\"#555\" stroke-dasharray=\"5 4\"/><text x=\""
-          << num(lx + 28) << "\" y=\"" << num(ly + 4) << "\">" << escapeHtml(markerLegend)
+          << num(lx + 28) << "\" y=\"" << num(ly + 4) << "\">" << escapeHtml(plot.markerLegend)
           << "</text>\n";
     }
-    s << "</g>\n</svg>\n";
+    s << "</g>\n";
+}
+
+}  // namespace
+
+std::string LinePlot::svg() const {
+    std::ostringstream s;
+    writeHeader(s, *this);
+    Axis xa, ya;
+    if (!fitAxes(*this, xa, ya)) {
+        s << "<text x=\"" << num(width / 2.0) << "\" y=\"" << num(height / 2.0)
+          << "\" text-anchor=\"middle\" class=\"plot-empty\">no data</text>\n</svg>\n";
+        return s.str();
+    }
+    writeBands(s, *this, xa, ya);
+    writeAxes(s, *this, xa, ya);
+    writeMarkers(s, *this, xa, ya);
+    for (const PlotSeries& ps : series) writeSeries(s, ps, xa, ya);
+    writeLegend(s, *this, xa, ya);
+    s << "</svg>\n";
     return s.str();
 }
 

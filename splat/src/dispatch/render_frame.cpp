@@ -62,7 +62,7 @@ std::vector<std::shared_ptr<const Scene::Impl>> levelOfDetail(const Scene::Impl&
     };
     const double sigma = q.pixelFilter > 0 ? q.pixelFilter : Quality::kEwaDefaultSigma;
     const Scene::Impl* level = &scene;
-    if (q.lodAuto) {
+    if (q.lod.kind == LevelOfDetail::Kind::Auto) {
         if (!lodAutoApplies(mode)) return one(scene);
         const int target =
             lodAutoLevel(voxelPixels(camera, *scene.volume), sigma, scene.kernel.variance(), 16);
@@ -73,7 +73,7 @@ std::vector<std::shared_ptr<const Scene::Impl>> levelOfDetail(const Scene::Impl&
         }
         return one(*level);
     }
-    if (q.lodBrick) {
+    if (q.lod.kind == LevelOfDetail::Kind::Brick) {
         if (!lodAutoApplies(mode)) return one(scene);
         auto levels = [&](const BrickDetail* detail) {
             return brickLevels(camera, scene.splats.origin, scene.splats.spacing,
@@ -87,8 +87,8 @@ std::vector<std::shared_ptr<const Scene::Impl>> levelOfDetail(const Scene::Impl&
             return one(scene);
         return scene.lodParts(levels(&scene.brickDetail()));
     }
-    const double lod = q.lod;
-    if (lod > 0)
+    const double lod = q.lod.pixels;
+    if (q.lod.kind == LevelOfDetail::Kind::Pixels)
         while (voxelPixels(camera, *level->volume) < lod) {
             const Scene::Impl* next = level->coarser();
             if (!next) break;
@@ -132,7 +132,7 @@ Image splatParts(const std::vector<std::shared_ptr<const Scene::Impl>>& parts, c
     // like the merged levels, whatever --ewa says (the levels' footprints then carry the same
     // total variance), also where every brick kept level 0.
     RenderSettings filtered = s;
-    if (s.quality.lodBrick && lodAutoApplies(s.mode) &&
+    if (s.quality.lod.kind == LevelOfDetail::Kind::Brick && lodAutoApplies(s.mode) &&
         voxelPixels(camera, *parts.front()->volume) < Quality::kEwaAutoPixels)
         filtered.quality.ewa = Ewa::On;
     if (parts.size() == 1) {

@@ -32,7 +32,7 @@ double ewaLowPass(const Quality& quality, RenderMode mode, const Camera& camera,
 FootprintFilter footprintFilter(const footprint::Kernel& kernel, const Quality& quality,
                                 RenderMode mode, const Camera& camera, const Volume& volume,
                                 int level) {
-    if ((quality.lodAuto || quality.lodBrick) && level > 0) {
+    if (quality.lod.filtered() && level > 0) {
         const LodFootprint f = lodFootprint(
             kernel.variance(), level,
             quality.pixelFilter > 0 ? quality.pixelFilter : Quality::kEwaDefaultSigma,

@@ -61,7 +61,7 @@ struct FootprintFilter {
 /// the modes where it was measured to lower the error against the pixel-filtered reference
 /// (ewaAutoApplies) while a voxel of `volume` (the grid of the splats: a level of detail's)
 /// covers fewer than Quality::kEwaAutoPixels pixels (voxelPixels, model/level_of_detail.h).
-/// A merged level `level` > 0 of `--lod auto` (Quality::lodAuto) is always low-passed (the
+/// A merged level `level` > 0 of `--lod auto` (LevelOfDetail::Kind::Auto) is always low-passed (the
 /// pixel filter, as EWA) and splatted with the kernel of lodFootprint (docs/speed-vs-accuracy.md
 /// "Level of detail": kernel and low-pass together the level-0 kernel plus the pixel filter less
 /// the pyramid's box, not the doubled kernel).

@@ -3,32 +3,16 @@
 // allocate gigabytes or abort the process: every file is first walked here element by
 // element (checkDicomLengths), and every GDCM parse runs in a forked child
 // (survivesInChild) whose death becomes one error line.
-#include <fcntl.h>
 #include <gdcmDicts.h>
 #include <gdcmGlobal.h>
 #include <gdcmTrace.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <cerrno>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
-#include <new>
 
 #include "dicom_detail.h"
-
-#if defined(__SANITIZE_ADDRESS__)
-#define SPLAT_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define SPLAT_ASAN 1
-#endif
-#endif
-#ifndef SPLAT_ASAN
-#define SPLAT_ASAN 0
-#endif
+#include "io/parse_in_child.h"
 
 namespace splat::detail {
 namespace {
@@ -220,67 +204,26 @@ DicomLayout checkDicomLengths(const std::vector<unsigned char>& b, const std::st
     return layout;
 }
 
-/// Runs `work` in a forked child and reports how the child ended. Debian's GDCM keeps its
-/// assertions: a malformed file can abort the process inside gdcm::Reader (SIGABRT from
-/// gdcm::DataSet::ReadNested, FileMetaInformation::ReadCompat, ...). Each GDCM parse is
-/// first tried in a child; a child killed by a signal becomes one error line. Measured
-/// cost: docs/decisions.md (fork per slice of a 500-slice series).
+/// Runs `work` in a forked child (parse_in_child.h) and reports how the child ended. Debian's
+/// GDCM keeps its assertions: a malformed file can abort the process inside gdcm::Reader
+/// (SIGABRT from gdcm::DataSet::ReadNested, FileMetaInformation::ReadCompat, ...). Each GDCM
+/// parse is first tried in a child; a child killed by a signal becomes one error line. GDCM's
+/// recovery heuristics (explicit/implicit mixes, guessed byte orders) can read a length the
+/// element walk never saw and allocate it: the child's address space is capped at its present
+/// size + 1 GiB, and an allocation that fails is reported. A child that exits otherwise (a
+/// sanitizer) leaves the verdict to the parent's own parse. Measured cost: docs/decisions.md
+/// (fork per slice of a 500-slice series).
 void survivesInChild(const std::string& name, const char* what, const std::function<void()>& work) {
-    std::fflush(nullptr);
-    const pid_t pid = fork();
-    if (pid < 0) throw Error(name + ": cannot start a process to parse the DICOM file");
-    if (pid == 0) {
-        alarm(60);  // a parser that hangs is a failure too
-        // GDCM's recovery heuristics (explicit/implicit mixes, guessed byte orders) can read a
-        // length the element walk never saw and allocate it. The child's address space is
-        // capped (its present size + 1 GiB; not under AddressSanitizer, whose shadow memory
-        // needs terabytes of address space), and an allocation that fails ends the child
-        // with status 3, which the parent reports.
-#if !SPLAT_ASAN
-        {
-            long pages = 0;
-            if (FILE* f = std::fopen("/proc/self/statm", "r")) {
-                if (std::fscanf(f, "%ld", &pages) != 1) pages = 0;
-                std::fclose(f);
-            }
-            if (pages > 0) {
-                const rlim_t cap =
-                    rlim_t(pages) * rlim_t(sysconf(_SC_PAGESIZE)) + (rlim_t(1) << 30);
-                const rlimit limit{cap, cap};
-                setrlimit(RLIMIT_AS, &limit);
-            }
-        }
-#endif
-        std::set_new_handler([] { _exit(3); });
-        // GDCM's assertion text is not for the user: the parent prints the one error line.
-        // The host's crash handlers (a test framework's, a fuzzer's) must not report the
-        // child's death as its own: the child dies plainly and quietly.
-        for (int sig : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGALRM}) signal(sig, SIG_DFL);
-        const int null = open("/dev/null", O_WRONLY);
-        if (null >= 0) {
-            dup2(null, 1);
-            dup2(null, 2);
-        }
-        try {
-            work();
-        } catch (...) {
-        }
-        _exit(0);
-    }
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0)
-        if (errno != EINTR) throw Error(name + ": lost the DICOM parsing process");
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 3)
+    const ChildEnd end = runInChild(name, "DICOM", ChildMemory::PresentPlusGiB, work);
+    if (end.kind == ChildEnd::OutOfMemory)
         throw Error(name + ": malformed DICOM file (GDCM " + what +
                     " ran out of memory: a length the file cannot hold)");
-    if (WIFSIGNALED(status)) {
-        const int sig = WTERMSIG(status);
+    if (end.kind == ChildEnd::Signalled)
         throw Error(name + ": malformed DICOM file (GDCM " + what + " died on it with " +
-                    (sig == SIGABRT   ? std::string("SIGABRT, a failed assertion")
-                     : sig == SIGALRM ? std::string("a timeout")
-                                      : "signal " + std::to_string(sig)) +
+                    (end.code == SIGABRT   ? std::string("SIGABRT, a failed assertion")
+                     : end.code == SIGALRM ? std::string("a timeout")
+                                           : "signal " + std::to_string(end.code)) +
                     ")");
-    }
 }
 
 }  // namespace splat::detail

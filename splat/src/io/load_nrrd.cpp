@@ -235,60 +235,30 @@ struct NrrdParsed {
     std::optional<fs::path> dataFile;  ///< detached data
 };
 
-NrrdParsed nrrdParse(const fs::path& p, const LoadOptions& options, const NrrdHeader& header) {
-    const std::string name = displayName(p);
-    const std::map<std::string, std::string>& fields = header.fields;
-    auto field = [&](const char* key) -> std::string {
+/// A header's fields by key, for the steps of nrrdParse.
+struct NrrdFields {
+    const std::map<std::string, std::string>& fields;
+    const std::string& name;
+
+    std::string operator()(const char* key) const {
         auto it = fields.find(key);
         return it == fields.end() ? std::string() : it->second;
-    };
-    auto required = [&](const char* key) {
-        std::string v = field(key);
+    }
+    std::string required(const char* key) const {
+        std::string v = (*this)(key);
         if (v.empty()) throw Error(name + ": NRRD header has no '" + key + "' field");
         return v;
-    };
-
-    auto type = parseSampleType(required("type"));
-    if (!type) throw Error(name + ": unsupported NRRD type '" + field("type") + "'");
-    int dimension = std::atoi(required("dimension").c_str());
-    if (dimension != 2 && dimension != 3 && dimension != 4)
-        throw Error(name + ": NRRD dimension " + field("dimension") +
-                    " not supported (need a 2D or 3D scalar volume, or a 3D time series)");
-    const int spatialAxes = std::min(dimension, 3);
-    std::vector<double> sizes = parseNumbers(required("sizes"), name, "sizes");
-    if (int(sizes.size()) != dimension)
-        throw Error(name + ": 'sizes' has " + std::to_string(sizes.size()) + " entries, " +
-                    "dimension is " + std::to_string(dimension));
-    glm::ivec3 dims(1);
-    for (int a = 0; a < spatialAxes; ++a)
-        dims[a] = dimensionFrom(sizes[a], name, "NRRD sizes", field("sizes"));
-    // Every size check before anything is allocated (64-bit, no wrap).
-    const std::size_t expected = volumeBytes(dims, *type, name);
-    std::vector<std::string> notes;
-    // A 4D NRRD is a time series along its last (slowest) axis: each step is a contiguous
-    // 3D volume. A vector or list axis (kind list, vector, RGB-color, ...) is not one.
-    std::uint64_t steps = 1;
-    if (dimension == 4) {
-        std::istringstream kinds(field("kinds"));
-        std::vector<std::string> kind;
-        for (std::string k; kinds >> k;) kind.push_back(toLower(k));
-        if (!kind.empty() && (kind.size() != 4 || (kind[3] != "time" && kind[3] != "domain" &&
-                                                   kind[3] != "none" && kind[3] != "???")))
-            throw Error(name + ": NRRD 4D data whose last axis is of kind '" +
-                        (kind.size() == 4 ? kind[3] : field("kinds")) +
-                        "': only a time series along the last axis (kind time) is read");
-        steps = std::uint64_t(dimensionFrom(sizes[3], name, "NRRD sizes", field("sizes")));
     }
-    const std::size_t total = std::size_t(checkedMul(expected, steps, name));
-    const std::uint64_t step = timeStep(name, options, steps);
-    if (!options.time && steps > 1)
-        notes.push_back("4D NRRD: only the first of " + std::to_string(steps) +
-                        " time steps was loaded (--time T loads another)");
+};
 
-    // Geometry: space directions (with optional space origin) or per-axis spacings.
+/// The geometry of the header: space directions (with optional space origin) or per-axis
+/// spacings, in RAS; `oriented` when space directions gave it.
+void nrrdGeometry(const NrrdFields& field, int dimension, std::vector<std::string>& notes,
+                  SampleLayout& L, bool& oriented) {
+    const std::string& name = field.name;
+    const int spatialAxes = std::min(dimension, 3);
     glm::dmat3 M(1.0);
     glm::dvec3 t(0.0);
-    bool oriented = false;
     if (!field("space directions").empty() && !field("spacings").empty())
         throw Error(name +
                     ": NRRD header has both 'spacings' and 'space directions' (the format "
@@ -365,74 +335,117 @@ NrrdParsed nrrdParse(const fs::path& p, const LoadOptions& options, const NrrdHe
                             "' is not finite");
         t = spatial(*o[0], space, name, "space origin");
     }
+    L.M = M;
+    L.t = t;
+}
 
+/// A whole number of bytes or lines (NRRD byte skip, line skip) in [lo, 9e15].
+long long nrrdSkip(const NrrdFields& field, const char* key, double lo) {
+    if (field(key).empty()) return 0;
+    std::vector<double> v = parseNumbers(field(key), field.name, key);
+    if (v.size() != 1 || !(v[0] >= lo && v[0] <= 9.0e15) || v[0] != std::floor(v[0]))
+        throw Error(field.name + ": bad NRRD " + key + " '" + field(key) + "'");
+    return (long long)v[0];
+}
+
+/// The encoding, byte order and skips of the samples.
+void nrrdEncoding(const NrrdFields& field, SampleType type, std::vector<std::string>& notes,
+                  NrrdParsed& P) {
+    const std::string& name = field.name;
     std::string encoding = toLower(field("encoding"));
     if (encoding.empty()) encoding = "raw";
-    const bool gzip = encoding == "gzip" || encoding == "gz";
-    const bool bzip2 = encoding == "bzip2" || encoding == "bz2";
-    const bool text = encoding == "text" || encoding == "txt" || encoding == "ascii";
-    const bool hex = encoding == "hex";
-    if (!gzip && !bzip2 && !text && !hex && encoding != "raw")
+    P.gzip = encoding == "gzip" || encoding == "gz";
+    P.bzip2 = encoding == "bzip2" || encoding == "bz2";
+    P.text = encoding == "text" || encoding == "txt" || encoding == "ascii";
+    P.hex = encoding == "hex";
+    if (!P.gzip && !P.bzip2 && !P.text && !P.hex && encoding != "raw")
         throw Error(name + ": unsupported NRRD encoding '" + encoding +
                     "' (the format's five: raw, gzip, bzip2, text, hex)");
+    P.encoding = encoding;
     std::string endian = toLower(field("endian"));
     if (!endian.empty() && endian != "big" && endian != "little")
         throw Error(name + ": bad NRRD endian '" + endian + "'");
-    if (endian.empty() && !text && sampleSize(*type) > 1)
+    if (endian.empty() && !P.text && sampleSize(type) > 1)
         notes.push_back("NRRD header has no 'endian' field: little-endian assumed for its " +
-                        std::to_string(sampleSize(*type)) + "-byte samples");
-    const bool bigEndian = endian == "big";
-    long long byteSkip = 0;
-    if (!field("byte skip").empty()) {
-        std::vector<double> b = parseNumbers(field("byte skip"), name, "byte skip");
-        if (b.size() != 1 || !(b[0] >= -1 && b[0] <= 9.0e15) || b[0] != std::floor(b[0]))
-            throw Error(name + ": bad NRRD byte skip '" + field("byte skip") + "'");
-        byteSkip = (long long)b[0];
-        if (byteSkip == -1 && !(encoding == "raw"))
-            throw Error(name + ": NRRD byte skip -1 is only allowed with raw encoding");
-    }
-    long long lineSkip = 0;
-    if (!field("line skip").empty()) {
-        std::vector<double> l = parseNumbers(field("line skip"), name, "line skip");
-        if (l.size() != 1 || !(l[0] >= 0 && l[0] <= 9.0e15) || l[0] != std::floor(l[0]))
-            throw Error(name + ": bad NRRD line skip '" + field("line skip") + "'");
-        lineSkip = (long long)l[0];
-    }
+                        std::to_string(sampleSize(type)) + "-byte samples");
+    P.layout.bigEndian = endian == "big";
+    P.byteSkip = nrrdSkip(field, "byte skip", -1);
+    if (P.byteSkip == -1 && !(encoding == "raw"))
+        throw Error(name + ": NRRD byte skip -1 is only allowed with raw encoding");
+    P.lineSkip = nrrdSkip(field, "line skip", 0);
+}
 
-    // Where the data is.
-    NrrdParsed P;
+/// Where the data is: a detached data file, or after the header's blank line.
+void nrrdDataFile(const fs::path& p, const LoadOptions& options, const NrrdHeader& header,
+                  const NrrdFields& field, NrrdParsed& P) {
     std::string dataFile = field("data file");
     if (dataFile.empty()) dataFile = field("datafile");
     if (!dataFile.empty()) {
         if (dataFile.rfind("LIST", 0) == 0 || dataFile.find('%') != std::string::npos)
-            throw Error(name + ": multi-file NRRD data ('data file: " + dataFile +
+            throw Error(field.name + ": multi-file NRRD data ('data file: " + dataFile +
                         "') is not supported");
         P.dataFile = resolveDataFile(p, dataFile, options.allowOutsideDataFiles);
     } else if (!header.blankSeen) {
-        throw Error(name + ": NRRD header has no data (no blank line, no 'data file')");
+        throw Error(field.name + ": NRRD header has no data (no blank line, no 'data file')");
     }
-    P.expected = expected;
-    P.total = total;
-    P.step = step;
-    P.gzip = gzip;
-    P.bzip2 = bzip2;
-    P.text = text;
-    P.hex = hex;
-    P.encoding = encoding;
-    P.byteSkip = byteSkip;
-    P.lineSkip = lineSkip;
+}
+
+/// The number of time steps: a 4D NRRD is a time series along its last (slowest) axis, each
+/// step a contiguous 3D volume. A vector or list axis (kind list, vector, RGB-color, ...) is
+/// not one.
+std::uint64_t nrrdSteps(const NrrdFields& field, int dimension, const std::vector<double>& sizes) {
+    if (dimension != 4) return 1;
+    std::istringstream kinds(field("kinds"));
+    std::vector<std::string> kind;
+    for (std::string k; kinds >> k;) kind.push_back(toLower(k));
+    if (!kind.empty() && (kind.size() != 4 || (kind[3] != "time" && kind[3] != "domain" &&
+                                               kind[3] != "none" && kind[3] != "???")))
+        throw Error(field.name + ": NRRD 4D data whose last axis is of kind '" +
+                    (kind.size() == 4 ? kind[3] : field("kinds")) +
+                    "': only a time series along the last axis (kind time) is read");
+    return std::uint64_t(dimensionFrom(sizes[3], field.name, "NRRD sizes", field("sizes")));
+}
+
+NrrdParsed nrrdParse(const fs::path& p, const LoadOptions& options, const NrrdHeader& header) {
+    const std::string name = displayName(p);
+    const NrrdFields field{header.fields, name};
+    auto type = parseSampleType(field.required("type"));
+    if (!type) throw Error(name + ": unsupported NRRD type '" + field("type") + "'");
+    int dimension = std::atoi(field.required("dimension").c_str());
+    if (dimension != 2 && dimension != 3 && dimension != 4)
+        throw Error(name + ": NRRD dimension " + field("dimension") +
+                    " not supported (need a 2D or 3D scalar volume, or a 3D time series)");
+    const int spatialAxes = std::min(dimension, 3);
+    std::vector<double> sizes = parseNumbers(field.required("sizes"), name, "sizes");
+    if (int(sizes.size()) != dimension)
+        throw Error(name + ": 'sizes' has " + std::to_string(sizes.size()) + " entries, " +
+                    "dimension is " + std::to_string(dimension));
+    glm::ivec3 dims(1);
+    for (int a = 0; a < spatialAxes; ++a)
+        dims[a] = dimensionFrom(sizes[a], name, "NRRD sizes", field("sizes"));
+    // Every size check before anything is allocated (64-bit, no wrap).
+    NrrdParsed P;
+    P.expected = volumeBytes(dims, *type, name);
+    std::vector<std::string> notes;
+    const std::uint64_t steps = nrrdSteps(field, dimension, sizes);
+    P.total = std::size_t(checkedMul(P.expected, steps, name));
+    P.step = timeStep(name, options, steps);
+    if (!options.time && steps > 1)
+        notes.push_back("4D NRRD: only the first of " + std::to_string(steps) +
+                        " time steps was loaded (--time T loads another)");
+    bool oriented = false;
+    nrrdGeometry(field, dimension, notes, P.layout, oriented);
+    nrrdEncoding(field, *type, notes, P);
+    nrrdDataFile(p, options, header, field, P);
     SampleLayout& L = P.layout;
     L.dims = dims;
     L.type = *type;
-    L.bigEndian = bigEndian;
-    L.M = M;
-    L.t = t;
     L.orientation = oriented ? "space directions" : "spacings";
     L.name = name;
-    L.source = std::string("NRRD ") + sampleTypeName(*type) + " " + encoding + " (" +
+    L.source = std::string("NRRD ") + sampleTypeName(*type) + " " + P.encoding + " (" +
                p.filename().string() + ")";
     if (steps > 1 && options.time)
-        L.source += ", time step " + std::to_string(step) + " of " + std::to_string(steps);
+        L.source += ", time step " + std::to_string(P.step) + " of " + std::to_string(steps);
     L.exact = steps == 1;  // a step before the last is followed by the others
     L.notes = notes;
     return P;

@@ -2,7 +2,7 @@
 // Error-driven level of detail per brick and view (Laur & Hanrahan, "Hierarchical
 // splatting", SIGGRAPH 1991, with the merged levels filtered as in level_of_detail.h).
 //
-// `--lod brick` (Quality::lodBrick) cuts the level-0 grid into bricks of kLodBrick^3 voxels,
+// `--lod brick` (LevelOfDetail::Kind::Brick) cuts the level-0 grid into bricks of kLodBrick^3 voxels,
 // aligned with the pyramid (a level-L cell, L <= log2 kLodBrick, lies inside one brick), and
 // splats every brick from its own level, each level with its footprint (lodFootprint). In
 // X-ray the image is the sum over splats of their footprints, so a frame mixing levels is the

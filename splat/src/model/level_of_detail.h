@@ -39,7 +39,7 @@ double voxelPixels(const Camera& camera, const Volume& volume);
 /// (0.25 at level 1).
 double lodBoxVariance(int level);
 
-/// `--lod auto` (Quality::lodAuto): how a merged level L is splatted so that it reconstructs
+/// `--lod auto` (LevelOfDetail::Kind::Auto): how a merged level L is splatted so that it reconstructs
 /// the level-0 field low-passed as the pixel-filtered reference sees it. Derivation
 /// (docs/speed-vs-accuracy.md "Level of detail"): level 0 with EWA renders sum_v f_v (h0 * g)(x - x_v) ~ f * h0 * g, h0
 /// the kernel (per-axis variance k^2 = Kernel::variance(), voxels^2) and g the screen

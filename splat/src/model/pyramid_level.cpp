@@ -14,23 +14,29 @@ namespace splat {
 namespace {
 
 /// The level the rule of `q` picks in `mode` from a pyramid whose level l has voxels of
-/// voxelPixels[l] pixels (the one place that reads Quality::lod, lodAuto and lodBrick):
-/// numeric lod: the first level whose voxel covers at least lod pixels (else the last);
-/// auto: lodAutoLevel of level 0's voxel in the modes where it applies; brick (levels per
-/// brick, which the renderer builds from level 0) and off: level 0.
+/// voxelPixels[l] pixels (the one place that reads Quality::lod):
+/// a pixel threshold: the first level whose voxel covers at least that many pixels (else the
+/// last); auto: lodAutoLevel of level 0's voxel in the modes where it applies; brick (levels
+/// per brick, which the renderer builds from level 0) and off: level 0.
 int pyramidLevel(const Quality& q, RenderMode mode, double kernelVariance,
                  const std::vector<double>& voxelPixels) {
     const int last = int(voxelPixels.size()) - 1;
-    if (q.lodAuto) {
+    using Kind = LevelOfDetail::Kind;
+    switch (q.lod.kind) {
+    case Kind::Auto: {
         if (!lodAutoApplies(mode)) return 0;
         const double sigma = q.pixelFilter > 0 ? q.pixelFilter : Quality::kEwaDefaultSigma;
         return lodAutoLevel(voxelPixels[0], sigma, kernelVariance, last);
     }
-    if (q.lodBrick) return 0;
-    int level = 0;
-    if (q.lod > 0)
-        while (level < last && voxelPixels[std::size_t(level)] < q.lod) ++level;
-    return level;
+    case Kind::Pixels: {
+        int level = 0;
+        while (level < last && voxelPixels[std::size_t(level)] < q.lod.pixels) ++level;
+        return level;
+    }
+    case Kind::Off:
+    case Kind::Brick: break;
+    }
+    return 0;
 }
 
 double kernelVarianceOf(const RenderSettings& s) {

@@ -171,7 +171,7 @@ void validateFrame(const RenderSettings& s) {
     if (!(q.earlyTermination >= 0 && q.earlyTermination < 1))
         throw Error("early termination threshold must be in [0, 1)");
     if (q.tileSize < 8 || q.tileSize > 64) throw Error("tile size must be between 8 and 64 pixels");
-    if (!(q.lod >= 0 && q.lod <= 64))
+    if (!(q.lod.pixels >= 0 && q.lod.pixels <= 64))
         throw Error("level of detail threshold must be between 0 (off) and 64 pixels per voxel");
     if (!(q.pixelFilter >= 0 && q.pixelFilter <= 4))
         throw Error("pixel filter sigma must be between 0 (point sampling) and 4 pixels");

@@ -98,13 +98,11 @@ void parseKernelAndColours(const OptionValues& v, RenderSettings& s) {
 
 void parseLevelOfDetail(const std::string& lod, Quality& q) {
     if (lod == "auto") {
-        q.lodAuto = true;
-        q.lod = 0;
+        q.lod = LevelOfDetail::automatic();
         return;
     }
     if (lod == "brick") {
-        q.lodBrick = true;
-        q.lod = 0;
+        q.lod = LevelOfDetail::perBrick();
         return;
     }
     // One message for every value that is not a number: it names the words too.
@@ -118,7 +116,7 @@ void parseLevelOfDetail(const std::string& lod, Quality& q) {
     }
     if (l.size() != 1) throw OptionError(what);
     requireIn(l[0], 0, 64, "--lod (pixels per voxel; 0 = off; or auto or brick)");
-    q.lod = l[0];
+    q.lod = LevelOfDetail::threshold(l[0]);
 }
 
 void parseQuality(const OptionValues& v, RenderSettings& s) {
@@ -437,11 +435,9 @@ void applyOption(RenderSettings& s, std::string_view name, const std::string& te
         q.earlyTermination = pq.earlyTermination;
     else if (name == "tile-size")
         q.tileSize = pq.tileSize;
-    else if (name == "lod") {
+    else if (name == "lod")
         q.lod = pq.lod;
-        q.lodAuto = pq.lodAuto;
-        q.lodBrick = pq.lodBrick;
-    } else if (name == "ewa")
+    else if (name == "ewa")
         q.ewa = pq.ewa;
     else if (name == "pixel-filter")
         q.pixelFilter = pq.pixelFilter;

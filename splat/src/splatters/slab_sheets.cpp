@@ -262,7 +262,7 @@ Image renderBrickedSlabs(
     if (s.clipping.enabled())
         throw Error(
             "--bricks with --renderer sheet: clipping needs --brick-composite fast (approximate)");
-    if (s.quality.lod > 0 || s.quality.lodAuto || s.quality.lodBrick)
+    if (!s.quality.lod.off())
         throw Error(
             "--bricks with --renderer sheet renders full resolution: leave out --lod or use "
             "--brick-composite fast");
