@@ -313,11 +313,11 @@ TEST_CASE("zarr: the default level is the level of detail the view asks for", "[
         s.camera.width = s.camera.height = size;
         s.mode = mode;
         if (lod == "auto")
-            s.quality.lodAuto = true;
+            s.quality.lod = LevelOfDetail::automatic();
         else if (lod == "brick")
-            s.quality.lodBrick = true;
+            s.quality.lod = LevelOfDetail::perBrick();
         else
-            s.quality.lod = std::stod(lod);
+            s.quality.lod = LevelOfDetail::threshold(std::stod(lod));
         return zarrLevelForView(info, s);
     };
     // --lod 2: the first level whose voxel covers 2 pixels, else the coarsest.
@@ -329,7 +329,7 @@ TEST_CASE("zarr: the default level is the level of detail the view asks for", "[
     CHECK(levelAt(16, "0", RenderMode::Dvr) == 0);
     RenderSettings reference;
     reference.camera.width = reference.camera.height = 16;
-    reference.quality.lod = 2;
+    reference.quality.lod = LevelOfDetail::threshold(2);
     reference.renderer = RendererKind::Reference;
     CHECK(zarrLevelForView(info, reference) == 0);
     // --lod auto (xray): level 1 at v0 <= 0.472 pixels, level 2 at v0 <= 0.209.
