@@ -15,17 +15,19 @@
 
 namespace splat::cli {
 
-namespace {
-
-/// The view and quality options of a Gaussian scene, read by the library's option parser as
-/// for a volume (the renderer aside: the Gaussian renderers are not volume renderers).
 RenderSettings gaussianViewOf(const RenderArgs& a) {
     OptionValues values = a.values;
     values.set("renderer", "axis");
     return asOptionUsage([&] { return parseRenderOptions(values); });
 }
 
-}  // namespace
+GaussianRenderOptions gaussianRenderOptions(const CLI::App& cmd, const RenderSettings& view) {
+    GaussianRenderOptions o;
+    o.threads = view.threads;
+    o.slab = given(cmd, "slab") ? view.quality.slab : 0;
+    o.tolerance = view.quality.referenceTolerance;
+    return o;
+}
 
 void printGaussianInfo(const std::string& spec) {
     const GaussianScene s = openGaussians(spec);
@@ -52,14 +54,11 @@ void printGaussianInfo(const std::string& spec) {
 void renderGaussianFile(const CLI::App& cmd, const RenderArgs& args, const std::string& spec,
                         const std::string& output) {
     const RenderSettings view = gaussianViewOf(args);
-    GaussianRenderOptions o;
+    GaussianRenderOptions o = gaussianRenderOptions(cmd, view);
     o.renderer = asUsage([&] {
         return parseGaussianRenderer(given(cmd, "renderer") ? args.values.text("renderer")
                                                             : "3dgs");
     });
-    o.threads = view.threads;
-    o.slab = given(cmd, "slab") ? view.quality.slab : 0;
-    o.tolerance = view.quality.referenceTolerance;
     CameraParams camera = view.camera;
     const GaussianScene scene = openGaussians(spec);
     if (camera.lookAtSet && std::isnan(camera.lookAt.x)) camera.lookAt = scene.geometry().center();

@@ -8,6 +8,8 @@ from numpy.typing import ArrayLike, NDArray
 __version__: str
 
 Progress = Callable[[int, int, str], bool | None]
+# A Gaussian scene where a volume is taken: splat.Gaussians, a .ply path or 'gaussians:NAME'.
+SceneInput = Volume | Gaussians | str
 
 class Error(Exception): ...
 class InputError(Error, ValueError): ...
@@ -119,7 +121,7 @@ def from_nibabel(
 def list_dicom_series(folder: str) -> list[dict[str, Any]]: ...
 def render_options() -> list[str]: ...
 def render(
-    volume: Volume,
+    volume: SceneInput,
     *,
     progress: Progress | None = ...,
     return_stats: bool = ...,
@@ -172,11 +174,11 @@ def render(
 ) -> Any: ...
 
 class Scene:
-    volume: Volume
+    volume: Volume | Gaussians
     options: dict[str, Any]
     def __init__(
         self,
-        volume: Volume,
+        volume: SceneInput,
     mode: str | None = ...,
     classify: str | None = ...,
     tf: str | TransferFunction | ArrayLike | None = ...,
@@ -379,6 +381,8 @@ class PoppingResult:
     @property
     def predicted_switches(self) -> NDArray[np.float64]: ...
     @property
+    def predicted_name(self) -> str: ...
+    @property
     def events(self) -> list[dict[str, Any]]: ...
     @property
     def truth_filter(self) -> float: ...
@@ -387,7 +391,7 @@ class PoppingResult:
     def write_report(self, folder: str, command_line: str = ...) -> None: ...
 
 def popping(
-    volume: Volume,
+    volume: SceneInput,
     *,
     progress: Progress | None = ...,
     from_: float = ...,
@@ -545,6 +549,8 @@ class Gaussians:
         opacities: NDArray[np.float32],
         sh: NDArray[np.float32],
     ) -> None: ...
+    @property
+    def borrowed(self) -> bool: ...
     @property
     def sh_degree(self) -> int: ...
     @property
