@@ -1,6 +1,7 @@
 // splat.Gaussians, splat.load_gaussians and splat.render_gaussians (splat/gaussians.h): 3D
 // Gaussian Splatting scenes from NumPy arrays or .ply files, rendered with the GIL released.
 #include <cstring>
+#include <utility>
 
 #include "py_common.h"
 #include "splat/gaussian_popping.h"
@@ -53,7 +54,8 @@ void checkShape(const py::array& a, std::initializer_list<py::ssize_t> shape, co
 /// normalised (into an owned copy).
 void normaliseRotations(GaussianArray<glm::vec4>& rotations) {
     bool unit = true;
-    for (const glm::vec4& q : rotations) unit = unit && std::abs(glm::length(q) - 1.0f) <= 1e-6f;
+    for (const glm::vec4& q : std::as_const(rotations))  // reading: a borrowed array stays so
+        unit = unit && std::abs(glm::length(q) - 1.0f) <= 1e-6f;
     if (unit) return;
     for (glm::vec4& q : rotations) {
         const float len = glm::length(q);
@@ -139,7 +141,10 @@ GaussianRenderOptions gaussianOptionsOf(const Keywords& k, const RenderSettings&
 py::object renderGaussianFrame(const GaussianScene& scene, Keywords k, const py::object& progress,
                                bool withStats) {
     const std::string renderer = takeKeyword(k, "renderer");
-    const RenderSettings view = parseRenderSettings(k, "", nullptr, true);
+    // The view keywords read as for a volume's sheet renderer, the one that takes slab=.
+    Keywords parse = k;
+    parse.emplace_back("renderer", "sheet");
+    const RenderSettings view = parseRenderSettings(parse, "", nullptr, true);
     GaussianRenderOptions o = gaussianOptionsOf(k, view);
     o.renderer = parseGaussianRenderer(renderer.empty() ? "3dgs" : renderer);
     CameraParams camera = view.camera;

@@ -24,7 +24,7 @@ namespace splat {
 std::vector<GaussianRenderer> parseGaussianRenderers(const std::string& list);
 
 /// The sweep angles in (from, to) where two overlapping Gaussians' centre depths swap (the
-/// pairs above), sorted, to 1e-9 degrees; swaps closer than 1e-6 degrees are one.
+/// pairs above), sorted, to 1e-9 degrees; swaps closer than 1e-4 degrees are one.
 std::vector<double> predictOrderSwaps(const GaussianScene& scene, const Sweep& sweep);
 /// The path positions u (view n at u = n) where two overlapping Gaussians' depths swap.
 std::vector<double> predictOrderSwaps(const GaussianScene& scene, const CameraPath& path);

@@ -88,7 +88,8 @@ DirectionSet swapDirections(const GaussianScene& scene) {
 
 /// The positions in (positions.front(), positions.back()) where the view direction crosses
 /// the plane perpendicular to one of `directions`: sign changes of d . v sampled at 16
-/// sub-steps per interval, bisected to 1e-9; within 1e-6 of each other one.
+/// sub-steps per interval, bisected to 1e-9; within 1e-4 of each other one
+/// (directions rounded to 1e-7 move a swap by up to ~1e-5 degrees).
 std::vector<double> orderSwaps(const GaussianScene& scene, const std::vector<double>& positions,
                                const std::function<CameraParams(double)>& cameraAt) {
     const DirectionSet directions = swapDirections(scene);
@@ -117,7 +118,7 @@ std::vector<double> orderSwaps(const GaussianScene& scene, const std::vector<dou
     std::sort(out.begin(), out.end());
     std::vector<double> merged;
     for (double u : out)
-        if (merged.empty() || u - merged.back() > 1e-6) merged.push_back(u);
+        if (merged.empty() || u - merged.back() > 1e-4) merged.push_back(u);
     return merged;
 }
 
