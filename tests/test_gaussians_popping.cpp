@@ -111,8 +111,7 @@ TEST_CASE("Gaussian popping: order swaps predicted where the centres' depths swa
     CHECK(u[0] == Approx(0.5).margin(1e-8));
 }
 
-TEST_CASE("Gaussian popping: all four renderers in one analysis, by name",
-          "[gaussians][popping]") {
+TEST_CASE("Gaussian popping: all four renderers in one analysis, by name", "[gaussians][popping]") {
     const GaussianScene pop = syntheticGaussians("gaussians:pop");
     Sweep sweep;
     sweep.base.width = sweep.base.height = 40;
@@ -124,8 +123,8 @@ TEST_CASE("Gaussian popping: all four renderers in one analysis, by name",
     PoppingOptions o;
     o.flip = false;
     o.refine = 6;
-    const PoppingResult r =
-        analyzeGaussianPopping(pop, sweep, parseGaussianRenderers("3dgs,3dgs-pixel,sheet,reference"), g, o);
+    const PoppingResult r = analyzeGaussianPopping(
+        pop, sweep, parseGaussianRenderers("3dgs,3dgs-pixel,sheet,reference"), g, o);
     REQUIRE(r.series.size() == 4);
     CHECK(r.series[0].name == "3dgs");
     CHECK(r.series[1].name == "3dgs-pixel");

@@ -51,8 +51,8 @@ std::string nameOf(const RendererSeries& s) {
 
 py::dict eventDict(const PoppingResult& r, const PoppingEvent& e) {
     py::dict d;
-    d["renderer"] = e.series < r.series.size() ? nameOf(r.series[e.series])
-                                               : std::string(toString(e.renderer));
+    d["renderer"] =
+        e.series < r.series.size() ? nameOf(r.series[e.series]) : std::string(toString(e.renderer));
     d["angle_from"] = e.angleFrom;
     d["angle_to"] = e.angleTo;
     d["signal"] = e.signal;

@@ -172,11 +172,12 @@ PoppingResult poppingGaussians(const GaussianScene& scene, Keywords k, const py:
     OptionValues sweepValues(kSweepOptions);
     Sweep sweep;
     PoppingOptions o;
-    const RenderSettings view = parseRenderSettings(
-        k, "", nullptr, false, kSweepOptions, [&](const OptionValues& values, const RenderSettings& s) {
-            sweepValues = values;
-            poppingFrom(values, s, sweep, o);
-        });
+    const RenderSettings view =
+        parseRenderSettings(k, "", nullptr, false, kSweepOptions,
+                            [&](const OptionValues& values, const RenderSettings& s) {
+                                sweepValues = values;
+                                poppingFrom(values, s, sweep, o);
+                            });
     const std::vector<GaussianRenderer> list =
         parseGaussianRenderers(renderers.empty() ? "3dgs,3dgs-pixel,sheet,reference" : renderers);
     const GaussianRenderOptions g = gaussianOptionsOf(k, view);

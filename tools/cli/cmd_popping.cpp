@@ -80,10 +80,10 @@ void printPoppingSummary(const PoppingResult& r) {
         std::printf(
             "event (%s) %.4g..%.4g: signal %.3g; refined to %.3g%s at %.6f: jump "
             "%.3g, slope %.2f (%s)%s%s\n",
-            r.series[e.series].name.c_str(), e.angleFrom, e.angleTo, e.signal, e.refinedWidth,
-            unit, e.refinedAngle, e.refinedJump, e.refinedSlope,
-            std::abs(e.refinedSlope) < 0.25 ? "a discontinuity" : "continuous change",
-            axes.c_str(), e.predicted ? ", predicted" : "");
+            r.series[e.series].name.c_str(), e.angleFrom, e.angleTo, e.signal, e.refinedWidth, unit,
+            e.refinedAngle, e.refinedJump, e.refinedSlope,
+            std::abs(e.refinedSlope) < 0.25 ? "a discontinuity" : "continuous change", axes.c_str(),
+            e.predicted ? ", predicted" : "");
     }
 }
 

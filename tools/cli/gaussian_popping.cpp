@@ -1,5 +1,7 @@
 // `splat popping` of a Gaussian scene (gaussian_scenes.h): the popping analysis with the
 // Gaussian renderers (splat/gaussian_popping.h), the report and the summary as for a volume.
+#include "splat/gaussian_popping.h"
+
 #include <cstdio>
 
 #include "commands.h"
@@ -9,7 +11,6 @@
 #include "resume_journal.h"
 #include "scene_file.h"
 #include "splat/error.h"
-#include "splat/gaussian_popping.h"
 
 namespace splat::cli {
 
@@ -30,7 +31,9 @@ void runGaussianPopping(const CLI::App& cmd, const RenderArgs& render, PoppingAr
     if (given(cmd, "renderer") && !fromScene(cmd, "renderer"))
         warn("--renderer does not apply to popping (it compares --renderers); ignored");
     if (given(cmd, "truth") && !fromScene(cmd, "truth"))
-        warn("--truth does not apply to Gaussian scenes (their reference is point-sampled); ignored");
+        warn(
+            "--truth does not apply to Gaussian scenes (their reference is point-sampled); "
+            "ignored");
     const RenderSettings view = gaussianViewOf(render);
     const std::vector<GaussianRenderer> renderers = gaussianRenderersOf(cmd, popping);
     popping.values.set("renderers", "axis");  // the volume renderers' check passes
@@ -50,14 +53,16 @@ void runGaussianPopping(const CLI::App& cmd, const RenderArgs& render, PoppingAr
     };
     PoppingResult result;
     try {
-        result = popping.path().empty()
-                     ? analyzeGaussianPopping(scene, sweep, renderers, g, o)
-                     : analyzeGaussianPopping(
-                           scene, CameraPath::fromJson(popping.path(), view.camera, popping.frames()),
-                           renderers, g, o);
+        result =
+            popping.path().empty()
+                ? analyzeGaussianPopping(scene, sweep, renderers, g, o)
+                : analyzeGaussianPopping(
+                      scene, CameraPath::fromJson(popping.path(), view.camera, popping.frames()),
+                      renderers, g, o);
     } catch (const Cancelled&) {
         progress.finish();
-        throw Error("interrupted: no report written (--resume finishes it from the frames rendered)");
+        throw Error(
+            "interrupted: no report written (--resume finishes it from the frames rendered)");
     }
     progress.finish();
     writePoppingReport(result, report, commandLine());

@@ -51,7 +51,9 @@ void forEachOverlappingPair(const GaussianScene& scene,
     glm::dvec3 lo, hi;
     scene.bounds(lo, hi);
     const double cell = 2 * rMax;
-    auto cellOf = [&](std::size_t i) { return glm::ivec3(glm::floor((glm::dvec3(scene.means[i]) - lo) / cell)); };
+    auto cellOf = [&](std::size_t i) {
+        return glm::ivec3(glm::floor((glm::dvec3(scene.means[i]) - lo) / cell));
+    };
     auto key = [](const glm::ivec3& c) {
         return (std::uint64_t(std::uint32_t(c.x) & 0x1fffff) << 42) |
                (std::uint64_t(std::uint32_t(c.y) & 0x1fffff) << 21) |
@@ -154,9 +156,9 @@ PoppingOptions gaussianOptions(const GaussianScene& scene,
         const auto t0 = std::chrono::steady_clock::now();
         Image image = renderGaussians(scene, s.camera, g);
         if (stats)
-            stats->milliseconds = std::chrono::duration<double, std::milli>(
-                                      std::chrono::steady_clock::now() - t0)
-                                      .count();
+            stats->milliseconds =
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                    .count();
         return image;
     };
     options.predicted = std::move(predicted);
@@ -210,8 +212,8 @@ std::vector<double> predictOrderSwaps(const GaussianScene& scene, const CameraPa
 PoppingResult analyzeGaussianPopping(const GaussianScene& scene, const Sweep& sweep,
                                      const std::vector<GaussianRenderer>& renderers,
                                      const GaussianRenderOptions& render, PoppingOptions options) {
-    const PoppingOptions o =
-        gaussianOptions(scene, renderers, render, std::move(options), predictOrderSwaps(scene, sweep));
+    const PoppingOptions o = gaussianOptions(scene, renderers, render, std::move(options),
+                                             predictOrderSwaps(scene, sweep));
     return analyzePopping(scene.geometry(), gaussianSettings(sweep.base, render), sweep, o);
 }
 
@@ -219,8 +221,8 @@ PoppingResult analyzeGaussianPopping(const GaussianScene& scene, const CameraPat
                                      const std::vector<GaussianRenderer>& renderers,
                                      const GaussianRenderOptions& render, PoppingOptions options) {
     if (path.views.empty()) throw Error("popping: an empty camera path");
-    const PoppingOptions o =
-        gaussianOptions(scene, renderers, render, std::move(options), predictOrderSwaps(scene, path));
+    const PoppingOptions o = gaussianOptions(scene, renderers, render, std::move(options),
+                                             predictOrderSwaps(scene, path));
     return analyzePopping(scene.geometry(), gaussianSettings(path.views.front(), render), path, o);
 }
 

@@ -407,8 +407,8 @@ std::string metricsCsv(const PoppingResult& r) {
               << csvNumber(r.angles[n + 1]) << ',' << csvNumber(at(x.T, n)) << ','
               << csvNumber(at(x.J, n)) << ',' << csvNumber(at(x.flipT, n)) << ','
               << csvNumber(at(x.e, n)) << ',' << csvNumber(at(x.flipRef, n)) << ','
-              << csvNumber(at(x.signal, n)) << ',' << (isEvent(r, &x, n) ? 1 : 0) << ','
-              << truth << '\n';
+              << csvNumber(at(x.signal, n)) << ',' << (isEvent(r, &x, n) ? 1 : 0) << ',' << truth
+              << '\n';
     if (!r.crossJump.empty())
         for (std::size_t n = 0; n < intervals; ++n)
             s << "axis-sheet," << n << ',' << csvNumber(r.angles[n]) << ','
@@ -494,14 +494,14 @@ std::string headerSection(const PoppingResult& r, const std::string& commandLine
     auto row = [&](const std::string& k, const std::string& v) {
         h << "<tr><td>" << escapeHtml(k) << "</td><td>" << v << "</td></tr>\n";
     };
-    const std::string scene =
-        !r.options.scene.empty()
-            ? r.options.scene
-            : std::string(toString(s.mode)) + ", transfer function " + s.transfer.name + ", " +
-                  toString(s.classification) + "-classified, kernel " + s.kernel;
-    row("scene", escapeHtml(scene + ", " + std::to_string(s.camera.width) + "×" +
-                            std::to_string(s.camera.height) + " pixels, " +
-                            toString(s.camera.projection)));
+    const std::string scene = !r.options.scene.empty()
+                                  ? r.options.scene
+                                  : std::string(toString(s.mode)) + ", transfer function " +
+                                        s.transfer.name + ", " + toString(s.classification) +
+                                        "-classified, kernel " + s.kernel;
+    row("scene",
+        escapeHtml(scene + ", " + std::to_string(s.camera.width) + "×" +
+                   std::to_string(s.camera.height) + " pixels, " + toString(s.camera.projection)));
     if (r.pathViews > 0)
         row("camera path",
             escapeHtml(std::to_string(r.pathViews) +
@@ -513,8 +513,7 @@ std::string headerSection(const PoppingResult& r, const std::string& commandLine
                        " to " + deg(r.sweep.to) + " in steps of " + deg(r.sweep.step) + " (" +
                        std::to_string(r.angles.size()) + " views)"));
     std::string names;
-    for (std::size_t i = 0; i < r.renderers.size(); ++i)
-        names += (i ? ", " : "") + nameOf(r, i);
+    for (std::size_t i = 0; i < r.renderers.size(); ++i) names += (i ? ", " : "") + nameOf(r, i);
     row("renderers", escapeHtml(names));
     if (r.find(RendererKind::Reference))
         row("truth",
@@ -531,19 +530,18 @@ std::string headerSection(const PoppingResult& r, const std::string& commandLine
         std::size_t exact = 0;
         for (std::size_t p : x.exactPixels) exact += p > 0;
         if (exact > 0)
-            row("warning",
-                escapeHtml(seriesName(x) + ": " + std::to_string(exact) +
-                           " of " + std::to_string(x.exactPixels.size()) +
-                           " views are the reference's pixels, not the splatter's (" +
-                           x.exactReason + "); its measures there say nothing"));
+            row("warning", escapeHtml(seriesName(x) + ": " + std::to_string(exact) + " of " +
+                                      std::to_string(x.exactPixels.size()) +
+                                      " views are the reference's pixels, not the splatter's (" +
+                                      x.exactReason + "); its measures there say nothing"));
     }
     row("machine", escapeHtml(cpuModel() + ", " +
                               std::to_string(std::thread::hardware_concurrency()) + " cores"));
     row("date", escapeHtml(nowString()));
     std::string timing = "total " + formatNumber(r.totalMs / 1000.0, 4) + " s";
     for (const RendererSeries& x : r.series)
-        timing += "; " + seriesName(x) + " " + formatNumber(x.msPerFrame, 4) +
-                  " ms/frame, " + formatNumber(x.totalMs / 1000.0, 4) + " s";
+        timing += "; " + seriesName(x) + " " + formatNumber(x.msPerFrame, 4) + " ms/frame, " +
+                  formatNumber(x.totalMs / 1000.0, 4) + " s";
     row("timings", escapeHtml(timing));
     h << "</table>\n<p>Reproduce this report with:</p>\n<pre class=\"command\">"
       << escapeHtml(commandLine) << "</pre>\n";
@@ -556,9 +554,8 @@ std::string summarySection(const PoppingResult& r) {
       << th("median T") << th("flicker ratio") << th("events") << th("median error")
       << th("threshold") << th("ms / frame") << th("total s") << "</tr>\n";
     for (const RendererSeries& x : r.series) {
-        const auto n = std::count_if(r.events.begin(), r.events.end(), [&](const PoppingEvent& e) {
-            return firedBy(r, e) == &x;
-        });
+        const auto n = std::count_if(r.events.begin(), r.events.end(),
+                                     [&](const PoppingEvent& e) { return firedBy(r, e) == &x; });
         h << "<tr>" << td(seriesName(x), true) << td(formatNumber(x.spikeRatio, 4))
           << td(formatNumber(x.medianT, 4)) << td(formatNumber(x.flickerRatio, 4))
           << td(n ? "<span class=\"event-yes\">" + std::to_string(n) + "</span>" : "0")
@@ -603,7 +600,8 @@ std::string plotsSection(const PoppingResult& r) {
                          std::string("event: ") + nameOf(r, e.series) + " [" + deg(e.angleFrom) +
                              ", " + deg(e.angleTo) + "]"});
     std::vector<report::PlotMarker> markers;
-    for (double a : r.predictedSwitches) markers.push_back({a, "predicted " + r.options.predictedName + " " + deg(a)});
+    for (double a : r.predictedSwitches)
+        markers.push_back({a, "predicted " + r.options.predictedName + " " + deg(a)});
     const std::vector<double> mid = midpoints(r.angles);
     const std::string xLabel =
         r.pathViews > 0 ? positionName(r) : std::string(angleName(r.sweep.angle)) + " (degrees)";
@@ -624,8 +622,7 @@ std::string plotsSection(const PoppingResult& r) {
     auto add = [&](report::LinePlot& p, const RendererSeries& x, std::size_t i,
                    const std::vector<double>& xs, const std::vector<double>& ys) {
         if (ys.empty()) return;
-        p.series.push_back(
-            {seriesName(x), seriesColor(r, i), xs, ys, xs.size() < 40, false});
+        p.series.push_back({seriesName(x), seriesColor(r, i), xs, ys, xs.size() < 40, false});
     };
     auto figure = [](const report::LinePlot& p, const std::string& caption) {
         return "<figure>\n" + p.svg() + "<figcaption>" + caption + "</figcaption>\n</figure>\n";
@@ -688,18 +685,10 @@ std::string refinementFigure(const PoppingResult& r, const PoppingEvent& e, bool
     p.logX = p.logY = true;
     p.height = 260;
     for (std::size_t i = 0; i < r.renderers.size(); ++i) {
-        report::PlotSeries c{std::string("T ") + nameOf(r, i),
-                             seriesColor(r, i),
-                             {},
-                             {},
-                             true,
-                             false};
-        report::PlotSeries j{std::string("J ") + nameOf(r, i),
-                             seriesColor(r, i),
-                             {},
-                             {},
-                             true,
-                             true};
+        report::PlotSeries c{
+            std::string("T ") + nameOf(r, i), seriesColor(r, i), {}, {}, true, false};
+        report::PlotSeries j{
+            std::string("J ") + nameOf(r, i), seriesColor(r, i), {}, {}, true, true};
         for (const RefinementStep& st : e.refinement) {
             c.x.push_back(st.width);
             c.y.push_back(at(st.change, i));
@@ -754,8 +743,8 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
     const std::string caption =
         "Event " + std::to_string(index + 1) + ": " + escapeHtml(nameOf(r, e.series)) + " over [" +
         deg(e.angleFrom) + ", " + deg(e.angleTo) + "], signal " + formatNumber(e.signal, 4) +
-        (fired ? " (threshold " + formatNumber(fired->threshold, 4) + ")" : "") +
-        sheetChange(e) + ", " + predicted + ".";
+        (fired ? " (threshold " + formatNumber(fired->threshold, 4) + ")" : "") + sheetChange(e) +
+        ", " + predicted + ".";
     h << "<h3>" << caption << "</h3>\n";
 
     const EventFrames& f = e.frames;
@@ -796,13 +785,11 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
         const std::string name = "event " + std::to_string(index + 1) + " ";
         h << label("before<br>" + deg(e.angleFrom));
         for (std::size_t i = 0; i < R; ++i)
-            h << "<div>"
-              << pngImg(f.before[i], display, "frame", name + nameOf(r, i) + " before")
+            h << "<div>" << pngImg(f.before[i], display, "frame", name + nameOf(r, i) + " before")
               << "</div>";
         h << '\n' << label("after<br>" + deg(e.angleTo));
         for (std::size_t i = 0; i < R; ++i)
-            h << "<div>"
-              << pngImg(f.after[i], display, "frame", name + nameOf(r, i) + " after")
+            h << "<div>" << pngImg(f.after[i], display, "frame", name + nameOf(r, i) + " after")
               << "</div>";
         h << '\n' << label("|after − before|");
         for (std::size_t i = 0; i < R; ++i)
@@ -879,8 +866,7 @@ std::string animationSection(const PoppingResult& r) {
         movie.push_back(std::move(m));
     }
     std::string order;
-    for (int k = 0; k < n; ++k)
-        order += (k ? " | " : "") + seriesName(r.series[k]);
+    for (int k = 0; k < n; ++k) order += (k ? " | " : "") + seriesName(r.series[k]);
     const int fps = std::clamp(int(frames) / 3, 4, 12);
     // Small thumbnails are shown enlarged (whole pixels) to about 480 CSS pixels wide.
     const int scale = std::max(1, 480 / movie[0].width);
