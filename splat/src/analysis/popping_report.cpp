@@ -128,6 +128,11 @@ std::string nameOf(const PoppingResult& r, std::size_t i) {
     return i < r.series.size() ? seriesName(r.series[i]) : std::string(toString(r.renderers[i]));
 }
 
+// What a predicted event is called beside its angle: "switch" (a sheet switch), "order swap".
+std::string eventWord(const PoppingResult& r) {
+    return r.options.predictedName == "sheet switch" ? "switch" : r.options.predictedName;
+}
+
 // "sheet switches", "order swaps".
 std::string plural(const std::string& name) {
     return name + (!name.empty() && name.back() == 'h' ? "es" : "s");
@@ -601,7 +606,7 @@ std::string plotsSection(const PoppingResult& r) {
                              ", " + deg(e.angleTo) + "]"});
     std::vector<report::PlotMarker> markers;
     for (double a : r.predictedSwitches)
-        markers.push_back({a, "predicted " + r.options.predictedName + " " + deg(a)});
+        markers.push_back({a, "predicted " + eventWord(r) + " " + deg(a)});
     const std::vector<double> mid = midpoints(r.angles);
     const std::string xLabel =
         r.pathViews > 0 ? positionName(r) : std::string(angleName(r.sweep.angle)) + " (degrees)";
@@ -738,7 +743,7 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
     std::string predicted = "not predicted";
     for (double a : r.predictedSwitches)
         if (a >= std::min(e.angleFrom, e.angleTo) && a <= std::max(e.angleFrom, e.angleTo))
-            predicted = "predicted " + r.options.predictedName + " at " + deg(a);
+            predicted = "predicted " + eventWord(r) + " at " + deg(a);
     if (e.predicted && predicted == "not predicted") predicted = "predicted";
     const std::string caption =
         "Event " + std::to_string(index + 1) + ": " + escapeHtml(nameOf(r, e.series)) + " over [" +
