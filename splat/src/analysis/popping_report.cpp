@@ -664,7 +664,9 @@ std::string plotsSection(const PoppingResult& r) {
     h << "<h2>Measures along the sweep</h2>\n"
          "<p class=\"note\">Per-interval measures are drawn at the interval's middle, per-view "
          "ones at the view. Shaded bands: detected events; dashed lines: predicted "
-      << escapeHtml(plural(r.options.predictedName)) << ".</p>\n";
+      << escapeHtml(plural(r.options.predictedName))
+      << (r.options.predictedName == "sheet switch" ? " of the axis-aligned splatter" : "")
+      << ".</p>\n";
     h << figure(pT,
                 "T<sub>X</sub>(n) = RMS(I<sub>X</sub>(θ<sub>n+1</sub>) − "
                 "I<sub>X</sub>(θ<sub>n</sub>)): how much each renderer's image changes per "
