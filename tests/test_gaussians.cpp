@@ -224,3 +224,28 @@ TEST_CASE("CLI: Gaussian scenes in info, render and splat gaussians", "[gaussian
     CHECK(s.size() > 10);
     CHECK(s.scales[0].x == Approx(0.65f));
 }
+
+TEST_CASE("CLI: splat popping of a Gaussian scene", "[gaussians][cli][popping]") {
+    using splat::test::runProgram;
+    const std::string dir = splat::test::testTmpDir("gaussians_popping").string();
+    auto r = runProgram(SPLAT_EXE, {"popping", "gaussians:pop", "--from", "-5.5", "--to", "5.5",
+                                    "--step", "1", "--size", "32x32", "--slab", "0.05",
+                                    "--ref-tolerance", "1e-5", "--refine", "4", "--no-flip", "-q",
+                                    "--report", dir});
+    CHECK(r.status == 0);
+    CHECK(r.out.find("predicted order swap at 0.000000 degrees") != std::string::npos);
+    CHECK(r.out.find("event (3dgs) -0.5..0.5") != std::string::npos);
+    CHECK(r.out.find("event (3dgs-pixel) -0.5..0.5") != std::string::npos);
+    CHECK(r.out.find("event (sheet)") == std::string::npos);
+    CHECK(r.out.find("event (reference)") == std::string::npos);
+    const std::string summary = splat::test::readTextFile(dir + "/summary.json");
+    CHECK(summary.find("\"3dgs-pixel\"") != std::string::npos);
+    CHECK(std::filesystem::exists(dir + "/report.html"));
+    CHECK(!std::filesystem::exists(dir + "/.frames"));
+
+    r = runProgram(SPLAT_EXE, {"popping", "gaussians:pop", "--from", "-2.5", "--to", "2.5",
+                               "--step", "1", "--renderers", "3dgs,axis", "--report", dir});
+    CHECK(r.status == 2);
+    REQUIRE(r.errLines().size() == 1);
+    CHECK(r.errLines()[0].find("splat: error: unknown Gaussian renderer") == 0);
+}

@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "splat/gaussian_popping.h"
 #include "splat/gaussians.h"
 #include "splat/popping.h"
 
@@ -75,4 +76,98 @@ TEST_CASE("Gaussian popping: 3dgs-pixel pops too where the Gaussians are isotrop
     int others = 0;
     CHECK(rasterEvents(sweepPop(GaussianRenderer::PixelSorted), others) == 1);
     CHECK(others == 0);
+}
+
+TEST_CASE("Gaussian popping: order swaps predicted where the centres' depths swap",
+          "[gaussians][popping]") {
+    const GaussianScene pop = syntheticGaussians("gaussians:pop");
+    Sweep sweep;
+    sweep.from = -5.5;
+    sweep.to = 185.5;
+    sweep.step = 1;
+    // mu_blue - mu_red = (1.2, 0, 0) is perpendicular to the view (-sin a, cos a, 0) at
+    // azimuth 0 and 180.
+    const std::vector<double> swaps = predictOrderSwaps(pop, sweep);
+    REQUIRE(swaps.size() == 2);
+    CHECK(swaps[0] == Approx(0.0).margin(1e-8));
+    CHECK(swaps[1] == Approx(180.0).margin(1e-8));
+    // At elevation 60 the view still crosses the plane x = 0 at azimuth 0 and 180.
+    sweep.base.elevationDeg = 60;
+    CHECK(predictOrderSwaps(pop, sweep).size() == 2);
+    // Moved apart beyond their footprints (3 sigma each), the two never overlap: no swap.
+    GaussianScene apart = pop;
+    apart.means[0].x = -3.1f;
+    apart.means[1].x = 3.1f;
+    CHECK(predictOrderSwaps(apart, sweep).empty());
+    // A camera path through azimuth 0 (views at u = 0, 1, 2: azimuth -10, 10, 30).
+    CameraPath path;
+    for (double a : {-10.0, 10.0, 30.0}) {
+        CameraParams c;
+        c.azimuthDeg = a;
+        path.views.push_back(c);
+    }
+    const std::vector<double> u = predictOrderSwaps(pop, path);
+    REQUIRE(u.size() == 1);
+    CHECK(u[0] == Approx(0.5).margin(1e-8));
+}
+
+TEST_CASE("Gaussian popping: all four renderers in one analysis, by name", "[gaussians][popping]") {
+    const GaussianScene pop = syntheticGaussians("gaussians:pop");
+    Sweep sweep;
+    sweep.base.width = sweep.base.height = 40;
+    sweep.from = -3.5;
+    sweep.to = 3.5;
+    sweep.step = 1;
+    GaussianRenderOptions g;
+    g.slab = 0.05;
+    PoppingOptions o;
+    o.flip = false;
+    o.refine = 6;
+    const PoppingResult r = analyzeGaussianPopping(
+        pop, sweep, parseGaussianRenderers("3dgs,3dgs-pixel,sheet,reference"), g, o);
+    REQUIRE(r.series.size() == 4);
+    CHECK(r.series[0].name == "3dgs");
+    CHECK(r.series[1].name == "3dgs-pixel");
+    CHECK(r.series[2].name == "sheet");
+    CHECK(r.series[3].name == "reference");
+    REQUIRE(r.predictedSwitches.size() == 1);
+    CHECK(r.predictedSwitches[0] == Approx(0.0).margin(1e-8));
+    CHECK(r.options.predictedName == "order swap");
+    // One event for each rasterizer, at the predicted swap and a discontinuity; none for the
+    // sheets and the reference.
+    std::vector<int> events(4, 0);
+    for (const PoppingEvent& e : r.events) {
+        ++events[e.series];
+        CHECK(e.predicted);
+        CHECK(e.refinedAngle == Approx(0.0).margin(2 * e.refinedWidth));
+        CHECK(std::abs(e.refinedSlope) < 0.2);
+    }
+    CHECK(events == std::vector<int>{1, 1, 0, 0});
+}
+
+TEST_CASE("Gaussian popping: no event where no order swaps", "[gaussians][popping]") {
+    // Azimuth 20..30: the two Gaussians keep their order; the precision floor keeps the
+    // rasterizer's smooth change from being called an event.
+    const GaussianScene pop = syntheticGaussians("gaussians:pop");
+    Sweep sweep;
+    sweep.base.width = sweep.base.height = 32;
+    sweep.from = 20;
+    sweep.to = 30;
+    sweep.step = 1;
+    PoppingOptions o;
+    o.flip = false;
+    GaussianRenderOptions g;
+    g.slab = 0.05;
+    const PoppingResult r =
+        analyzeGaussianPopping(pop, sweep, parseGaussianRenderers("3dgs,sheet,reference"), g, o);
+    CHECK(r.predictedSwitches.empty());
+    CHECK(r.events.empty());
+}
+
+TEST_CASE("Gaussian popping: renderer lists", "[gaussians][popping]") {
+    CHECK(parseGaussianRenderers("reference,3dgs") ==
+          std::vector<GaussianRenderer>{GaussianRenderer::Reference, GaussianRenderer::Rasterizer});
+    CHECK_THROWS_AS(parseGaussianRenderers("3dgs,axis"), Error);
+    CHECK_THROWS_AS(parseGaussianRenderers("3dgs,3dgs"), Error);
+    CHECK_THROWS_AS(parseGaussianRenderers(""), Error);
 }

@@ -52,9 +52,15 @@ py::dict seriesDict(const RendererSeries& s) {
     return d;
 }
 
-py::dict eventDict(const PoppingEvent& e) {
+/// The series' name (PoppingOptions::names, else the kind's).
+std::string nameOf(const RendererSeries& s) {
+    return s.name.empty() ? std::string(toString(s.renderer)) : s.name;
+}
+
+py::dict eventDict(const PoppingResult& r, const PoppingEvent& e) {
     py::dict d;
-    d["renderer"] = toString(e.renderer);
+    d["renderer"] =
+        e.series < r.series.size() ? nameOf(r.series[e.series]) : std::string(toString(e.renderer));
     d["angle_from"] = e.angleFrom;
     d["angle_to"] = e.angleTo;
     d["signal"] = e.signal;
@@ -126,7 +132,7 @@ void bindAnalysis(py::module_& m) {
             "renderers",
             [](const PoppingResult& r) {
                 std::vector<std::string> out;
-                for (RendererKind k : r.renderers) out.push_back(toString(k));
+                for (const RendererSeries& s : r.series) out.push_back(nameOf(s));
                 return out;
             },
             "Renderer names, in the order of the series.")
@@ -134,7 +140,7 @@ void bindAnalysis(py::module_& m) {
             "series",
             [](const PoppingResult& r) {
                 py::dict d;
-                for (const RendererSeries& s : r.series) d[toString(s.renderer)] = seriesDict(s);
+                for (const RendererSeries& s : r.series) d[py::str(nameOf(s))] = seriesDict(s);
                 return d;
             },
             "{renderer: {'T', 'J', 'flip_T' (per interval), 'e', 'flip_ref', 'sheet_axis', "
@@ -148,12 +154,16 @@ void bindAnalysis(py::module_& m) {
         .def_property_readonly(
             "predicted_switches",
             [](const PoppingResult& r) { return doubles(r.predictedSwitches); },
-            "Angles where the axis-aligned splatter's sheet axis changes.")
+            "Angles where the axis-aligned splatter's sheet axis changes (a Gaussian scene: "
+            "where two overlapping Gaussians' centre depths swap; predicted_name says which).")
+        .def_property_readonly(
+            "predicted_name", [](const PoppingResult& r) { return r.options.predictedName; },
+            "What predicted_switches are: 'sheet switch' or 'order swap'.")
         .def_property_readonly(
             "events",
             [](const PoppingResult& r) {
                 py::list out;
-                for (const PoppingEvent& e : r.events) out.append(eventDict(e));
+                for (const PoppingEvent& e : r.events) out.append(eventDict(r, e));
                 return out;
             },
             "The events, as dicts (summary.json's fields, and 'refinement').")

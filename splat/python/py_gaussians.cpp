@@ -1,8 +1,10 @@
 // splat.Gaussians, splat.load_gaussians and splat.render_gaussians (splat/gaussians.h): 3D
 // Gaussian Splatting scenes from NumPy arrays or .ply files, rendered with the GIL released.
 #include <cstring>
+#include <utility>
 
 #include "py_common.h"
+#include "splat/gaussian_popping.h"
 #include "splat/gaussians.h"
 
 namespace splat::python {
@@ -10,52 +12,184 @@ namespace splat::python {
 namespace {
 
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+using Float32C = py::array_t<float, py::array::c_style>;
 
-// Copies an (N, width) float array into `out` (as `count` x `width` floats).
-template <class T>
-void copyRows(const FloatArray& a, std::size_t n, std::size_t width, const char* what,
-              std::vector<T>& out) {
-    if (a.ndim() != 2 || std::size_t(a.shape(0)) != n || std::size_t(a.shape(1)) != width)
-        throw Error(std::string("Gaussians: ") + what + " must have shape (N, " +
-                    std::to_string(width) + ") with N the number of means");
-    out.resize(n);
-    std::memcpy(out.data(), a.data(), n * width * sizeof(float));
+/// Keeps a NumPy array alive for the scene's borrowed arrays; released with the GIL held
+/// (the last copy of a scene may go in a thread that released it).
+std::shared_ptr<const void> keepAlive(const py::array& a) {
+    return std::shared_ptr<const void>(new py::object(a), [](const void* p) {
+        py::gil_scoped_acquire gil;
+        delete static_cast<const py::object*>(p);
+    });
 }
 
-GaussianScene fromArrays(const FloatArray& means, const FloatArray& scales,
-                         const FloatArray& rotations, const FloatArray& opacities,
-                         const FloatArray& sh) {
-    if (means.ndim() != 2 || means.shape(1) != 3)
-        throw Error("Gaussians: means must have shape (N, 3)");
-    const std::size_t n = std::size_t(means.shape(0));
-    GaussianScene s;
-    copyRows(means, n, 3, "means", s.means);
-    copyRows(scales, n, 3, "scales", s.scales);
-    copyRows(rotations, n, 4, "rotations (w, x, y, z)", s.rotations);
-    if (opacities.ndim() != 1 || std::size_t(opacities.shape(0)) != n)
-        throw Error("Gaussians: opacities must have shape (N,)");
-    s.opacities.assign(opacities.data(), opacities.data() + n);
-    if (sh.ndim() != 3 || std::size_t(sh.shape(0)) != n || sh.shape(2) != 3)
-        throw Error("Gaussians: sh must have shape (N, K, 3), K = 1, 4, 9 or 16");
-    const int k = int(sh.shape(1));
-    s.shDegree = k == 1 ? 0 : k == 4 ? 1 : k == 9 ? 2 : k == 16 ? 3 : -1;
-    if (s.shDegree < 0) throw Error("Gaussians: sh must have K = 1, 4, 9 or 16 coefficients");
-    s.sh.assign(sh.data(), sh.data() + n * std::size_t(k) * 3);
-    for (auto& q : s.rotations) {
+/// `a` as `count` values of T (T = `width` floats): borrowed where the array is float32 and
+/// C-contiguous, else converted and copied. Returns whether it was borrowed.
+template <class T>
+bool viewOrCopy(const py::array& a, std::size_t count, GaussianArray<T>& out) {
+    static_assert(sizeof(T) % sizeof(float) == 0);
+    if (Float32C::check_(a)) {
+        out.borrow(reinterpret_cast<const T*>(a.data()), count, keepAlive(a));
+        return true;
+    }
+    const FloatArray f = FloatArray::ensure(a);
+    if (!f) throw Error("Gaussians: the arrays must hold numbers");
+    out.resize(count);
+    std::memcpy(out.data(), f.data(), count * sizeof(T));
+    return false;
+}
+
+/// Throws unless `a` has shape `shape` (-1: any, the first dimension must be n).
+void checkShape(const py::array& a, std::initializer_list<py::ssize_t> shape, const char* what) {
+    bool ok = std::size_t(a.ndim()) == shape.size();
+    std::size_t d = 0;
+    for (py::ssize_t s : shape) {
+        if (ok && s >= 0 && a.shape(d) != s) ok = false;
+        ++d;
+    }
+    if (!ok) throw Error(std::string("Gaussians: ") + what);
+}
+
+/// Quaternions of unit length to float precision are read as they are; others are
+/// normalised (into an owned copy).
+void normaliseRotations(GaussianArray<glm::vec4>& rotations) {
+    bool unit = true;
+    for (const glm::vec4& q : std::as_const(rotations))  // reading: a borrowed array stays so
+        unit = unit && std::abs(glm::length(q) - 1.0f) <= 1e-6f;
+    if (unit) return;
+    for (glm::vec4& q : rotations) {
         const float len = glm::length(q);
         if (!(len > 0)) throw Error("Gaussians: a rotation quaternion is zero");
         q /= len;
     }
+}
+
+/// `o` as a NumPy array (lists and other sequences converted).
+py::array asArray(const py::object& o, const char* what) {
+    py::array a = py::array::ensure(o);
+    if (!a) throw Error(std::string("Gaussians: ") + what + " is not an array of numbers");
+    return a;
+}
+
+GaussianScene fromObjects(const py::object& meansObj, const py::object& scalesObj,
+                          const py::object& rotationsObj, const py::object& opacitiesObj,
+                          const py::object& shObj) {
+    const py::array means = asArray(meansObj, "means"), scales = asArray(scalesObj, "scales"),
+                    rotations = asArray(rotationsObj, "rotations"),
+                    opacities = asArray(opacitiesObj, "opacities"), sh = asArray(shObj, "sh");
+    checkShape(means, {-1, 3}, "means must have shape (N, 3)");
+    const py::ssize_t n = means.shape(0);
+    checkShape(scales, {n, 3}, "scales must have shape (N, 3) with N the number of means");
+    checkShape(rotations, {n, 4},
+               "rotations (w, x, y, z) must have shape (N, 4) with N the number of means");
+    checkShape(opacities, {n}, "opacities must have shape (N,)");
+    checkShape(sh, {n, -1, 3}, "sh must have shape (N, K, 3), K = 1, 4, 9 or 16");
+    const int k = int(sh.shape(1));
+    GaussianScene s;
+    s.shDegree = k == 1 ? 0 : k == 4 ? 1 : k == 9 ? 2 : k == 16 ? 3 : -1;
+    if (s.shDegree < 0) throw Error("Gaussians: sh must have K = 1, 4, 9 or 16 coefficients");
+    const std::size_t count = std::size_t(n);
+    viewOrCopy(means, count, s.means);
+    viewOrCopy(scales, count, s.scales);
+    viewOrCopy(rotations, count, s.rotations);
+    viewOrCopy(opacities, count, s.opacities);
+    viewOrCopy(sh, count * std::size_t(k) * 3, s.sh);
+    normaliseRotations(s.rotations);
     s.source = "NumPy arrays";
     s.validate();
     return s;
 }
 
 template <class T>
-py::array_t<float> rows(const std::vector<T>& v, py::ssize_t width) {
+py::array_t<float> rows(const GaussianArray<T>& v, py::ssize_t width) {
     py::array_t<float> a({py::ssize_t(v.size()), width});
     std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(T));
     return a;
+}
+
+/// The text of keyword `name`, taken out of `k` ("" when absent).
+std::string takeKeyword(Keywords& k, const std::string& name) {
+    std::string text;
+    for (auto it = k.begin(); it != k.end();)
+        if (it->first == name) {
+            text = it->second;
+            it = k.erase(it);
+        } else {
+            ++it;
+        }
+    return text;
+}
+
+bool hasKeyword(const Keywords& k, const std::string& name) {
+    for (const auto& kv : k)
+        if (kv.first == name) return true;
+    return false;
+}
+
+/// The Gaussian renderers' options from a frame's keywords (slab when given, ref_tolerance,
+/// threads), `view` their camera and threads.
+GaussianRenderOptions gaussianOptionsOf(const Keywords& k, const RenderSettings& view) {
+    GaussianRenderOptions o;
+    o.threads = view.threads;
+    o.slab = hasKeyword(k, "slab") ? view.quality.slab : 0;
+    o.tolerance = view.quality.referenceTolerance;
+    return o;
+}
+
+/// splat.render / Scene.render of a Gaussian scene: the render keywords as the CLI's
+/// `splat render scene.ply` reads them (renderer 3dgs, 3dgs-pixel, sheet or reference).
+py::object renderGaussianFrame(const GaussianScene& scene, Keywords k, const py::object& progress,
+                               bool withStats) {
+    const std::string renderer = takeKeyword(k, "renderer");
+    // The view keywords read as for a volume's sheet renderer, the one that takes slab=.
+    Keywords parse = k;
+    parse.emplace_back("renderer", "sheet");
+    const RenderSettings view = parseRenderSettings(parse, "", nullptr, true);
+    GaussianRenderOptions o = gaussianOptionsOf(k, view);
+    o.renderer = parseGaussianRenderer(renderer.empty() ? "3dgs" : renderer);
+    CameraParams camera = view.camera;
+    if (camera.lookAtSet && std::isnan(camera.lookAt.x)) camera.lookAt = scene.geometry().center();
+    Interrupt in(progress);
+    RenderStats stats;
+    Image image = interruptible(in, [&] {
+        const auto t0 = std::chrono::steady_clock::now();
+        Image im = renderGaussians(scene, camera, o);
+        stats.milliseconds =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count();
+        return im;
+    });
+    py::array_t<float> a = toArray(std::move(image));
+    if (!withStats) return a;
+    return py::make_tuple(a, statsDict(stats));
+}
+
+/// splat.popping of a Gaussian scene (splat/gaussian_popping.h): the sweep keywords as the
+/// CLI's, renderers= 3dgs, 3dgs-pixel, sheet, reference (default all four).
+PoppingResult poppingGaussians(const GaussianScene& scene, Keywords k, const py::object& progress) {
+    const std::string renderers = takeKeyword(k, "renderers");
+    takeKeyword(k, "truth");  // the Gaussian reference is point-sampled
+    OptionValues sweepValues(kSweepOptions);
+    Sweep sweep;
+    PoppingOptions o;
+    const RenderSettings view =
+        parseRenderSettings(k, "", nullptr, false, kSweepOptions,
+                            [&](const OptionValues& values, const RenderSettings& s) {
+                                sweepValues = values;
+                                poppingFrom(values, s, sweep, o);
+                            });
+    const std::vector<GaussianRenderer> list =
+        parseGaussianRenderers(renderers.empty() ? "3dgs,3dgs-pixel,sheet,reference" : renderers);
+    const GaussianRenderOptions g = gaussianOptionsOf(k, view);
+    Interrupt in(progress);
+    o.progress = in.progress();
+    return interruptible(in, [&] {
+        const std::string& path = sweepValues.text("path");
+        if (path.empty()) return analyzeGaussianPopping(scene, sweep, list, g, o);
+        return analyzeGaussianPopping(
+            scene, CameraPath::fromJson(path, view.camera, int(sweepValues.integer("frames"))),
+            list, g, o);
+    });
 }
 
 }  // namespace
@@ -65,9 +199,17 @@ void bindGaussians(py::module_& m) {
                               "A 3D Gaussian Splatting scene (splat/gaussians.h): means, scales "
                               "(standard deviations), unit quaternions (w, x, y, z), opacities in "
                               "[0, 1] and SH coefficients (N, K, 3).")
-        .def(py::init(&fromArrays), py::arg("means"), py::arg("scales"), py::arg("rotations"),
+        .def(py::init(&fromObjects), py::arg("means"), py::arg("scales"), py::arg("rotations"),
              py::arg("opacities"), py::arg("sh"))
         .def("__len__", &GaussianScene::size)
+        .def_property_readonly(
+            "borrowed",
+            [](const GaussianScene& s) {
+                return s.means.borrowed() && s.scales.borrowed() && s.rotations.borrowed() &&
+                       s.opacities.borrowed() && s.sh.borrowed();
+            },
+            "True when the scene reads the NumPy arrays it was made from (float32, "
+            "C-contiguous, unit quaternions) without a copy.")
         .def_property_readonly("sh_degree", [](const GaussianScene& s) { return s.shDegree; })
         .def_property_readonly("source", [](const GaussianScene& s) { return s.source; })
         .def_property_readonly("means", [](const GaussianScene& s) { return rows(s.means, 3); })
@@ -109,6 +251,10 @@ void bindGaussians(py::module_& m) {
         },
         py::arg("path"),
         "A 3DGS .ply scene, or a generated one: 'gaussians:pop', 'gaussians:random:N[:SEED]'.");
+    m.def("_render_gaussians", &renderGaussianFrame, py::arg("scene"), py::arg("options"),
+          py::arg("progress"), py::arg("return_stats"));
+    m.def("_popping_gaussians", &poppingGaussians, py::arg("scene"), py::arg("options"),
+          py::arg("progress"));
     m.def(
         "render_gaussians",
         [](const GaussianScene& scene, const std::string& renderer, int width, int height,

@@ -43,3 +43,57 @@ def test_bad_input_is_one_line(tmp_path):
         splat.load_gaussians(str(bad))
     with pytest.raises(splat.FileError):
         splat.load_gaussians(str(tmp_path / "missing.ply"))
+
+
+def _pop_arrays():
+    g = splat.load_gaussians("gaussians:pop")
+    return [np.ascontiguousarray(a, dtype=np.float32)
+            for a in (g.means, g.scales, g.rotations, g.opacities, g.sh)]
+
+
+def test_float32_contiguous_arrays_are_borrowed_not_copied():
+    means, scales, rotations, opacities, sh = _pop_arrays()
+    g = splat.Gaussians(means, scales, rotations, opacities, sh)
+    assert g.borrowed
+    before = splat.render(g, size=(32, 32))
+    # The scene reads the arrays' memory: moving a mean in the array moves the Gaussian.
+    means[0, 2] += 0.5
+    after = splat.render(g, size=(32, 32))
+    assert not np.array_equal(before, after)
+    assert g.means[0, 2] == means[0, 2]
+    # The same scene copied from float64 or strided arrays renders the same image.
+    h = splat.Gaussians(means.astype(np.float64), np.asfortranarray(scales), rotations,
+                        opacities.tolist(), sh)
+    assert not h.borrowed
+    assert np.array_equal(splat.render(h, size=(32, 32)), after)
+
+
+def test_render_and_scene_take_gaussian_scenes(tmp_path):
+    g = splat.load_gaussians("gaussians:pop")
+    ref = splat.render_gaussians(g, renderer="sheet", width=32, height=24, azimuth=30, slab=0.1)
+    img = splat.render(g, renderer="sheet", size=(32, 24), azimuth=30, slab=0.1)
+    assert np.array_equal(img, ref)
+    path = tmp_path / "pop.ply"
+    g.write(str(path))
+    assert np.array_equal(splat.render(str(path), size=(32, 24)),
+                          splat.render_gaussians(g, width=32, height=24))
+    scene = splat.Scene("gaussians:pop", size=(32, 24))
+    assert scene.splat_count == 2
+    assert np.array_equal(scene.render(renderer="sheet", azimuth=30, slab=0.1), ref)
+    frames = list(scene.rotate(3, from_=0, to=20))
+    assert len(frames) == 3
+    assert np.array_equal(frames[2], splat.render(g, size=(32, 24), azimuth=20))
+    with pytest.raises(splat.InputError, match="unknown Gaussian renderer"):
+        splat.render(g, renderer="axis")
+
+
+def test_popping_of_a_gaussian_scene():
+    r = splat.popping(splat.load_gaussians("gaussians:pop"), from_=-5.5, to=5.5, step=1,
+                      size=(32, 32), slab=0.05, ref_tolerance=1e-5, refine=4, no_flip=True)
+    assert r.renderers == ["3dgs", "3dgs-pixel", "sheet", "reference"]
+    assert r.predicted_name == "order swap"
+    assert list(r.predicted_switches) == pytest.approx([0.0], abs=1e-8)
+    assert sorted(e["renderer"] for e in r.events) == ["3dgs", "3dgs-pixel"]
+    assert all(e["predicted"] and abs(e["refined_slope"]) < 0.2 for e in r.events)
+    with pytest.raises(splat.InputError, match="unknown Gaussian renderer"):
+        splat.popping("gaussians:pop", renderers="3dgs,axis")

@@ -15,15 +15,13 @@
 
 namespace splat::cli {
 
-namespace {
-
-/// The view and quality options of a Gaussian scene, read by the library's option parser as
-/// for a volume (the renderer aside: the Gaussian renderers are not volume renderers).
 RenderSettings gaussianViewOf(const RenderArgs& a) {
     OptionValues values = a.values;
     values.set("renderer", "axis");
     return asOptionUsage([&] { return parseRenderOptions(values); });
 }
+
+namespace {
 
 /// Whether the run sets `key` itself: a flag, or a scene's value other than the default (a
 /// written scene holds every option, at its default when the run left it unset).
@@ -32,6 +30,15 @@ bool setByRun(const CLI::App& cmd, const RenderArgs& args, const std::string& ke
 }
 
 }  // namespace
+
+GaussianRenderOptions gaussianRenderOptions(const CLI::App& cmd, const RenderArgs& args,
+                                            const RenderSettings& view) {
+    GaussianRenderOptions o;
+    o.threads = view.threads;
+    o.slab = setByRun(cmd, args, "slab") ? view.quality.slab : 0;
+    o.tolerance = view.quality.referenceTolerance;
+    return o;
+}
 
 void printGaussianInfo(const std::string& spec) {
     const GaussianScene s = openGaussians(spec);
@@ -58,14 +65,11 @@ void printGaussianInfo(const std::string& spec) {
 void renderGaussianFile(const CLI::App& cmd, const RenderArgs& args, const std::string& spec,
                         const std::string& output) {
     const RenderSettings view = gaussianViewOf(args);
-    GaussianRenderOptions o;
+    GaussianRenderOptions o = gaussianRenderOptions(cmd, args, view);
     o.renderer = asUsage([&] {
         return parseGaussianRenderer(setByRun(cmd, args, "renderer") ? args.values.text("renderer")
                                                                      : "3dgs");
     });
-    o.threads = view.threads;
-    o.slab = setByRun(cmd, args, "slab") ? view.quality.slab : 0;
-    o.tolerance = view.quality.referenceTolerance;
     CameraParams camera = view.camera;
     const GaussianScene scene = openGaussians(spec);
     if (camera.lookAtSet && std::isnan(camera.lookAt.x)) camera.lookAt = scene.geometry().center();

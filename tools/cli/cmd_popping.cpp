@@ -13,6 +13,7 @@
 #include "bricked_requests.h"
 #include "commands.h"
 #include "diagnostics.h"
+#include "gaussian_scenes.h"
 #include "parallel.h"
 #include "popping_options.h"
 #include "progress.h"
@@ -26,6 +27,20 @@
 namespace splat::cli {
 
 namespace {
+
+/// The predicted sheet switches (or order swaps): every one up to 20, else the first 10 and
+/// the count.
+void printPredicted(const PoppingResult& r, const char* unit) {
+    const std::vector<double>& p = r.predictedSwitches;
+    const std::string& what = r.options.predictedName;
+    const std::size_t shown = p.size() <= 20 ? p.size() : 10;
+    for (std::size_t i = 0; i < shown; ++i)
+        std::printf("predicted %s at %.6f%s\n", what.c_str(), p[i], unit);
+    if (shown < p.size())
+        std::printf("... %zu predicted %s%s in all (summary.json lists them)\n", p.size(),
+                    what.c_str(), what.back() == 'h' ? "es" : "s");
+}
+
 struct PoppingCommand {
     VolumeArgs volume;
     RenderArgs render;
@@ -42,13 +57,15 @@ std::string warpedColumn(double v) {
     return v >= 0 ? buf : "-";
 }
 
-void printSummary(const PoppingResult& r) {
+}  // namespace
+
+void printPoppingSummary(const PoppingResult& r) {
     std::printf("%-10s %12s %12s %10s %8s %10s %10s %12s\n", "renderer", "spike ratio", "median T",
                 "flicker", "events", "FLIP1 warp", "FLIP7 warp", "ms/frame");
     for (const RendererSeries& s : r.series) {
         int events = 0;
-        for (const PoppingEvent& e : r.events) events += e.renderer == s.renderer;
-        std::printf("%-10s %12.2f %12.3g %10.2f %8d %10s %10s %12.1f\n", toString(s.renderer),
+        for (const PoppingEvent& e : r.events) events += &r.series[e.series] == &s;
+        std::printf("%-10s %12.2f %12.3g %10.2f %8d %10s %10s %12.1f\n", s.name.c_str(),
                     s.spikeRatio, s.medianT, s.flickerRatio, events,
                     warpedColumn(s.flipWarp1Mean).c_str(), warpedColumn(s.flipWarp7Mean).c_str(),
                     s.msPerFrame);
@@ -57,23 +74,27 @@ void printSummary(const PoppingResult& r) {
         std::size_t exact = 0;
         for (std::size_t p : s.exactPixels) exact += p > 0;
         if (exact > 0)
-            warn(std::string(toString(s.renderer)) + ": " + std::to_string(exact) + " of " +
+            warn(s.name + ": " + std::to_string(exact) + " of " +
                  std::to_string(s.exactPixels.size()) +
                  " views handed to the exact path (the reference's pixels): " + s.exactReason);
     }
     // Positions: degrees of a sweep, or view positions of a camera path.
     const char* unit = r.pathViews > 0 ? " (path position)" : " degrees";
-    for (double a : r.predictedSwitches) std::printf("predicted sheet switch at %.6f%s\n", a, unit);
-    for (const PoppingEvent& e : r.events)
+    printPredicted(r, unit);
+    for (const PoppingEvent& e : r.events) {
+        const std::string axes = e.sheetAxisBefore < 0 && e.sheetAxisAfter < 0
+                                     ? ""
+                                     : "; sheet axis " + std::to_string(e.sheetAxisBefore) +
+                                           " -> " + std::to_string(e.sheetAxisAfter);
         std::printf(
             "event (%s) %.4g..%.4g: signal %.3g; refined to %.3g%s at %.6f: jump "
-            "%.3g, slope %.2f (%s); sheet axis %d -> %d%s\n",
-            toString(e.renderer), e.angleFrom, e.angleTo, e.signal, e.refinedWidth, unit,
+            "%.3g, slope %.2f (%s)%s%s\n",
+            r.series[e.series].name.c_str(), e.angleFrom, e.angleTo, e.signal, e.refinedWidth, unit,
             e.refinedAngle, e.refinedJump, e.refinedSlope,
-            std::abs(e.refinedSlope) < 0.25 ? "a discontinuity" : "continuous change",
-            e.sheetAxisBefore, e.sheetAxisAfter, e.predicted ? ", predicted" : "");
+            std::abs(e.refinedSlope) < 0.25 ? "a discontinuity" : "continuous change", axes.c_str(),
+            e.predicted ? ", predicted" : "");
+    }
 }
-}  // namespace
 
 void registerPopping(CLI::App& app) {
     auto a = std::make_shared<PoppingCommand>();
@@ -95,6 +116,9 @@ void registerPopping(CLI::App& app) {
         "  splat popping ch2.nii.gz --tf mri-head --renderers axis,sheet --no-flip --report pop");
     cmd->callback([a, cmd] {
         prepareCommand(*cmd, {"volume", "report"});
+        if (isGaussianScene(a->volume.spec))
+            return runGaussianPopping(*cmd, a->render, a->popping, a->volume.spec, a->report,
+                                      a->quiet, a->resume);
         if (given(*cmd, "renderer") && !fromScene(*cmd, "renderer"))
             warn("--renderer does not apply to popping (it compares --renderers); ignored");
         RenderUse use;
@@ -216,7 +240,7 @@ void registerPopping(CLI::App& app) {
         }
         writePoppingReport(result, a->report, commandLine());
         removeJournal(journal);
-        printSummary(result);
+        printPoppingSummary(result);
         if (!a->quiet) printRankStats(ranks, requests->frames(), "");
         std::printf("wrote %s/report.html, metrics.csv, summary.json (%.1f s)\n", a->report.c_str(),
                     result.totalMs / 1000.0);

@@ -30,6 +30,8 @@
 // on the view (as 3DGS's alpha does): within one frame the field is fixed.
 #include <cstddef>
 #include <glm/glm.hpp>
+#include <initializer_list>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -42,15 +44,108 @@ namespace splat {
 /// Largest number of Gaussians a scene may hold (2^28; 1.6 GiB at SH degree 3).
 inline constexpr std::size_t kMaxGaussians = std::size_t(1) << 28;
 
+/// One per-Gaussian array of a scene: owned (a std::vector), or borrowed — memory of the
+/// caller's (e.g. NumPy arrays behind splat.Gaussians) kept alive by an owner handle. Reading
+/// never copies; the first write to a borrowed array copies it into an owned one. Copies of a
+/// scene share borrowed memory and copy owned arrays.
+template <class T>
+class GaussianArray {
+  public:
+    GaussianArray() = default;
+    GaussianArray(std::initializer_list<T> v) : own_(v) {}
+    GaussianArray(const GaussianArray& o) : own_(o.own_), owner_(o.owner_) {
+        borrowedData_ = o.borrowedData_;
+        borrowedSize_ = o.borrowedSize_;
+    }
+    GaussianArray(GaussianArray&& o) noexcept = default;
+    GaussianArray& operator=(const GaussianArray& o) {
+        if (this != &o) *this = GaussianArray(o);
+        return *this;
+    }
+    GaussianArray& operator=(GaussianArray&& o) noexcept = default;
+    GaussianArray& operator=(std::initializer_list<T> v) {
+        release();
+        own_ = v;
+        return *this;
+    }
+
+    /// Borrows `count` values at `data`, which `owner` keeps alive and unchanged while this
+    /// array (or a copy of it) reads them.
+    void borrow(const T* data, std::size_t count, std::shared_ptr<const void> owner) {
+        own_.clear();
+        own_.shrink_to_fit();
+        borrowedData_ = data;
+        borrowedSize_ = count;
+        owner_ = std::move(owner);
+    }
+    bool borrowed() const { return owner_ != nullptr; }
+
+    std::size_t size() const { return borrowed() ? borrowedSize_ : own_.size(); }
+    bool empty() const { return size() == 0; }
+    const T* data() const { return borrowed() ? borrowedData_ : own_.data(); }
+    const T& operator[](std::size_t i) const { return data()[i]; }
+    const T* begin() const { return data(); }
+    const T* end() const { return data() + size(); }
+    const T& front() const { return data()[0]; }
+    const T& back() const { return data()[size() - 1]; }
+
+    /// Writing access: the owned vector (a borrowed array is copied first).
+    std::vector<T>& vector() {
+        release();
+        return own_;
+    }
+    T* data() { return vector().data(); }
+    T& operator[](std::size_t i) { return vector()[i]; }
+    T* begin() { return data(); }
+    T* end() { return data() + size(); }
+    void resize(std::size_t n, const T& v = T()) { vector().resize(n, v); }
+    void reserve(std::size_t n) { vector().reserve(n); }
+    void push_back(const T& v) { vector().push_back(v); }
+    void assign(std::size_t n, const T& v) { vector().assign(n, v); }
+    template <class It>
+    void assign(It first, It last) {
+        vector().assign(first, last);
+    }
+    /// Inserts [first, last) before `at` (a position of this array).
+    template <class It>
+    void insert(const T* at, It first, It last) {
+        const std::ptrdiff_t offset = at - static_cast<const GaussianArray&>(*this).data();
+        std::vector<T>& v = vector();
+        v.insert(v.begin() + offset, first, last);
+    }
+    void clear() { vector().clear(); }
+
+    friend bool operator==(const GaussianArray& a, const GaussianArray& b) {
+        if (a.size() != b.size()) return false;
+        for (std::size_t i = 0; i < a.size(); ++i)
+            if (!(a[i] == b[i])) return false;
+        return true;
+    }
+
+  private:
+    /// A borrowed array becomes an owned copy.
+    void release() {
+        if (!borrowed()) return;
+        own_.assign(borrowedData_, borrowedData_ + borrowedSize_);
+        owner_.reset();
+        borrowedData_ = nullptr;
+        borrowedSize_ = 0;
+    }
+    std::vector<T> own_;
+    const T* borrowedData_ = nullptr;
+    std::size_t borrowedSize_ = 0;
+    std::shared_ptr<const void> owner_;
+};
+
 struct GaussianScene {
-    std::vector<glm::vec3> means;      ///< world positions
-    std::vector<glm::vec3> scales;     ///< standard deviations along the local axes (> 0)
-    std::vector<glm::vec4> rotations;  ///< unit quaternions (w, x, y, z)
-    std::vector<float> opacities;      ///< in [0, 1]
+    GaussianArray<glm::vec3> means;      ///< world positions
+    GaussianArray<glm::vec3> scales;     ///< standard deviations along the local axes (> 0)
+    GaussianArray<glm::vec4> rotations;  ///< unit quaternions (w, x, y, z)
+    GaussianArray<float> opacities;      ///< in [0, 1]
     int shDegree = 0;                  ///< 0..3
     /// SH coefficients, shCount() x 3 floats per Gaussian: coefficient k of channel c of
     /// Gaussian i at sh[(i * shCount() + k) * 3 + c] (k = 0 is the file's f_dc).
-    std::vector<float> sh;
+    GaussianArray<float> sh;
     std::string source;  ///< how it was obtained, e.g. "3DGS PLY (scene.ply)"
 
     std::size_t size() const { return means.size(); }

@@ -25,6 +25,7 @@
 // linearly with it (fitted slope ~1 on log-log axes). Flicker is fast but continuous
 // change: the ratio of a renderer's median T to the reference's.
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -87,6 +88,23 @@ struct PoppingOptions {
     /// rendered through it, one after another (parallelFrames does not apply). The findings
     /// depend only on the images.
     std::function<Image(const RenderSettings&, RenderStats*)> renderFrame;
+    /// The renderers' names in the report, summary.json, metrics.csv and the journal
+    /// (`renderers` order; empty: their kinds' names). Named renderers may share a kind (the
+    /// kind is their role: Reference the truth, Axis and Sheet the cross jump's pair), e.g. a
+    /// Gaussian scene's 3dgs and 3dgs-pixel both as Axis (splat/gaussian_popping.h); their
+    /// frames come from renderNamed.
+    std::vector<std::string> names;
+    /// Renders one frame of renderer `index` (into `renderers`); set, it is used instead of
+    /// renderFrame, as renderFrame is.
+    std::function<Image(std::size_t index, const RenderSettings&, RenderStats*)> renderNamed;
+    /// The positions where a renderer is predicted to pop, and what the report calls them,
+    /// instead of the axis-aligned splatter's sheet switches (e.g. a Gaussian scene's order
+    /// swaps, predictOrderSwaps in splat/gaussian_popping.h).
+    std::optional<std::vector<double>> predicted;
+    std::string predictedName = "sheet switch";
+    /// How the report describes the scene (empty: the settings' mode, transfer function,
+    /// classification and kernel).
+    std::string scene;
     /// The reference e, J and flipRef are measured against (truthFilter, splat/render.h):
     /// auto (the default) the pixel-filtered reference where the splatters' frames are
     /// filtered (EWA on at some view of the sweep, e.g. X-ray below a pixel per voxel, or a
@@ -113,6 +131,7 @@ struct EventFrames {
 
 struct PoppingEvent {
     RendererKind renderer = RendererKind::Axis;  ///< whose signal fired
+    std::size_t series = 0;                      ///< its index in PoppingResult::series
     double angleFrom = 0, angleTo = 0;           ///< the sweep interval
     double signal = 0;                           ///< J (or C, or T) over it
     /// Refinement: the change at the finest width, the finest width, and the slope of
@@ -129,6 +148,7 @@ struct PoppingEvent {
 /// Everything measured for one renderer over the sweep.
 struct RendererSeries {
     RendererKind renderer = RendererKind::Axis;
+    std::string name;  ///< PoppingOptions::names, else the kind's name
     /// Per interval n (angles.size() - 1 entries).
     std::vector<double> T, J, flipT;
     /// StopThePop's FLIP_1 per interval n (frame n warped to n + 1) and FLIP_7 per pair
@@ -166,7 +186,9 @@ struct PoppingResult {
     std::vector<double> angles;
     std::vector<RendererSeries> series;     ///< renderers order
     std::vector<double> crossJump;          ///< C per interval (axis and sheet both present)
-    std::vector<double> predictedSwitches;  ///< angles where the sheet axis changes
+    /// Angles where the sheet axis changes, or PoppingOptions::predicted (options.predictedName
+    /// says which).
+    std::vector<double> predictedSwitches;
     std::vector<PoppingEvent> events;
     /// The pixel filter sigma of the reference's frames, pixels: 0 the point-sampled
     /// reference (one ray per pixel centre), > 0 the pixel-filtered one (PoppingOptions::truth).

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import numbers
+import os
 import warnings
 
 import numpy as np
@@ -161,7 +162,31 @@ def from_nibabel(img, *, background_value: float | None = None,
                                background_value, nan_policy)
 
 
+def _is_gaussians(scene) -> bool:
+    """A Gaussians, or the path of a .ply or a 'gaussians:NAME' generator."""
+    if isinstance(scene, Gaussians):
+        return True
+    if isinstance(scene, (str, os.PathLike)):
+        name = os.fspath(scene)
+        return name.lower().endswith(".ply") or name.startswith("gaussians:")
+    return False
+
+
+def _gaussians(scene) -> Gaussians:
+    return scene if isinstance(scene, Gaussians) else load_gaussians(os.fspath(scene))
+
+
+def _gaussian_argv(options: dict) -> list[tuple[str, str]]:
+    argv, tf_json = _argv(options)
+    if tf_json:
+        raise InputError("tf= does not apply to a Gaussian scene (its colours are its own)")
+    return argv
+
+
 def render(volume: Volume, *, progress=None, return_stats: bool = False, **options):
+    if _is_gaussians(volume):
+        return _splat._render_gaussians(_gaussians(volume), _gaussian_argv(options), progress,
+                                        return_stats)
     argv, tf_json = _argv(options)
     return _splat._render(volume, argv, tf_json, progress, return_stats)
 
@@ -172,6 +197,9 @@ render.__doc__ = f"""render(volume, *, progress=None, return_stats=False, **opti
 
 One frame: an H x W x 4 float32 array (premultiplied RGBA, row 0 on top), the pixels of
 `splat render VOLUME [options] -o x.exr`. return_stats=True: (image, stats dict).
+volume may be a Gaussian scene (splat.Gaussians, a .ply path or 'gaussians:NAME'): renderer
+3dgs (default), 3dgs-pixel, sheet or reference, the camera options, slab (world units),
+ref_tolerance and threads apply.
 progress: callable(done, total, what) -> bool|None; False stops (splat.Cancelled).
 Options (the CLI's render options):
 {_RENDER_DOC}
@@ -243,8 +271,14 @@ class Scene:
     needs a new Scene). Thread-safe: several threads may render one Scene at once."""
 
     def __init__(self, volume: Volume, **options):
-        self.volume = volume
         self.options = dict(options)
+        if _is_gaussians(volume):
+            # A Gaussian scene has no view-independent state to build: frames render from it.
+            self.volume = _gaussians(volume)
+            _gaussian_argv(self.options)  # refuse what cannot apply, now
+            self._scene = None
+            return
+        self.volume = volume
         argv, tf_json = _argv(self.options)
         self._scene = _splat._Scene(volume, argv, tf_json)
 
@@ -254,12 +288,18 @@ class Scene:
     def render(self, *, progress=None, return_stats: bool = False, **frame):
         """One frame from the Scene; keyword arguments as splat.render's override the
         Scene's for this frame."""
+        if self._scene is None:
+            return _splat._render_gaussians(self.volume,
+                                            _gaussian_argv({**self.options, **frame}), progress,
+                                            return_stats)
         argv, tf_json = self._frame(frame)
         return self._scene.render(argv, tf_json, progress, return_stats, False)
 
     def iso_depth(self, *, progress=None, **frame) -> np.ndarray:
         """Iso mode: per pixel the world distance to the first hit of the level (H x W;
         NaN where the ray misses)."""
+        if self._scene is None:
+            raise InputError("iso_depth applies to volumes, not Gaussian scenes")
         argv, tf_json = self._frame(frame)
         image = self._scene.render(argv, tf_json, progress, False, True)
         depth = image[..., 0].copy()
@@ -275,19 +315,37 @@ class Scene:
         in order, rendered `batch` views at a time."""
         if to is None:
             to = from_ + 360.0 * (int(frames) - 1) / max(1, int(frames))
+        if self._scene is None:
+            yield from self._rotate_gaussians(int(frames), float(from_), float(to), sweep, path,
+                                              progress)
+            return
         for first in range(0, int(frames), max(1, int(batch))):
             yield from self._scene.sequence(sweep, float(from_), float(to), int(frames),
                                             path or "", int(parallel_frames), first,
                                             max(1, int(batch)), progress)
 
+    def _rotate_gaussians(self, frames, from_, to, sweep, path, progress):
+        if path:
+            raise InputError("rotate(path=) applies to volumes; render a Gaussian scene's "
+                             "views with render(azimuth=..., elevation=...)")
+        if sweep not in ("azimuth", "elevation"):
+            raise InputError("--sweep must be azimuth or elevation")
+        for n in range(frames):
+            angle = from_ + (to - from_) * n / (frames - 1) if frames > 1 else from_
+            yield self.render(progress=progress, **{sweep: angle})
+
     @property
     def splat_count(self) -> int:
-        """Splats the classification kept."""
+        """Splats the classification kept (a Gaussian scene: its Gaussians)."""
+        if self._scene is None:
+            return len(self.volume)
         return self._scene.splat_count
 
     @property
     def transfer(self) -> TransferFunction:
         """The transfer function, resolved to absolute densities."""
+        if self._scene is None:
+            raise InputError("a Gaussian scene has no transfer function")
         return self._scene.transfer
 
 
@@ -318,6 +376,8 @@ def compare(test, reference, *, flip: bool = True, ppd: float = 67.0206432765822
 
 
 def popping(volume: Volume, *, progress=None, **options) -> PoppingResult:
+    if _is_gaussians(volume):
+        return _splat._popping_gaussians(_gaussians(volume), _gaussian_argv(options), progress)
     argv, tf_json = _argv(options)
     return _splat._popping(volume, argv, tf_json, progress)
 
@@ -329,6 +389,9 @@ per interval, finds and refines events. Sweep options (`from` is written from_):
 """ + "\n".join(f"  {k.replace('-', '_') + ('_' if k == 'from' else '')}: {h}"
                 for k, h in _splat._popping_options()) + f"""
 Render options as splat.render's (renderer is replaced by renderers=).
+volume may be a Gaussian scene (splat.Gaussians, a .ply path or 'gaussians:NAME'):
+renderers= 3dgs, 3dgs-pixel, sheet, reference (default all four); the events are predicted
+where two overlapping Gaussians' centre depths swap (result.predicted_switches).
 result.write_report(folder) writes report.html, metrics.csv and summary.json.
 """
 

@@ -8,6 +8,8 @@ from numpy.typing import ArrayLike, NDArray
 __version__: str
 
 Progress = Callable[[int, int, str], bool | None]
+# A Gaussian scene where a volume is taken: splat.Gaussians, a .ply path or 'gaussians:NAME'.
+SceneInput = Volume | Gaussians | str
 
 class Error(Exception): ...
 class InputError(Error, ValueError): ...
@@ -125,7 +127,7 @@ def render_scene(
 ) -> Any: ...
 def save_scene(path: str, volume: str, *, command: str = ..., **options: Any) -> None: ...
 def render(
-    volume: Volume,
+    volume: SceneInput,
     *,
     progress: Progress | None = ...,
     return_stats: bool = ...,
@@ -179,11 +181,11 @@ def render(
 ) -> Any: ...
 
 class Scene:
-    volume: Volume
+    volume: Volume | Gaussians
     options: dict[str, Any]
     def __init__(
         self,
-        volume: Volume,
+        volume: SceneInput,
     mode: str | None = ...,
     classify: str | None = ...,
     tf: str | TransferFunction | ArrayLike | None = ...,
@@ -389,6 +391,8 @@ class PoppingResult:
     @property
     def predicted_switches(self) -> NDArray[np.float64]: ...
     @property
+    def predicted_name(self) -> str: ...
+    @property
     def events(self) -> list[dict[str, Any]]: ...
     @property
     def truth_filter(self) -> float: ...
@@ -397,7 +401,7 @@ class PoppingResult:
     def write_report(self, folder: str, command_line: str = ...) -> None: ...
 
 def popping(
-    volume: Volume,
+    volume: SceneInput,
     *,
     progress: Progress | None = ...,
     from_: float = ...,
@@ -557,6 +561,8 @@ class Gaussians:
         opacities: NDArray[np.float32],
         sh: NDArray[np.float32],
     ) -> None: ...
+    @property
+    def borrowed(self) -> bool: ...
     @property
     def sh_degree(self) -> int: ...
     @property

@@ -51,6 +51,19 @@ double robustThreshold(const std::vector<double>& s, double k, double floorRatio
     return std::max(med + k * mad, floorRatio * med);
 }
 
+/// The renderers' names: PoppingOptions::names (one per renderer), else the kinds' names.
+std::vector<std::string> rendererNames(const PoppingOptions& options) {
+    if (options.names.empty()) {
+        std::vector<std::string> out;
+        for (RendererKind k : options.renderers) out.push_back(toString(k));
+        return out;
+    }
+    if (options.names.size() != options.renderers.size())
+        throw Error("popping: " + std::to_string(options.names.size()) + " names for " +
+                    std::to_string(options.renderers.size()) + " renderers");
+    return options.names;
+}
+
 /// One view rendered by every renderer.
 struct View {
     std::vector<Image> images;
@@ -71,18 +84,21 @@ class Analyzer {
           sweep_(sweep),
           pathViews_(pathViews),
           positions_(std::move(positions)),
-          predicted_(std::move(predicted)),
+          predicted_(options.predicted ? *options.predicted : std::move(predicted)),
           cameraAt_(std::move(cameraAt)),
           options_(options),
           temporal_(options, geometry, scene) {
         kinds_ = options.renderers;
         if (kinds_.empty()) throw Error("popping: no renderer to analyse");
-        if (!scene_ && !options.renderFrame) throw Error("popping: no Scene and no renderFrame");
+        if (!scene_ && !options.renderFrame && !options.renderNamed)
+            throw Error("popping: no Scene and no renderFrame");
+        names_ = rendererNames(options);
         for (std::size_t i = 0; i < kinds_.size(); ++i)
             for (std::size_t j = 0; j < i; ++j)
-                if (kinds_[i] == kinds_[j])
-                    throw Error(std::string("popping: renderer '") + toString(kinds_[i]) +
-                                "' listed twice");
+                if (names_[i] == names_[j])
+                    throw Error("popping: renderer '" + names_[i] + "' listed twice");
+        if (std::count(kinds_.begin(), kinds_.end(), RendererKind::Reference) > 1)
+            throw Error("popping: more than one renderer in the reference's role");
         ref_ = indexOf(RendererKind::Reference);
         axis_ = indexOf(RendererKind::Axis);
         sheet_ = indexOf(RendererKind::Sheet);
@@ -111,7 +127,10 @@ class Analyzer {
         totalUnits_ = views * kinds_.size();
         const CameraParams& base = cameraAt_(r.angles.front());
         r.series.resize(kinds_.size());
-        for (std::size_t k = 0; k < kinds_.size(); ++k) r.series[k].renderer = kinds_[k];
+        for (std::size_t k = 0; k < kinds_.size(); ++k) {
+            r.series[k].renderer = kinds_[k];
+            r.series[k].name = names_[k];
+        }
 
         std::vector<std::vector<double>> frameMs(kinds_.size());
         CameraPath path;
@@ -158,7 +177,7 @@ class Analyzer {
         // for; else, and with renderFrame, every view by renderView, below.
         const bool sceneTruth =
             ref_ < 0 || (scene_ && scene_->settings().quality.pixelFilter == truthFilter_);
-        if (!options_.renderFrame && sceneTruth)
+        if (!options_.renderFrame && !options_.renderNamed && sceneTruth)
             renderSequence(*scene_, kinds_, path, so, [&](SequenceFrame&& f) {
                 readUpTo(f.view);
                 View cur{std::move(f.images), std::move(f.stats)};
@@ -299,6 +318,7 @@ class Analyzer {
     PoppingEvent event(const PoppingResult& r, std::size_t k, std::size_t n) {
         PoppingEvent ev;
         ev.renderer = kinds_[k];
+        ev.series = k;
         ev.angleFrom = r.angles[n];
         ev.angleTo = r.angles[n + 1];
         ev.signal = r.series[k].signal[n];
@@ -355,7 +375,7 @@ class Analyzer {
         std::uint64_t bits;
         std::memcpy(&bits, &angle, sizeof bits);
         char name[64];
-        std::snprintf(name, sizeof name, "%s_%016llx.frame", toString(kinds_[k]),
+        std::snprintf(name, sizeof name, "%s_%016llx.frame", names_[k].c_str(),
                       static_cast<unsigned long long>(bits));
         return std::filesystem::path(options_.frameJournal) / name;
     }
@@ -393,11 +413,12 @@ class Analyzer {
             const std::filesystem::path file = journaling ? journalFile(angle, k) : "";
             if (!journaling || !journal::loadFrame(file, s.camera.width, s.camera.height,
                                                    v.images[k], v.stats[k])) {
-                v.images[k] = options_.renderFrame ? options_.renderFrame(s, &v.stats[k])
-                                                   : scene_->render(s, &v.stats[k]);
+                v.images[k] = options_.renderNamed   ? options_.renderNamed(k, s, &v.stats[k])
+                              : options_.renderFrame ? options_.renderFrame(s, &v.stats[k])
+                                                     : scene_->render(s, &v.stats[k]);
                 if (journaling) journal::storeFrame(file, v.images[k], v.stats[k]);
             }
-            report(std::string(toString(kinds_[k])) + " at " + std::to_string(angle));
+            report(names_[k] + " at " + std::to_string(angle));
         }
         if (cancelled_) throw Cancelled();
         return v;
@@ -454,6 +475,7 @@ class Analyzer {
     std::function<CameraParams(double)> cameraAt_;
     const PoppingOptions& options_;
     std::vector<RendererKind> kinds_;
+    std::vector<std::string> names_;  ///< PoppingOptions::names, else the kinds' names
     int ref_ = -1, axis_ = -1, sheet_ = -1;
     double truthFilter_ = 0;  ///< the reference's pixel filter (PoppingOptions::truth)
     std::size_t done_ = 0, totalUnits_ = 0;

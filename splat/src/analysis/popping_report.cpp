@@ -102,6 +102,13 @@ std::string sheetName(int axis, int sign) {
     return s + "ijk"[axis];
 }
 
+// ", sheet axis +i → +j" of an event, or nothing where no sheet axis was recorded.
+std::string sheetChange(const PoppingEvent& e) {
+    if (e.sheetAxisBefore < 0 && e.sheetAxisAfter < 0) return "";
+    return ", sheet axis " + sheetName(e.sheetAxisBefore, e.sheetSignBefore) + " → " +
+           sheetName(e.sheetAxisAfter, e.sheetSignAfter);
+}
+
 std::string rendererColor(RendererKind k, std::size_t index) {
     switch (k) {
         case RendererKind::Axis:
@@ -114,15 +121,47 @@ std::string rendererColor(RendererKind k, std::size_t index) {
     return "#7f7f7f";
 }
 
+// The series whose signal fired event `e`.
+const RendererSeries* firedBy(const PoppingResult& r, const PoppingEvent& e) {
+    return e.series < r.series.size() ? &r.series[e.series] : nullptr;
+}
+
+// The report's name of a renderer: PoppingOptions::names, else its kind's name.
+std::string seriesName(const RendererSeries& x) {
+    return x.name.empty() ? std::string(toString(x.renderer)) : x.name;
+}
+std::string nameOf(const PoppingResult& r, std::size_t i) {
+    return i < r.series.size() ? seriesName(r.series[i]) : std::string(toString(r.renderers[i]));
+}
+
+// What a predicted event is called beside its angle: "switch" (a sheet switch), "order swap".
+std::string eventWord(const PoppingResult& r) {
+    return r.options.predictedName == "sheet switch" ? "switch" : r.options.predictedName;
+}
+
+// "sheet switches", "order swaps".
+std::string plural(const std::string& name) {
+    return name + (!name.empty() && name.back() == 'h' ? "es" : "s");
+}
+
+// Renderer i's colour; a second renderer of the same kind (named renderers) gets the kind's
+// other colour.
+std::string seriesColor(const PoppingResult& r, std::size_t i) {
+    std::size_t index = i;
+    for (std::size_t j = 0; j < i; ++j)
+        if (r.renderers[j] == r.renderers[i]) index = std::max<std::size_t>(index, 3);
+    return rendererColor(r.renderers[i], index);
+}
+
 bool sameAngle(double a, double b, double step) {
     return std::abs(a - b) <= 1e-6 * std::max(std::abs(step), 1e-9) + 1e-12;
 }
 
-// Whether `renderer` (nullptr: any) has an event on interval n.
-bool isEvent(const PoppingResult& r, const RendererKind* renderer, std::size_t n) {
+// Whether `series` (nullptr: any) has an event on interval n.
+bool isEvent(const PoppingResult& r, const RendererSeries* series, std::size_t n) {
     if (n + 1 >= r.angles.size()) return false;
     for (const PoppingEvent& e : r.events)
-        if ((!renderer || e.renderer == *renderer) &&
+        if ((!series || firedBy(r, e) == series) &&
             sameAngle(e.angleFrom, r.angles[n], r.sweep.step))
             return true;
     return false;
@@ -347,7 +386,7 @@ json summaryJson(const PoppingResult& r) {
         if (!s.exactReason.empty()) o["exact_reason"] = s.exactReason;
         o["events"] = json::array();
         for (const PoppingEvent& e : r.events) {
-            if (e.renderer != s.renderer) continue;
+            if (firedBy(r, e) != &s) continue;
             o["events"].push_back({{"angle_from", e.angleFrom},
                                    {"angle_to", e.angleTo},
                                    {"J", number(e.signal)},
@@ -361,7 +400,7 @@ json summaryJson(const PoppingResult& r) {
                                    {"sheet_sign_after", e.sheetSignAfter},
                                    {"predicted", e.predicted}});
         }
-        renderers[toString(s.renderer)] = o;
+        renderers[seriesName(s)] = o;
     }
     j["renderers"] = renderers;
     j["predicted_switches"] = json::array();
@@ -382,11 +421,11 @@ std::string metricsCsv(const PoppingResult& r) {
     const std::size_t intervals = r.angles.size() > 1 ? r.angles.size() - 1 : 0;
     for (const RendererSeries& x : r.series)
         for (std::size_t n = 0; n < intervals; ++n)
-            s << toString(x.renderer) << ',' << n << ',' << csvNumber(r.angles[n]) << ','
+            s << seriesName(x) << ',' << n << ',' << csvNumber(r.angles[n]) << ','
               << csvNumber(r.angles[n + 1]) << ',' << csvNumber(at(x.T, n)) << ','
               << csvNumber(at(x.J, n)) << ',' << csvNumber(at(x.flipT, n)) << ','
               << csvNumber(at(x.e, n)) << ',' << csvNumber(at(x.flipRef, n)) << ','
-              << csvNumber(at(x.signal, n)) << ',' << (isEvent(r, &x.renderer, n) ? 1 : 0) << ','
+              << csvNumber(at(x.signal, n)) << ',' << (isEvent(r, &x, n) ? 1 : 0) << ','
               << truth << ',' << csvNumber(warpedAt(x.flipWarp1, n)) << ','
               << csvNumber(warpedAt(x.flipWarp7, n)) << '\n';
     if (!r.crossJump.empty())
@@ -475,11 +514,14 @@ std::string headerSection(const PoppingResult& r, const std::string& commandLine
     auto row = [&](const std::string& k, const std::string& v) {
         h << "<tr><td>" << escapeHtml(k) << "</td><td>" << v << "</td></tr>\n";
     };
+    const std::string scene = !r.options.scene.empty()
+                                  ? r.options.scene
+                                  : std::string(toString(s.mode)) + ", transfer function " +
+                                        s.transfer.name + ", " + toString(s.classification) +
+                                        "-classified, kernel " + s.kernel;
     row("scene",
-        escapeHtml(std::string(toString(s.mode)) + ", transfer function " + s.transfer.name + ", " +
-                   toString(s.classification) + "-classified, kernel " + s.kernel + ", " +
-                   std::to_string(s.camera.width) + "×" + std::to_string(s.camera.height) +
-                   " pixels, " + toString(s.camera.projection)));
+        escapeHtml(scene + ", " + std::to_string(s.camera.width) + "×" +
+                   std::to_string(s.camera.height) + " pixels, " + toString(s.camera.projection)));
     if (r.pathViews > 0)
         row("camera path",
             escapeHtml(std::to_string(r.pathViews) +
@@ -491,8 +533,7 @@ std::string headerSection(const PoppingResult& r, const std::string& commandLine
                        " to " + deg(r.sweep.to) + " in steps of " + deg(r.sweep.step) + " (" +
                        std::to_string(r.angles.size()) + " views)"));
     std::string names;
-    for (std::size_t i = 0; i < r.renderers.size(); ++i)
-        names += (i ? ", " : "") + std::string(toString(r.renderers[i]));
+    for (std::size_t i = 0; i < r.renderers.size(); ++i) names += (i ? ", " : "") + nameOf(r, i);
     row("renderers", escapeHtml(names));
     if (r.find(RendererKind::Reference))
         row("truth",
@@ -503,24 +544,24 @@ std::string headerSection(const PoppingResult& r, const std::string& commandLine
                            : std::string("the point-sampled reference (one ray per pixel "
                                          "centre)")));
     row("events", std::to_string(r.events.size()) + " detected, " +
-                      std::to_string(r.predictedSwitches.size()) + " predicted sheet switches");
+                      std::to_string(r.predictedSwitches.size()) + " predicted " +
+                      plural(r.options.predictedName));
     for (const RendererSeries& x : r.series) {
         std::size_t exact = 0;
         for (std::size_t p : x.exactPixels) exact += p > 0;
         if (exact > 0)
-            row("warning",
-                escapeHtml(std::string(toString(x.renderer)) + ": " + std::to_string(exact) +
-                           " of " + std::to_string(x.exactPixels.size()) +
-                           " views are the reference's pixels, not the splatter's (" +
-                           x.exactReason + "); its measures there say nothing"));
+            row("warning", escapeHtml(seriesName(x) + ": " + std::to_string(exact) + " of " +
+                                      std::to_string(x.exactPixels.size()) +
+                                      " views are the reference's pixels, not the splatter's (" +
+                                      x.exactReason + "); its measures there say nothing"));
     }
     row("machine", escapeHtml(cpuModel() + ", " +
                               std::to_string(std::thread::hardware_concurrency()) + " cores"));
     row("date", escapeHtml(nowString()));
     std::string timing = "total " + formatNumber(r.totalMs / 1000.0, 4) + " s";
     for (const RendererSeries& x : r.series)
-        timing += "; " + std::string(toString(x.renderer)) + " " + formatNumber(x.msPerFrame, 4) +
-                  " ms/frame, " + formatNumber(x.totalMs / 1000.0, 4) + " s";
+        timing += "; " + seriesName(x) + " " + formatNumber(x.msPerFrame, 4) + " ms/frame, " +
+                  formatNumber(x.totalMs / 1000.0, 4) + " s";
     row("timings", escapeHtml(timing));
     h << "</table>\n<p>Reproduce this report with:</p>\n<pre class=\"command\">"
       << escapeHtml(commandLine) << "</pre>\n";
@@ -534,10 +575,9 @@ std::string summarySection(const PoppingResult& r) {
       << th("threshold") << th("ꟻLIP₁ warped") << th("ꟻLIP₇ warped") << th("ms / frame")
       << th("total s") << "</tr>\n";
     for (const RendererSeries& x : r.series) {
-        const auto n = std::count_if(r.events.begin(), r.events.end(), [&](const PoppingEvent& e) {
-            return e.renderer == x.renderer;
-        });
-        h << "<tr>" << td(toString(x.renderer), true) << td(formatNumber(x.spikeRatio, 4))
+        const auto n = std::count_if(r.events.begin(), r.events.end(),
+                                     [&](const PoppingEvent& e) { return firedBy(r, e) == &x; });
+        h << "<tr>" << td(seriesName(x), true) << td(formatNumber(x.spikeRatio, 4))
           << td(formatNumber(x.medianT, 4)) << td(formatNumber(x.flickerRatio, 4))
           << td(n ? "<span class=\"event-yes\">" + std::to_string(n) + "</span>" : "0")
           << td(formatNumber(median(x.e), 4)) << td(formatNumber(x.threshold, 4))
@@ -563,7 +603,7 @@ std::string eventsTable(const PoppingResult& r) {
       << th("predicted", true) << "</tr>\n";
     for (std::size_t i = 0; i < r.events.size(); ++i) {
         const PoppingEvent& e = r.events[i];
-        h << "<tr>" << td(std::to_string(i + 1)) << td(toString(e.renderer), true)
+        h << "<tr>" << td(std::to_string(i + 1)) << td(nameOf(r, e.series), true)
           << td(std::string("[").append(deg(e.angleFrom)).append(", ").append(deg(e.angleTo)) + "]",
                 true)
           << td(formatNumber(e.signal, 4)) << td(formatNumber(e.refinedJump, 4))
@@ -582,10 +622,11 @@ std::string plotsSection(const PoppingResult& r) {
     std::vector<report::PlotBand> bands;
     for (const PoppingEvent& e : r.events)
         bands.push_back({e.angleFrom, e.angleTo,
-                         std::string("event: ") + toString(e.renderer) + " [" + deg(e.angleFrom) +
+                         std::string("event: ") + nameOf(r, e.series) + " [" + deg(e.angleFrom) +
                              ", " + deg(e.angleTo) + "]"});
     std::vector<report::PlotMarker> markers;
-    for (double a : r.predictedSwitches) markers.push_back({a, "predicted switch " + deg(a)});
+    for (double a : r.predictedSwitches)
+        markers.push_back({a, "predicted " + eventWord(r) + " " + deg(a)});
     const std::vector<double> mid = midpoints(r.angles);
     const std::string xLabel =
         r.pathViews > 0 ? positionName(r) : std::string(angleName(r.sweep.angle)) + " (degrees)";
@@ -606,8 +647,7 @@ std::string plotsSection(const PoppingResult& r) {
     auto add = [&](report::LinePlot& p, const RendererSeries& x, std::size_t i,
                    const std::vector<double>& xs, const std::vector<double>& ys) {
         if (ys.empty()) return;
-        p.series.push_back(
-            {toString(x.renderer), rendererColor(x.renderer, i), xs, ys, xs.size() < 40, false});
+        p.series.push_back({seriesName(x), seriesColor(r, i), xs, ys, xs.size() < 40, false});
     };
     auto figure = [](const report::LinePlot& p, const std::string& caption) {
         return "<figure>\n" + p.svg() + "<figcaption>" + caption + "</figcaption>\n</figure>\n";
@@ -647,8 +687,10 @@ std::string plotsSection(const PoppingResult& r) {
     std::ostringstream h;
     h << "<h2>Measures along the sweep</h2>\n"
          "<p class=\"note\">Per-interval measures are drawn at the interval's middle, per-view "
-         "ones at the view. Shaded bands: detected events; dashed lines: predicted sheet "
-         "switches of the axis-aligned splatter.</p>\n";
+         "ones at the view. Shaded bands: detected events; dashed lines: predicted "
+      << escapeHtml(plural(r.options.predictedName))
+      << (r.options.predictedName == "sheet switch" ? " of the axis-aligned splatter" : "")
+      << ".</p>\n";
     h << figure(pT,
                 "T<sub>X</sub>(n) = RMS(I<sub>X</sub>(θ<sub>n+1</sub>) − "
                 "I<sub>X</sub>(θ<sub>n</sub>)): how much each renderer's image changes per "
@@ -678,18 +720,10 @@ std::string refinementFigure(const PoppingResult& r, const PoppingEvent& e, bool
     p.logX = p.logY = true;
     p.height = 260;
     for (std::size_t i = 0; i < r.renderers.size(); ++i) {
-        report::PlotSeries c{std::string("T ") + toString(r.renderers[i]),
-                             rendererColor(r.renderers[i], i),
-                             {},
-                             {},
-                             true,
-                             false};
-        report::PlotSeries j{std::string("J ") + toString(r.renderers[i]),
-                             rendererColor(r.renderers[i], i),
-                             {},
-                             {},
-                             true,
-                             true};
+        report::PlotSeries c{
+            std::string("T ") + nameOf(r, i), seriesColor(r, i), {}, {}, true, false};
+        report::PlotSeries j{
+            std::string("J ") + nameOf(r, i), seriesColor(r, i), {}, {}, true, true};
         for (const RefinementStep& st : e.refinement) {
             c.x.push_back(st.width);
             c.y.push_back(at(st.change, i));
@@ -718,7 +752,7 @@ std::string refinementFigure(const PoppingResult& r, const PoppingEvent& e, bool
         "Change over the refined interval against its width, per renderer "
         "(T solid";
     caption += withJump ? ", J dashed" : "";
-    caption += "). " + escapeHtml(toString(e.renderer)) + ": fitted log–log slope " +
+    caption += "). " + escapeHtml(nameOf(r, e.series)) + ": fitted log–log slope " +
                formatNumber(e.refinedSlope, 3) + ", jump " + formatNumber(e.refinedJump, 4) +
                " at width " + formatNumber(e.refinedWidth, 3) + "° (near " + deg(e.refinedAngle) +
                "). A slope near 0 is a discontinuity (popping); near 1, "
@@ -734,19 +768,18 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
         refIt == r.renderers.end() ? R : std::size_t(refIt - r.renderers.begin());
     const RendererSeries* fired = nullptr;
     for (const RendererSeries& x : r.series)
-        if (x.renderer == e.renderer) fired = &x;
+        if (firedBy(r, e) == &x) fired = &x;
 
     std::string predicted = "not predicted";
     for (double a : r.predictedSwitches)
         if (a >= std::min(e.angleFrom, e.angleTo) && a <= std::max(e.angleFrom, e.angleTo))
-            predicted = "predicted switch at " + deg(a);
+            predicted = "predicted " + eventWord(r) + " at " + deg(a);
     if (e.predicted && predicted == "not predicted") predicted = "predicted";
     const std::string caption =
-        "Event " + std::to_string(index + 1) + ": " + escapeHtml(toString(e.renderer)) + " over [" +
+        "Event " + std::to_string(index + 1) + ": " + escapeHtml(nameOf(r, e.series)) + " over [" +
         deg(e.angleFrom) + ", " + deg(e.angleTo) + "], signal " + formatNumber(e.signal, 4) +
-        (fired ? " (threshold " + formatNumber(fired->threshold, 4) + ")" : "") + ", sheet axis " +
-        sheetName(e.sheetAxisBefore, e.sheetSignBefore) + " → " +
-        sheetName(e.sheetAxisAfter, e.sheetSignAfter) + ", " + predicted + ".";
+        (fired ? " (threshold " + formatNumber(fired->threshold, 4) + ")" : "") + sheetChange(e) +
+        ", " + predicted + ".";
     h << "<h3>" << caption << "</h3>\n";
 
     const EventFrames& f = e.frames;
@@ -781,25 +814,23 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
         h << "<figure>\n<div class=\"grid\" style=\"grid-template-columns: 7em repeat(" << R
           << ", 1fr)\">\n<div></div>";
         for (std::size_t i = 0; i < R; ++i)
-            h << "<div class=\"cell\"><b>" << escapeHtml(toString(r.renderers[i])) << "</b></div>";
+            h << "<div class=\"cell\"><b>" << escapeHtml(nameOf(r, i)) << "</b></div>";
         h << '\n';
         auto label = [](const std::string& s) { return "<div class=\"cell\">" + s + "</div>"; };
         const std::string name = "event " + std::to_string(index + 1) + " ";
         h << label("before<br>" + deg(e.angleFrom));
         for (std::size_t i = 0; i < R; ++i)
-            h << "<div>"
-              << pngImg(f.before[i], display, "frame", name + toString(r.renderers[i]) + " before")
+            h << "<div>" << pngImg(f.before[i], display, "frame", name + nameOf(r, i) + " before")
               << "</div>";
         h << '\n' << label("after<br>" + deg(e.angleTo));
         for (std::size_t i = 0; i < R; ++i)
-            h << "<div>"
-              << pngImg(f.after[i], display, "frame", name + toString(r.renderers[i]) + " after")
+            h << "<div>" << pngImg(f.after[i], display, "frame", name + nameOf(r, i) + " after")
               << "</div>";
         h << '\n' << label("|after − before|");
         for (std::size_t i = 0; i < R; ++i)
             h << "<div>"
               << heatmapImg(change[i], w, hgt, changeScale,
-                            name + toString(r.renderers[i]) + " |after − before|")
+                            name + nameOf(r, i) + " |after − before|")
               << "</div>";
         h << '\n';
         if (ref < R) {
@@ -812,7 +843,7 @@ std::string eventSection(const PoppingResult& r, const PoppingEvent& e, std::siz
                     }
                     h << "<div>"
                       << heatmapImg(side ? errAfter[i] : errBefore[i], w, hgt, errScale,
-                                    name + toString(r.renderers[i]) +
+                                    name + nameOf(r, i) +
                                         (side ? " |X − ref| after" : " |X − ref| before"))
                       << "</div>";
                 }
@@ -870,8 +901,7 @@ std::string animationSection(const PoppingResult& r) {
         movie.push_back(std::move(m));
     }
     std::string order;
-    for (int k = 0; k < n; ++k)
-        order += (k ? " | " : "") + std::string(toString(r.series[k].renderer));
+    for (int k = 0; k < n; ++k) order += (k ? " | " : "") + seriesName(r.series[k]);
     const int fps = std::clamp(int(frames) / 3, 4, 12);
     // Small thumbnails are shown enlarged (whole pixels) to about 480 CSS pixels wide.
     const int scale = std::max(1, 480 / movie[0].width);

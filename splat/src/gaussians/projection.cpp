@@ -54,7 +54,7 @@ Projected project(const GaussianScene& scene, const ViewFrame& f, Footprint foot
     p.depth.resize(n);
     p.radius.assign(n, 0);
     p.colour.resize(n);
-    p.opacity = scene.opacities;
+    p.opacity.assign(scene.opacities.begin(), scene.opacities.end());
     const bool ray = footprint == Footprint::Volume;
     if (rays) {
         p.precision.resize(n);

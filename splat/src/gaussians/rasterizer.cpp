@@ -4,6 +4,9 @@
 // once the transmittance would fall below 1e-4 (that Gaussian not added). Float throughout,
 // as the CUDA code. A tile first copies its Gaussians into one packed array (as the CUDA code
 // loads batches into shared memory), so its 256 pixels read them in order.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <vector>
 
@@ -23,20 +26,30 @@ struct Packed {
     glm::vec3 colour;
 };
 
+/// Packed::skipBelow per Gaussian, once per frame (a Gaussian lands in several tiles).
+std::vector<float> skipExponents(const Projected& p) {
+    std::vector<float> skip(p.opacity.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, skip.size(), 65536), [&](const auto& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const float o = p.opacity[i];
+            skip[i] = o > 0 ? std::log(1.0f / (255.0f * o)) - 1e-3f : -INFINITY;
+        }
+    });
+    return skip;
+}
+
 }  // namespace
 
 Image rasterize(const Projected& p, const TileLists& tiles, int width, int height) {
     Image image(width, height);
+    const std::vector<float> skip = skipExponents(p);
     forEachTile(tiles, [&](int tx, int ty) {
         const int tile = ty * tiles.tilesX + tx;
         std::vector<Packed> local;
         local.reserve(std::size_t(tiles.end(tile) - tiles.begin(tile)));
-        for (const std::uint32_t* id = tiles.begin(tile); id != tiles.end(tile); ++id) {
-            const float o = p.opacity[*id];
-            local.push_back({p.centre[*id], p.conic[*id], o,
-                             o > 0 ? std::log(1.0f / (255.0f * o)) - 1e-3f : -INFINITY,
-                             p.colour[*id]});
-        }
+        for (const std::uint32_t* id = tiles.begin(tile); id != tiles.end(tile); ++id)
+            local.push_back(
+                {p.centre[*id], p.conic[*id], p.opacity[*id], skip[*id], p.colour[*id]});
         for (int y = ty * kTile; y < std::min(height, (ty + 1) * kTile); ++y)
             for (int x = tx * kTile; x < std::min(width, (tx + 1) * kTile); ++x) {
                 const glm::vec2 pixel(float(x) + 0.5f, float(y) + 0.5f);
