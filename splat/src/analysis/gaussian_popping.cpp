@@ -1,8 +1,6 @@
 // Popping analysis of Gaussian scenes (see splat/gaussian_popping.h).
 #include "splat/gaussian_popping.h"
 
-#include "splat/depth.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -10,6 +8,8 @@
 #include <functional>
 #include <set>
 #include <unordered_map>
+
+#include "splat/depth.h"
 
 namespace splat {
 
