@@ -250,6 +250,8 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
             largest = std::max(largest, r.samplesLoaded);
             held = std::max(held, r.rendered);
         }
+        // One process composites each partial image as it is rendered: the frame and one.
+        if (group->size() == 1) held = std::min(held, 2);
         std::printf(
             "memory estimate: %.0f MiB for the busiest process (%zu samples, %d images)\n",
             double(brickMemoryEstimate(largest, image.width, image.height, held, 0.25)) / 1048576.0,

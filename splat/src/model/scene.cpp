@@ -50,6 +50,26 @@ footprint::FootprintTable makeTable(const footprint::Kernel& kernel, const Quali
     }
 }
 
+/// The polynomial fit of makeTable's table (footprint/footprint_poly.h), the last one kept
+/// and copied likewise.
+footprint::FootprintPoly makePoly(const footprint::FootprintTable& table,
+                                  const footprint::Kernel& kernel, const Quality& q) {
+    static std::mutex mutex;
+    static std::optional<std::tuple<footprint::KernelType, double, double, int>> lastKey;
+    static std::optional<footprint::FootprintPoly> last;
+    const auto key =
+        std::make_tuple(kernel.type(), kernel.sigma(), kernel.radius(), q.footprintResolution);
+    {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (last && lastKey == key) return *last;
+    }
+    footprint::FootprintPoly poly(table);
+    const std::lock_guard<std::mutex> lock(mutex);
+    last = poly;
+    lastKey = key;
+    return poly;
+}
+
 /// Largest ratio between a volume's largest and smallest spacing a renderer accepts: beyond
 /// it, slab counts and float depths lose all meaning (1e-30,1,1 or 1e-6,1,1e6 spacings).
 constexpr double kMaxSpacingRatio = 1e4;
@@ -243,7 +263,7 @@ Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
         classify(*volume, settings.transfer, s.mode, s.classification, kernel.radius(), options);
     transfer = TransferTable(settings.transfer, 4096, volume->background);
     if (s.quality.polynomialTolerance > 0) {
-        poly.emplace(table);
+        poly.emplace(makePoly(table, kernel, s.quality));
         if (poly->maxError() > s.quality.polynomialTolerance) poly.reset();
     }
 }

@@ -194,16 +194,22 @@ Volume geometry(const std::string& name, const openvdb::GridBase& g, const openv
 
 /// Calls `voxel(coord, value)` for every active voxel of `grid` inside `box` and
 /// `tile(box, value)` for every active tile's part of it; either returns true to stop.
-/// Only the leaves whose boxes meet `box` are visited voxel by voxel.
+/// The leaves that meet `box` are found by their origins (one probe of the tree each), so
+/// the cost follows the box and its active voxels, not the grid.
 template <typename GridT, typename Voxel, typename Tile>
 void visitActive(const GridT& grid, const openvdb::CoordBBox& box, Voxel&& voxel, Tile&& tile) {
     using TreeT = typename GridT::TreeType;
     const TreeT& tree = grid.tree();
-    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
-        if (!box.hasOverlap(leaf->getNodeBoundingBox())) continue;
-        for (auto it = leaf->cbeginValueOn(); it; ++it)
-            if (box.isInside(it.getCoord()) && voxel(it.getCoord(), *it)) return;
-    }
+    constexpr int dim = int(TreeT::LeafNodeType::DIM);
+    const openvdb::Coord first = box.min() & ~(dim - 1);  // the first leaf's origin
+    for (int z = first.z(); z <= box.max().z(); z += dim)
+        for (int y = first.y(); y <= box.max().y(); y += dim)
+            for (int x = first.x(); x <= box.max().x(); x += dim) {
+                const auto* leaf = tree.probeConstLeaf(openvdb::Coord(x, y, z));
+                if (!leaf) continue;
+                for (auto it = leaf->cbeginValueOn(); it; ++it)
+                    if (box.isInside(it.getCoord()) && voxel(it.getCoord(), *it)) return;
+            }
     auto it = tree.cbeginValueOn();
     it.setMaxDepth(TreeT::ValueOnCIter::LEAF_DEPTH - 1);  // tiles of the root and inner nodes
     for (; it; ++it) {
