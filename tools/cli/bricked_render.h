@@ -37,7 +37,7 @@ std::function<bool(const Brick&)> brickEmptiness(const VolumeArgs& volume);
 int automaticBricks(const VolumeArgs& volume, const RenderSettings& settings);
 
 /// The samples of a brick of an OpenVDB grid rendered by automaticBricks.
-constexpr std::size_t kSparseBrickSamples = std::size_t(32) * 32 * 32;
+constexpr std::size_t kSparseBrickSamples = std::size_t(64) * 64 * 64;
 
 /// K from the budget per process (`rankBytes`, 0: defaultRankBytes) by chooseBricks, said on
 /// rank 0 unless `quiet`; `wholeFits`: whether the whole volume fits one process.
