@@ -21,6 +21,8 @@ OUTDIR/tczyx.zarr: a 5D image (2 time points, 3 channels): value 1000 t + 100 c 
 OUTDIR/grids.vdb: a vec3s grid 'velocity', a float grid 'temperature' (background -1, voxel 0.25)
 and a float grid 'smoke' with an active tile; OUTDIR/rotated.vdb: a grid whose transform
 turns about z (refused).
+OUTDIR/blobs.nii.gz, blobs.vdb: four separated blobs (one below b) and two corner markers on a
+background of 3 in a 64x48x40 box, spacing 1, 0.75, 1.25: the VDB's bricks mostly hold only b.
 With --shell N: OUTDIR/shell_N.vdb only, a thin spherical shell of radius 0.45 N (one
 voxel thick) in an N^3 box, for tools/bench/sparse_bench.py.
 Exit status 77 when a library is missing (the tests are then skipped).
@@ -57,6 +59,26 @@ def same_volume():
     d[0, 0, 0] = BACKGROUND + 4.0  # markers at two corners: the active box is the volume's
     d[-1, -1, -1] = BACKGROUND + 6.0
     return d
+
+
+BLOBS_DIMS = (64, 48, 40)
+BLOBS_SPACING = (1.0, 0.75, 1.25)
+
+
+def blobs_volume():
+    """Four separated Gaussian blobs (one of them below b) and two corner markers (so that
+    the VDB's active box is the volume's) on a background of 3, float32 indexed [x, y, z]:
+    most of the box holds only b."""
+    x, y, z = np.meshgrid(*[np.arange(n, dtype=np.float64) for n in BLOBS_DIMS], indexing="ij")
+    d = np.zeros(BLOBS_DIMS)
+    for (cx, cy, cz, h) in [(10, 10, 9, 10.0), (52, 36, 10, 6.0), (14, 37, 30, -2.0),
+                            (50, 12, 29, 8.0)]:
+        r2 = (x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2
+        d += h * np.exp(-r2 / (2 * 1.3 ** 2))
+    d[np.abs(d) < 0.02] = 0.0  # each blob ends
+    d[0, 0, 0] = 4.0
+    d[-1, -1, -1] = 6.0
+    return (BACKGROUND + d).astype(np.float32)
 
 
 def write_vdb(path, grids):
@@ -205,6 +227,14 @@ def main():
     turned.transform = vdb.createLinearTransform(
         [[0.6, 0.8, 0, 0], [-0.8, 0.6, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
     write_vdb(os.path.join(out, "rotated.vdb"), [turned])
+
+    b = blobs_volume()
+    affine = np.diag([1.0, 1.0, 1.0, 1.0])
+    affine[:3, :3] = np.diag(BLOBS_SPACING)
+    affine[:3, 3] = ORIGIN
+    nib.save(nib.Nifti1Image(b, affine), os.path.join(out, "blobs.nii.gz"))
+    write_vdb(os.path.join(out, "blobs.vdb"),
+              [float_grid(b, "density", BACKGROUND, BLOBS_SPACING, ORIGIN)])
 
 
 main()

@@ -118,6 +118,76 @@ std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume) {
     };
 }
 
+std::function<bool(const Brick&)> brickEmptiness(const VolumeArgs& volume) {
+    const std::string& background = volume.values.text("background-value");
+    if (!background.empty() && background != "auto") return {};  // b is not the file's
+    const LoadOptions options = loadOptionsFromArgs(volume);
+    return [spec = volume.spec, options](const Brick& brick) {
+        return brickHoldsOnlyBackground(spec, options, brick.loadLo, brick.loadHi);
+    };
+}
+
+namespace {
+
+/// Whether a volume of b draws one constant image in `settings` (emptyBrickImage), the
+/// transfer function and iso level resolved against the sparse volume's range: else every
+/// brick of it draws, and bricks gain nothing over the whole volume.
+bool backgroundDrawsOneImage(const VolumeArgs& volume, const LoadOptions& options,
+                             const Volume& geometry, RenderSettings s) {
+    if (!brickEmptiness(volume)) return false;
+    float lo = 0, hi = 0;
+    if (!sparseValueRange(volume.spec, options, lo, hi)) return false;
+    s.transfer = s.transfer.resolved(lo, hi);
+    if (s.isoNormalized) {
+        s.isoLevel = lo + s.isoLevel * (hi - lo);
+        s.isoNormalized = false;
+    }
+    s = withFreeCameraTarget(s, geometry);
+    Brick whole;
+    whole.hi = whole.loadHi = geometry.dims;
+    return emptyBrickImage(geometry, brickSettings(s, geometry, whole, geometry.dims)).has_value();
+}
+
+}  // namespace
+
+int automaticBricks(const VolumeArgs& volume, const RenderSettings& settings) {
+    if (settings.edges.enabled() || settings.labels.enabled) return 0;
+    // Post-classified dvr draws the transfer function's value at b wherever the field is b;
+    // bricks draw that haze per brick, not as one volume.
+    if (settings.mode == RenderMode::Dvr && settings.classification == Classification::Post)
+        return 0;
+    const Quality& q = settings.quality;
+    if (q.lod > 0 || q.lodAuto || q.lodBrick) return 0;
+    if (settings.renderer == RendererKind::Sheet &&  // its exact bricks refuse these
+        (settings.clipping.enabled() || settings.camera.projection == Projection::Perspective))
+        return 0;
+    const LoadOptions options = loadOptionsFromArgs(volume);
+    Volume geometry;
+    try {
+        if (!volumeReadsByBrick(volume.spec, options)) return 0;
+        bool alone = false;
+        geometry = volumeGeometry(volume.spec, options, &alone, false);
+    } catch (const std::exception&) {
+        return 0;  // the whole volume's load says what is wrong, as without bricks
+    }
+    bool fits = true;
+    const int needed = bricksFromBudget(geometry, settings, 1, 0, &fits, true);
+    const std::size_t cap = std::min<std::size_t>(geometry.voxelCount(), 4096);
+    if (volumeIsSparse(volume.spec) && backgroundDrawsOneImage(volume, options, geometry, settings)) {
+        const std::size_t k = (geometry.voxelCount() + kSparseBrickSamples - 1) / kSparseBrickSamples;
+        return int(std::clamp<std::size_t>(std::max<std::size_t>(k, std::size_t(fits ? 1 : needed)),
+                                           1, cap));
+    }
+    if (fits) return 0;
+    std::fprintf(stderr,
+                 "splat: %s: %dx%dx%d samples do not fit the memory budget of %.0f MiB "
+                 "(docs/parallel.md \"Larger than memory\"): rendering %d bricks one after "
+                 "another\n",
+                 volume.spec.c_str(), geometry.dims.x, geometry.dims.y, geometry.dims.z,
+                 double(defaultRankBytes(1)) / 1048576.0, needed);
+    return needed;
+}
+
 Volume brickedGeometry(const VolumeArgs& volume, bool* aloneOut) {
     const LoadOptions options = loadOptionsFromArgs(volume);
     const std::string& background = volume.values.text("background-value");
@@ -150,15 +220,15 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
     std::snprintf(b, sizeof b, "%.9g", double(geometry.background));
     runMetadata().push_back(
         {"splat:background_value", std::string(b) + " (" + geometry.backgroundSource + ")"});
-    settings = withFreeCameraTarget(settings, geometry);
+    settings = withDataDefaults(render, settings, geometry);  // as the whole volume's frame
     const std::unique_ptr<BrickGroup> group = brickGroup(compositor);
     if (bricks == 0) bricks = bricksFromBudget(geometry, settings, group->size(), rankBytes);
     if (bricks > int(std::min<std::size_t>(geometry.voxelCount(), 1 << 20)))
         throw UsageError("--bricks " + std::to_string(bricks) + " is more than the volume's " +
                          std::to_string(geometry.voxelCount()) + " samples");
     BrickStats st;
-    const Image image =
-        renderBricked(geometry, brickLoader(volume), settings, bricks, *group, &st, composite);
+    const Image image = renderBricked(geometry, brickLoader(volume), settings, bricks, *group, &st,
+                                      composite, brickEmptiness(volume));
     const std::vector<BrickStats> all = group->gather(st);
     if (workerProcess()) return;
     removeStaleTemporaries(std::filesystem::path(output).parent_path());
@@ -168,6 +238,10 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
         "processes, composite %.1f ms\n",
         output.c_str(), image.width, image.height, toString(settings.renderer),
         toString(settings.mode), st.bricks, group->size(), st.compositeMs);
+    int empty = 0;
+    for (const BrickStats& r : all) empty += r.empty;
+    if (empty > 0)
+        std::printf("bricks holding only the background value: %d of %d\n", empty, st.bricks);
     {
         // splat/brick_budget.h's estimate for the busiest process, beside its peak RSS.
         std::size_t largest = 0;
@@ -176,6 +250,8 @@ void renderBrickedToFile(const VolumeArgs& volume, const RenderArgs& render,
             largest = std::max(largest, r.samplesLoaded);
             held = std::max(held, r.rendered);
         }
+        // One process composites each partial image as it is rendered: the frame and one.
+        if (group->size() == 1) held = std::min(held, 2);
         std::printf(
             "memory estimate: %.0f MiB for the busiest process (%zu samples, %d images)\n",
             double(brickMemoryEstimate(largest, image.width, image.height, held, 0.25)) / 1048576.0,

@@ -21,6 +21,24 @@ Volume brickedGeometry(const VolumeArgs& volume, bool* alone = nullptr);
 /// Loads brick's samples (with its ghost layers) of the volume of `volume`.
 std::function<Volume(const Brick&)> brickLoader(const VolumeArgs& volume);
 
+/// Which bricks of the volume of `volume` hold only its background value b, known without
+/// loading them (brickHoldsOnlyBackground: an OpenVDB grid's empty boxes).
+std::function<bool(const Brick&)> brickEmptiness(const VolumeArgs& volume);
+
+/// The bricks `splat render` on one process chooses by itself (0: the whole volume at once),
+/// docs/parallel.md "Larger than memory": an OpenVDB grid is rendered in bricks of about
+/// kSparseBrickSamples samples (at most 4096 bricks) when a volume of b draws one constant
+/// image (emptyBrickImage): its empty bricks are then neither loaded nor rendered, so cost
+/// follows the active voxels; a volume read by brick that does not fit the budget (defaultRankBytes)
+/// in as many as it needs, said on stderr. Volumes loaded whole, and settings that bricks
+/// refuse (edge enhancement, labels, level of detail; the image-aligned splatter's clipping
+/// and perspective views) and post-classified dvr (a transfer function that gives b opacity
+/// fills the box with a haze that bricks do not draw as one volume) render whole.
+int automaticBricks(const VolumeArgs& volume, const RenderSettings& settings);
+
+/// The samples of a brick of an OpenVDB grid rendered by automaticBricks.
+constexpr std::size_t kSparseBrickSamples = std::size_t(64) * 64 * 64;
+
 /// K from the budget per process (`rankBytes`, 0: defaultRankBytes) by chooseBricks, said on
 /// rank 0 unless `quiet`; `wholeFits`: whether the whole volume fits one process.
 /// `extraSampleBytes`: bytes per sample held beyond the samples and one splat list

@@ -183,7 +183,8 @@ void registerPopping(CLI::App& app) {
             group = brickGroup(a->brick.compositor);
             frames = std::make_unique<BrickedFrames>(
                 *geometry, brickLoader(a->volume), settings, bricks, *group,
-                a->brick.composite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
+                a->brick.composite == "exact" ? BrickComposite::Exact : BrickComposite::Fast,
+                true, brickEmptiness(a->volume));
             settings = frames->settings();
         }
         std::optional<BrickedFrameRequests> requests;

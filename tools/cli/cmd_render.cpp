@@ -99,7 +99,12 @@ void registerRender(CLI::App& app) {
         checkCompositor(args->compositor);
         if (given(*cmd, "compositor") && !fromScene(*cmd, "compositor") && processCount() == 1)
             warn("--compositor applies to bricks under mpirun: ignored");
-        const bool bricked = args->bricks > 0 || args->rankMemory > 0 || processCount() > 1;
+        bool bricked = args->bricks > 0 || args->rankMemory > 0 || processCount() > 1;
+        int bricks = args->bricks;
+        if (!bricked) {  // docs/parallel.md "Larger than memory"
+            bricks = automaticBricks(args->volume, settings);
+            bricked = bricks > 0;
+        }
         if (given(*cmd, "brick-composite") && !fromScene(*cmd, "brick-composite") &&
             (!bricked || settings.renderer != RendererKind::Sheet))
             warn(
@@ -109,7 +114,7 @@ void registerRender(CLI::App& app) {
         if (bricked) {
             if (!workerProcess()) beginRun(*cmd);
             renderBrickedToFile(
-                args->volume, args->render, settings, args->bricks,
+                args->volume, args->render, settings, bricks,
                 std::uint64_t(args->rankMemory * 1048576.0), args->output,
                 args->brickComposite == "exact" ? BrickComposite::Exact : BrickComposite::Fast,
                 args->compositor);

@@ -311,7 +311,8 @@ void renderBrickedFrames(const RotateCommand& a, const Volume& geometry,
             "brick face (docs/parallel.md); --brick-composite exact is not");
     BrickedFrames frames(
         geometry, brickLoader(a.volume), settings, bricks, group,
-        a.brick.composite == "exact" ? BrickComposite::Exact : BrickComposite::Fast);
+        a.brick.composite == "exact" ? BrickComposite::Exact : BrickComposite::Fast, true,
+        brickEmptiness(a.volume));
     std::size_t pending = 0, done = 0;
     for (bool k : keep) pending += k ? 0 : 1;
     std::string failure;

@@ -51,9 +51,10 @@ struct BrickChoice {
 /// `maxBricks` fits, the largest tried, with withinBudget false.
 BrickChoice chooseBricks(const glm::ivec3& dims, const BrickBudget& budget, int maxBricks = 4096);
 
-/// The default budget per process: 80% of the machine's physical memory divided by the
-/// processes on this node (OpenMPI's OMPI_COMM_WORLD_LOCAL_SIZE, MPICH's MPI_LOCALNRANKS,
-/// else `ranks`: all on this node).
+/// The default budget per process: the environment variable SPLAT_MEMORY_BUDGET_MIB when set
+/// (MiB, > 0), else 80% of the machine's physical memory divided by the processes on this
+/// node (OpenMPI's OMPI_COMM_WORLD_LOCAL_SIZE, MPICH's MPI_LOCALNRANKS, else `ranks`: all on
+/// this node).
 std::uint64_t defaultRankBytes(int ranks);
 
 }  // namespace splat

@@ -14,6 +14,7 @@
 // (frame/clip_cut.h) and their seam error is measured there.
 #include <functional>
 #include <memory>
+#include <optional>
 #include <glm/glm.hpp>
 #include <string>
 #include <utility>
@@ -113,6 +114,24 @@ Volume volumeGeometry(const std::string& spec, const LoadOptions& options, bool*
 Volume loadVolumeBrick(const std::string& spec, const LoadOptions& options, const glm::ivec3& lo,
                        const glm::ivec3& hi);
 
+/// Whether loadVolumeBrick reads a brick of the volume `spec` names alone (volumeGeometry's
+/// `alone`), from its name and header, without reading samples.
+bool volumeReadsByBrick(const std::string& spec, const LoadOptions& options);
+
+/// Whether brickHoldsOnlyBackground knows the empty bricks of the volume `spec` names (an
+/// OpenVDB file).
+bool volumeIsSparse(const std::string& spec);
+
+/// The smallest and largest sample of the volume `spec` names, known without reading its
+/// samples: an OpenVDB grid's, from its tree. False (lo, hi unchanged) for other volumes.
+bool sparseValueRange(const std::string& spec, const LoadOptions& options, float& lo, float& hi);
+
+/// Whether the samples [lo, hi) of the volume `spec` names all equal its background value b,
+/// known without reading them: an OpenVDB file's box that no active voxel or tile of another
+/// value meets (from the grid's tree). False for every other volume (not known).
+bool brickHoldsOnlyBackground(const std::string& spec, const LoadOptions& options,
+                              const glm::ivec3& lo, const glm::ivec3& hi);
+
 }  // namespace splat
 
 namespace splat {
@@ -120,6 +139,7 @@ namespace splat {
 struct BrickStats {
     int bricks = 0;                 ///< in the frame
     int rendered = 0;               ///< by this process
+    int empty = 0;                  ///< of those, holding only b: not loaded (emptyBrickImage)
     std::size_t samplesLoaded = 0;  ///< the largest brick this process held, ghost layers included
     std::size_t splats = 0;         ///< splats of the bricks this process rendered
     std::uint64_t bytesExchanged = 0;  ///< sent + received by this process (compositing)
@@ -208,9 +228,14 @@ class BrickedFrames {
   public:
     /// `frame`: the settings of every view but the camera. `composite`: how the
     /// image-aligned splatter's bricks are composited.
+    /// `empty` (optional) says which bricks hold only the background value b without
+    /// loading them (brickHoldsOnlyBackground): such a brick is neither loaded nor rendered
+    /// when a volume of b draws nothing but one constant image in this frame's settings
+    /// (emptyBrickImage); that image stands for it, so the frame is unchanged.
     BrickedFrames(const Volume& geometry, std::function<Volume(const Brick&)> load,
                   const RenderSettings& frame, int bricks, BrickGroup& group,
-                  BrickComposite composite = BrickComposite::Exact, bool keep = true);
+                  BrickComposite composite = BrickComposite::Exact, bool keep = true,
+                  std::function<bool(const Brick&)> empty = {});
     ~BrickedFrames();
     BrickedFrames(const BrickedFrames&) = delete;
     BrickedFrames& operator=(const BrickedFrames&) = delete;
@@ -235,12 +260,18 @@ class BrickedFrames {
         return renderer == RendererKind::Sheet && composite_ == BrickComposite::Exact;
     }
     Volume loadBrick(int b);
+    Image renderPieces(const CameraParams& camera, const RenderSettings& s, RenderStats& stats);
+    Image renderInOrder(const CameraParams& camera, const RenderSettings& s, RenderStats& stats);
+    Image renderPiece(std::size_t i, const RenderSettings& s, RenderStats& stats);
+    std::optional<Image> emptyImage(const RenderSettings& s) const;
 
     Volume geometry_;
     std::function<Volume(const Brick&)> load_;
     BrickGroup& group_;
     BrickLayout layout_;
     std::vector<int> mine_;
+    std::vector<char> empty_;  ///< mine_'s bricks that hold only b
+    std::optional<Image> emptyImage_;  ///< the current frame's image of an empty brick
     RenderSettings s_;
     BrickComposite composite_ = BrickComposite::Exact;
     bool keep_ = true;
@@ -251,12 +282,21 @@ class BrickedFrames {
     BrickStats st_;
 };
 
-/// One frame: BrickedFrames(geometry, load, frame, bricks, group, composite, false)
+/// One frame: BrickedFrames(geometry, load, frame, bricks, group, composite, false, empty)
 /// rendered once at frame.camera; `stats`: this process's work. Returns the frame on
 /// process 0.
 Image renderBricked(const Volume& geometry, const std::function<Volume(const Brick&)>& load,
                     const RenderSettings& frame, int bricks, BrickGroup& group,
-                    BrickStats* stats = nullptr, BrickComposite composite = BrickComposite::Exact);
+                    BrickStats* stats = nullptr, BrickComposite composite = BrickComposite::Exact,
+                    const std::function<bool(const Brick&)>& empty = {});
+
+/// The partial image of a brick that holds only the background value b, in `brickFrame`
+/// (brickSettings' settings, clipping of the brick's faces left out) of the volume `whole`:
+/// a volume of b that makes no splat and renders one constant image (a mip sees b, x-ray
+/// and an unlit b draw nothing) draws that same image over any box, so that image stands
+/// for every empty brick. Empty when b makes splats or draws anything else (pre-classified
+/// dvr whose transfer function gives b opacity): then empty bricks are rendered.
+std::optional<Image> emptyBrickImage(const Volume& whole, const RenderSettings& brickFrame);
 
 /// renderBricked's exact path of the image-aligned splatter (slab_sheets.h): this process's
 /// bricks `mine` of `layout` (`scene` gives brick mine[i]'s Scene built with the settings

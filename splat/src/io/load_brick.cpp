@@ -97,4 +97,27 @@ Volume loadVolumeBrick(const std::string& spec, const LoadOptions& options, cons
     return crop(loadVolume(spec, options), lo, hi);
 }
 
+bool volumeReadsByBrick(const std::string& spec, const LoadOptions& options) {
+    detail::SampleLayout L;
+    return isSynthetic(spec) || isZarr(spec) || detail::isVdbFile(spec) ||
+           detail::sampleLayoutOf(spec, options, &L);
+}
+
+bool volumeIsSparse(const std::string& spec) {
+    return !isSynthetic(spec) && detail::isVdbFile(spec);
+}
+
+bool sparseValueRange(const std::string& spec, const LoadOptions& options, float& lo, float& hi) {
+    if (!volumeIsSparse(spec)) return false;
+    const glm::dvec2 r = detail::vdbValueRange(spec, options);
+    lo = float(r.x);
+    hi = float(r.y);
+    return true;
+}
+
+bool brickHoldsOnlyBackground(const std::string& spec, const LoadOptions& options,
+                              const glm::ivec3& lo, const glm::ivec3& hi) {
+    return volumeIsSparse(spec) && detail::vdbBoxHoldsOnlyBackground(spec, options, lo, hi);
+}
+
 }  // namespace splat

@@ -230,9 +230,14 @@ struct VoxelRule {
 
     bool keep(int i, int j, int k, float value) const {
         // Clipping keeps every voxel whose kernel reaches the kept region: the renderers cut
-        // the reconstructed field at the planes and box (model/clip_region.h).
-        if (clips && !keepsNear(options.clipping, volume.world(glm::dvec3(i, j, k)), clipMargin))
-            return false;
+        // the reconstructed field at the planes and box (model/clip_region.h). Tested last:
+        // most voxels of a sparse volume fail the value test first.
+        return keepsValue(i, j, k, value) &&
+               (!clips ||
+                keepsNear(options.clipping, volume.world(glm::dvec3(i, j, k)), clipMargin));
+    }
+
+    bool keepsValue(int i, int j, int k, float value) const {
         if (labelled) {
             if (near[volume.index(i, j, k)]) return true;
             if (!intensity) return false;

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <tuple>
 
@@ -25,12 +27,47 @@ footprint::Kernel makeKernel(const RenderSettings& s) {
     }
 }
 
+/// The footprint table of `kernel` at the quality's resolution. The last one built is kept
+/// and copied: a frame of many bricks builds one Scene per brick with the same kernel.
 footprint::FootprintTable makeTable(const footprint::Kernel& kernel, const Quality& q) {
+    static std::mutex mutex;
+    static std::optional<std::tuple<footprint::KernelType, double, double, int>> lastKey;
+    static std::optional<footprint::FootprintTable> last;
+    const auto key =
+        std::make_tuple(kernel.type(), kernel.sigma(), kernel.radius(), q.footprintResolution);
+    {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (last && lastKey == key) return *last;
+    }
     try {
-        return footprint::FootprintTable(kernel, q.footprintResolution);
+        footprint::FootprintTable table(kernel, q.footprintResolution);
+        const std::lock_guard<std::mutex> lock(mutex);
+        last = table;
+        lastKey = key;
+        return table;
     } catch (const std::invalid_argument& e) {
         throw Error(std::string("footprint table: ") + e.what());
     }
+}
+
+/// The polynomial fit of makeTable's table (footprint/footprint_poly.h), the last one kept
+/// and copied likewise.
+footprint::FootprintPoly makePoly(const footprint::FootprintTable& table,
+                                  const footprint::Kernel& kernel, const Quality& q) {
+    static std::mutex mutex;
+    static std::optional<std::tuple<footprint::KernelType, double, double, int>> lastKey;
+    static std::optional<footprint::FootprintPoly> last;
+    const auto key =
+        std::make_tuple(kernel.type(), kernel.sigma(), kernel.radius(), q.footprintResolution);
+    {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (last && lastKey == key) return *last;
+    }
+    footprint::FootprintPoly poly(table);
+    const std::lock_guard<std::mutex> lock(mutex);
+    last = poly;
+    lastKey = key;
+    return poly;
 }
 
 /// Largest ratio between a volume's largest and smallest spacing a renderer accepts: beyond
@@ -226,7 +263,7 @@ Scene::Impl::Impl(std::shared_ptr<const Volume> v, const RenderSettings& s)
         classify(*volume, settings.transfer, s.mode, s.classification, kernel.radius(), options);
     transfer = TransferTable(settings.transfer, 4096, volume->background);
     if (s.quality.polynomialTolerance > 0) {
-        poly.emplace(table);
+        poly.emplace(makePoly(table, kernel, s.quality));
         if (poly->maxError() > s.quality.polynomialTolerance) poly.reset();
     }
 }

@@ -64,6 +64,10 @@ BrickChoice chooseBricks(const glm::ivec3& dims, const BrickBudget& budget, int 
 }
 
 std::uint64_t defaultRankBytes(int ranks) {
+    if (const char* v = std::getenv("SPLAT_MEMORY_BUDGET_MIB")) {
+        const double mib = std::atof(v);
+        if (mib > 0 && mib <= 1e9) return std::uint64_t(mib * 1048576.0);
+    }
     int local = std::max(ranks, 1);
     for (const char* name : {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS"})
         if (const char* v = std::getenv(name)) {

@@ -146,24 +146,30 @@ RenderSettings brickSettings(const RenderSettings& frame, const Volume& whole, c
     return s;
 }
 
+namespace {
+
+/// Lays the partial image `behind` behind `out` as `mode` combines pieces of a ray.
+void compositeBehind(Image& out, const Image& behind, RenderMode mode) {
+    if (behind.width != out.width || behind.height != out.height)
+        throw Error("bricks: partial images differ in size");
+    for (std::size_t p = 0; p < out.pixels.size(); ++p) {
+        glm::vec4& o = out.pixels[p];
+        const glm::vec4& c = behind.pixels[p];
+        if (mode == RenderMode::Mip)
+            o = glm::max(o, c);
+        else if (mode == RenderMode::Xray)
+            o = glm::vec4(glm::vec3(o) + glm::vec3(c), 1.0f);
+        else
+            o += (1.0f - o.a) * c;
+    }
+}
+
+}  // namespace
+
 Image compositePieces(const std::vector<const Image*>& frontToBack, RenderMode mode) {
     if (frontToBack.empty()) throw Error("bricks: no partial image to composite");
     Image out = *frontToBack.front();
-    for (std::size_t b = 1; b < frontToBack.size(); ++b) {
-        const Image& im = *frontToBack[b];
-        if (im.width != out.width || im.height != out.height)
-            throw Error("bricks: partial images differ in size");
-        for (std::size_t p = 0; p < out.pixels.size(); ++p) {
-            glm::vec4& o = out.pixels[p];
-            const glm::vec4& c = im.pixels[p];
-            if (mode == RenderMode::Mip)
-                o = glm::max(o, c);
-            else if (mode == RenderMode::Xray)
-                o = glm::vec4(glm::vec3(o) + glm::vec3(c), 1.0f);
-            else
-                o += (1.0f - o.a) * c;
-        }
-    }
+    for (std::size_t b = 1; b < frontToBack.size(); ++b) compositeBehind(out, *frontToBack[b], mode);
     return out;
 }
 
@@ -193,9 +199,25 @@ Image LocalBrickGroup::composite(std::vector<std::pair<int, Image>>& partials,
     return compositeBricks(ordered, mode, background);
 }
 
+std::optional<Image> emptyBrickImage(const Volume& whole, const RenderSettings& brickFrame) {
+    // Two samples of b a side at the volume's corner, spacing and orientation.
+    Volume probe = makeVolume(glm::ivec3(2), whole.spacing, whole.source);
+    probe.origin = whole.origin;
+    probe.direction = whole.direction;
+    probe.background = whole.background;
+    std::fill(probe.data.begin(), probe.data.end(), whole.background);
+    const Scene scene(std::move(probe), brickFrame);
+    if (scene.splats().size() > 0) return std::nullopt;
+    Image image = scene.render(brickFrame);
+    for (const glm::vec4& p : image.pixels)
+        if (p != image.pixels.front()) return std::nullopt;
+    return image;
+}
+
 BrickedFrames::BrickedFrames(const Volume& geometry, std::function<Volume(const Brick&)> load,
                              const RenderSettings& frame, int bricks, BrickGroup& group,
-                             BrickComposite composite, bool keep)
+                             BrickComposite composite, bool keep,
+                             std::function<bool(const Brick&)> empty)
     : geometry_(geometry),
       load_(std::move(load)),
       group_(group),
@@ -213,6 +235,17 @@ BrickedFrames::BrickedFrames(const Volume& geometry, std::function<Volume(const 
     st_.bricks = bricks;
     for (int b = group.rank(); b < bricks; b += group.size()) mine_.push_back(b);
     st_.rendered = int(mine_.size());
+    empty_.assign(mine_.size(), 0);
+    std::string error;
+    try {
+        if (empty)
+            for (std::size_t i = 0; i < mine_.size(); ++i)
+                empty_[i] = empty(layout_.bricks[std::size_t(mine_[i])]);
+    } catch (const std::exception& e) {
+        error = e.what();
+    }
+    group.agree(error);
+    st_.empty = int(std::count(empty_.begin(), empty_.end(), 1));
     volumes_.resize(mine_.size());
     scenes_.resize(3);
 
@@ -220,11 +253,14 @@ BrickedFrames::BrickedFrames(const Volume& geometry, std::function<Volume(const 
     // each brick; kept when the Scenes are (`keep`), or when this process holds one brick.
     const bool relative = frame.transfer.normalized || frame.isoNormalized;
     const bool exactSheets = exact(frame.renderer);
-    std::string error;
     float lo = INFINITY, hi = -INFINITY;
     try {
         if (keep || relative || (mine_.size() == 1 && !exactSheets))
             for (std::size_t i = 0; i < mine_.size(); ++i) {
+                if (empty_[i]) {  // b alone: loaded only if its frames need it
+                    lo = std::min(lo, geometry.background), hi = std::max(hi, geometry.background);
+                    continue;
+                }
                 Volume v = loadBrick(mine_[i]);
                 if (relative)
                     for (std::size_t n = 0; n < v.voxelCount(); ++n)
@@ -247,6 +283,7 @@ BrickedFrames::BrickedFrames(const Volume& geometry, std::function<Volume(const 
     if (!keep) return;
     try {  // the Scenes, once (their camera is any view's: a Scene does not depend on it)
         for (std::size_t i = 0; i < mine_.size(); ++i) {
+            if (empty_[i]) continue;  // built at its first frame that renders it
             RenderSettings bs =
                 brickSettings(s_, geometry_, layout_.bricks[std::size_t(mine_[i])], geometry_.dims);
             if (exactSheets) bs.clipping.planes.clear();
@@ -302,28 +339,67 @@ Image BrickedFrames::renderFrame(const CameraParams& camera, RendererKind render
     RenderSettings s = s_;
     s.camera = camera;
     s.renderer = renderer;
-    if (exact(renderer))
+    emptyImage_.reset();
+    if (st_.empty > 0) {
+        std::string error;
+        try {
+            emptyImage_ = emptyImage(s);
+        } catch (const std::exception& e) {
+            error = e.what();
+        }
+        group_.agree(error);
+    }
+    if (exact(renderer)) {
+        // The slab sheets are sums over the bricks: a brick of b that makes no splat adds
+        // nothing to them (every process keeps one brick, so that it takes part).
+        std::vector<std::size_t> kept;
+        for (std::size_t i = 0; i < mine_.size(); ++i)
+            if (!emptyImage_ || !empty_[i]) kept.push_back(i);
+        if (kept.empty() && !mine_.empty()) kept.push_back(0);
+        std::vector<int> bricks;
+        for (std::size_t i : kept) bricks.push_back(mine_[i]);
         return renderBrickedSlabs(
-            geometry_, layout_, mine_,
-            [&](int i, const RenderSettings& bs) { return scene(i, bs); }, s, group_, st_);
+            geometry_, layout_, bricks,
+            [&](int k, const RenderSettings& bs) { return scene(int(kept[std::size_t(k)]), bs); },
+            s, group_, st_);
+    }
+    if (dynamic_cast<LocalBrickGroup*>(&group_)) return renderInOrder(camera, s, frameStats);
+    return renderPieces(camera, s, frameStats);
+}
+
+std::optional<Image> BrickedFrames::emptyImage(const RenderSettings& s) const {
+    Brick whole;
+    whole.hi = whole.loadHi = geometry_.dims;
+    return emptyBrickImage(geometry_, brickSettings(s, geometry_, whole, geometry_.dims));
+}
+
+Image BrickedFrames::renderPiece(std::size_t i, const RenderSettings& s, RenderStats& frameStats) {
+    if (empty_[i] && emptyImage_) return *emptyImage_;
+    const int b = mine_[i];
+    const RenderSettings bs =
+        brickSettings(s, geometry_, layout_.bricks[std::size_t(b)], geometry_.dims);
+    const std::shared_ptr<const Scene> sc = scene(int(i), bs);
+    const auto t = Clock::now();
+    RenderStats rs;
+    Image image = sc->render(bs, &rs);
+    st_.renderMs += msSince(t);
+    st_.splats += rs.splats;
+    frameStats.splats += rs.splats;
+    frameStats.voxels += rs.voxels;
+    frameStats.sheetAxis = rs.sheetAxis;
+    frameStats.sheetSign = rs.sheetSign;
+    return image;
+}
+
+/// Every brick's partial image held until the group composites them (the processes
+/// exchange them).
+Image BrickedFrames::renderPieces(const CameraParams& camera, const RenderSettings& s,
+                                  RenderStats& frameStats) {
     std::vector<std::pair<int, Image>> partials;
     std::string error;
     try {
-        for (std::size_t i = 0; i < mine_.size(); ++i) {
-            const int b = mine_[i];
-            const RenderSettings bs =
-                brickSettings(s, geometry_, layout_.bricks[std::size_t(b)], geometry_.dims);
-            const std::shared_ptr<const Scene> sc = scene(int(i), bs);
-            const auto t = Clock::now();
-            RenderStats rs;
-            partials.emplace_back(b, sc->render(bs, &rs));
-            st_.renderMs += msSince(t);
-            st_.splats += rs.splats;
-            frameStats.splats += rs.splats;
-            frameStats.voxels += rs.voxels;
-            frameStats.sheetAxis = rs.sheetAxis;
-            frameStats.sheetSign = rs.sheetSign;
-        }
+        for (std::size_t i = 0; i < mine_.size(); ++i)
+            partials.emplace_back(mine_[i], renderPiece(i, s, frameStats));
     } catch (const std::exception& e) {
         error = e.what();
     }
@@ -336,10 +412,34 @@ Image BrickedFrames::renderFrame(const CameraParams& camera, RendererKind render
     return out;
 }
 
+/// One process: the bricks rendered in visibility order, each partial image composited
+/// into the frame as soon as it is rendered (compositePieces' operations in its order, so
+/// the frame is the same) and freed: one partial image held, not one per brick.
+Image BrickedFrames::renderInOrder(const CameraParams& camera, const RenderSettings& s,
+                                   RenderStats& frameStats) {
+    std::vector<int> slot(layout_.bricks.size(), -1);
+    for (std::size_t i = 0; i < mine_.size(); ++i) slot[std::size_t(mine_[i])] = int(i);
+    Image out, rendered;
+    for (int b : visibilityOrder(layout_, geometry_, camera)) {
+        const std::size_t i = std::size_t(slot[std::size_t(b)]);
+        const bool skip = empty_[i] && emptyImage_;
+        if (!skip) rendered = renderPiece(i, s, frameStats);
+        const Image& piece = skip ? *emptyImage_ : rendered;
+        const auto t = Clock::now();
+        if (out.pixels.empty())
+            out = piece;
+        else
+            compositeBehind(out, piece, s.mode);
+        st_.compositeMs += msSince(t);
+    }
+    blendBackground(out, s.mode, s.background);
+    return out;
+}
+
 Image renderBricked(const Volume& geometry, const std::function<Volume(const Brick&)>& load,
                     const RenderSettings& frame, int bricks, BrickGroup& group, BrickStats* stats,
-                    BrickComposite composite) {
-    BrickedFrames frames(geometry, load, frame, bricks, group, composite, false);
+                    BrickComposite composite, const std::function<bool(const Brick&)>& empty) {
+    BrickedFrames frames(geometry, load, frame, bricks, group, composite, false, empty);
     Image out = frames.render(frame.camera);
     if (stats) *stats = frames.stats();
     return out;

@@ -12,6 +12,7 @@
 #if SPLAT_HAVE_OPENVDB
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/Count.h>
 
 #include <mutex>
 #endif
@@ -44,6 +45,11 @@ Volume vdbGeometry(const fs::path& p, const LoadOptions&) { withoutOpenVdb(p); }
 Volume loadVdbBrick(const fs::path& p, const LoadOptions&, const glm::ivec3&, const glm::ivec3&) {
     withoutOpenVdb(p);
 }
+bool vdbBoxHoldsOnlyBackground(const fs::path& p, const LoadOptions&, const glm::ivec3&,
+                               const glm::ivec3&) {
+    withoutOpenVdb(p);
+}
+glm::dvec2 vdbValueRange(const fs::path& p, const LoadOptions&) { withoutOpenVdb(p); }
 }  // namespace detail
 }  // namespace splat
 
@@ -186,32 +192,72 @@ Volume geometry(const std::string& name, const openvdb::GridBase& g, const openv
     return v;
 }
 
+/// Calls `voxel(coord, value)` for every active voxel of `grid` inside `box` and
+/// `tile(box, value)` for every active tile's part of it; either returns true to stop.
+/// The leaves that meet `box` are found by their origins (one probe of the tree each), so
+/// the cost follows the box and its active voxels, not the grid.
+template <typename GridT, typename Voxel, typename Tile>
+void visitActive(const GridT& grid, const openvdb::CoordBBox& box, Voxel&& voxel, Tile&& tile) {
+    using TreeT = typename GridT::TreeType;
+    const TreeT& tree = grid.tree();
+    constexpr int dim = int(TreeT::LeafNodeType::DIM);
+    const openvdb::Coord first = box.min() & ~(dim - 1);  // the first leaf's origin
+    for (int z = first.z(); z <= box.max().z(); z += dim)
+        for (int y = first.y(); y <= box.max().y(); y += dim)
+            for (int x = first.x(); x <= box.max().x(); x += dim) {
+                const auto* leaf = tree.probeConstLeaf(openvdb::Coord(x, y, z));
+                if (!leaf) continue;
+                for (auto it = leaf->cbeginValueOn(); it; ++it)
+                    if (box.isInside(it.getCoord()) && voxel(it.getCoord(), *it)) return;
+            }
+    auto it = tree.cbeginValueOn();
+    it.setMaxDepth(TreeT::ValueOnCIter::LEAF_DEPTH - 1);  // tiles of the root and inner nodes
+    for (; it; ++it) {
+        openvdb::CoordBBox t;
+        it.getBoundingBox(t);
+        t.intersect(box);
+        if (!t.empty() && tile(t, *it)) return;
+    }
+}
+
 /// Fills `v` (the box [lo, lo + v.dims) in index space, already holding b) with the grid's
 /// active values: voxels one by one, active tiles over their boxes.
 template <typename GridT>
 void fillActive(const GridT& grid, const openvdb::Coord& lo, Volume& v) {
     const openvdb::CoordBBox box(lo, lo + openvdb::Coord(v.dims.x - 1, v.dims.y - 1, v.dims.z - 1));
-    for (auto it = grid.cbeginValueOn(); it; ++it) {
-        if (it.isVoxelValue()) {
-            const openvdb::Coord c = it.getCoord();
-            if (box.isInside(c)) v.at(c.x() - lo.x(), c.y() - lo.y(), c.z() - lo.z()) = float(*it);
-            continue;
-        }
-        openvdb::CoordBBox tile;
-        it.getBoundingBox(tile);
-        tile.intersect(box);
-        if (tile.empty()) continue;
-        for (int z = tile.min().z(); z <= tile.max().z(); ++z)
-            for (int y = tile.min().y(); y <= tile.max().y(); ++y)
-                for (int x = tile.min().x(); x <= tile.max().x(); ++x)
-                    v.at(x - lo.x(), y - lo.y(), z - lo.z()) = float(*it);
-    }
+    visitActive(
+        grid, box,
+        [&](const openvdb::Coord& c, double value) {
+            v.at(c.x() - lo.x(), c.y() - lo.y(), c.z() - lo.z()) = float(value);
+            return false;
+        },
+        [&](const openvdb::CoordBBox& t, double value) {
+            for (int z = t.min().z(); z <= t.max().z(); ++z)
+                for (int y = t.min().y(); y <= t.max().y(); ++y)
+                    for (int x = t.min().x(); x <= t.max().x(); ++x)
+                        v.at(x - lo.x(), y - lo.y(), z - lo.z()) = float(value);
+            return false;
+        });
+}
+
+/// Whether `box` (index space) holds an active voxel or tile whose value is not `b`.
+template <typename GridT>
+bool holdsOtherThan(const GridT& grid, const openvdb::CoordBBox& box, double b) {
+    bool found = false;
+    const auto other = [&](double value) {
+        found = float(value) != float(b);
+        return found;
+    };
+    visitActive(
+        grid, box, [&](const openvdb::Coord&, double value) { return other(value); },
+        [&](const openvdb::CoordBBox&, double value) { return other(value); });
+    return found;
 }
 
 /// The box [lo, hi) of the volume whose index (0,0,0) is voxel `origin` of `grid`.
-Volume readBox(const VdbFile& f, const openvdb::GridBase& grid, const Volume& g,
+Volume readBox(const std::string& name, const openvdb::GridBase& grid, const Volume& g,
                const openvdb::Coord& origin, const glm::ivec3& lo, const glm::ivec3& hi) {
-    Volume v = makeVolume(hi - lo, g.spacing, f.name);
+    Volume v = makeVolume(hi - lo, g.spacing, name);
     v.origin = g.world(glm::dvec3(lo));
     v.source = g.source;
     v.note = g.note;
@@ -232,32 +278,58 @@ struct Chosen {
     Volume geometry;
 };
 
-/// The chosen grid's geometry; `grid` receives the whole grid when it had to be read.
+/// The chosen grid's geometry; `grid` receives the whole grid.
 Chosen choose(const VdbFile& f, const LoadOptions& options, openvdb::GridBase::Ptr* grid) {
     Chosen c;
     c.meta = chooseGrid(f, options.grid);
-    std::uint64_t active = 0;
-    if (const auto n =
-            c.meta->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT))
-        active = std::uint64_t(n->value());
-    if (grid || !fileBBox(*c.meta, c.box)) {
-        openvdb::GridBase::Ptr whole = f.guard([&] { return f.file->readGrid(c.meta->getName()); });
-        c.box = whole->evalActiveVoxelBoundingBox();
-        active = whole->activeVoxelCount();
-        if (grid) *grid = whole;
-        c.meta = whole;
-    }
-    c.geometry = geometry(f.name, *c.meta, c.box, active);
-    if (!grid) {
-        // The metadata hold no tree, and so no background: read the grid clipped to one
-        // voxel's world box (the root node, which holds the background, and a leaf at most).
-        const glm::dvec3 w = c.geometry.world(glm::dvec3(0.0));
-        const openvdb::BBoxd one(openvdb::Vec3d(w.x, w.y, w.z), openvdb::Vec3d(w.x, w.y, w.z));
-        c.meta = f.guard([&] { return f.file->readGrid(c.meta->getName(), one); });
-    }
-    c.geometry.background = float(background(*c.meta));
+    *grid = f.guard([&] { return f.file->readGrid(c.meta->getName()); });
+    c.meta = *grid;
+    c.box = (*grid)->evalActiveVoxelBoundingBox();
+    c.geometry = geometry(f.name, **grid, c.box, (*grid)->activeVoxelCount());
+    c.geometry.background = float(background(**grid));
     c.geometry.backgroundSource = "OpenVDB grid background";
     return c;
+}
+
+/// The chosen grid of one file read whole (its tree: memory follows the active voxels, not
+/// the bounding box) with its geometry: a frame's bricks read their samples from it.
+struct OpenGrid {
+    std::string key, name;
+    openvdb::GridBase::Ptr grid;
+    openvdb::Coord origin;  ///< the voxel at the volume's index (0, 0, 0)
+    Volume geometry;
+
+    void check(const glm::ivec3& lo, const glm::ivec3& hi) const {
+        if (glm::any(glm::lessThan(lo, glm::ivec3(0))) ||
+            glm::any(glm::greaterThan(hi, geometry.dims)) ||
+            glm::any(glm::lessThanEqual(hi, lo)))
+            throw Error(name + ": brick outside the volume");
+    }
+};
+
+/// The grid of `p` that `options` choose, read once per process and kept while the same
+/// file (path, size, modification time) and grid are asked for: the bricks of a frame open
+/// and check the file once.
+std::shared_ptr<const OpenGrid> openGrid(const fs::path& p, const LoadOptions& options) {
+    static std::mutex mutex;
+    static std::shared_ptr<const OpenGrid> last;
+    std::error_code ec;
+    const auto size = fs::file_size(p, ec);
+    const auto time = fs::last_write_time(p, ec).time_since_epoch().count();
+    const std::string key = fs::absolute(p, ec).string() + '\n' + options.grid + '\n' +
+                            std::to_string(size) + '\n' + std::to_string(time);
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (last && last->key == key) return last;
+    last.reset();  // the previous file's tree is freed before the next is read
+    const VdbFile f(p);
+    auto g = std::make_shared<OpenGrid>();
+    const Chosen c = choose(f, options, &g->grid);
+    g->key = key;
+    g->name = f.name;
+    g->origin = c.box.min();
+    g->geometry = c.geometry;
+    last = g;
+    return g;
 }
 
 }  // namespace
@@ -304,29 +376,47 @@ Volume loadVdb(const fs::path& p, const LoadOptions& options) {
     const VdbFile f(p);
     openvdb::GridBase::Ptr grid;
     const Chosen c = choose(f, options, &grid);
-    return readBox(f, *grid, c.geometry, c.box.min(), glm::ivec3(0), c.geometry.dims);
+    return readBox(f.name, *grid, c.geometry, c.box.min(), glm::ivec3(0), c.geometry.dims);
 }
 
 Volume vdbGeometry(const fs::path& p, const LoadOptions& options) {
-    const VdbFile f(p);
-    return choose(f, options, nullptr).geometry;
+    return openGrid(p, options)->geometry;
 }
 
 Volume loadVdbBrick(const fs::path& p, const LoadOptions& options, const glm::ivec3& lo,
                     const glm::ivec3& hi) {
-    const VdbFile f(p);
-    const Chosen c = choose(f, options, nullptr);
-    if (glm::any(glm::lessThan(lo, glm::ivec3(0))) ||
-        glm::any(glm::greaterThan(hi, c.geometry.dims)) || glm::any(glm::lessThanEqual(hi, lo)))
-        throw Error(f.name + ": brick outside the volume");
-    // The world box of the brick's voxel centres, half a voxel wider: only the tree's nodes
-    // that intersect it are read.
-    const glm::dvec3 w0 = c.geometry.world(glm::dvec3(lo) - 0.5);
-    const glm::dvec3 w1 = c.geometry.world(glm::dvec3(hi) - 0.5);
-    const openvdb::BBoxd world(openvdb::Vec3d(w0.x, w0.y, w0.z), openvdb::Vec3d(w1.x, w1.y, w1.z));
-    const openvdb::GridBase::Ptr part =
-        f.guard([&] { return f.file->readGrid(c.meta->getName(), world); });
-    return readBox(f, *part, c.geometry, c.box.min(), lo, hi);
+    const std::shared_ptr<const OpenGrid> g = openGrid(p, options);
+    g->check(lo, hi);
+    return readBox(g->name, *g->grid, g->geometry, g->origin, lo, hi);
+}
+
+glm::dvec2 vdbValueRange(const fs::path& p, const LoadOptions& options) {
+    const std::shared_ptr<const OpenGrid> g = openGrid(p, options);
+    glm::dvec2 range(INFINITY, -INFINITY);
+    if (g->grid->activeVoxelCount() < g->geometry.voxelCount())  // some samples are b
+        range = glm::dvec2(g->geometry.background);
+    const auto widen = [&](const auto& grid) {
+        const auto m = openvdb::tools::minMax(grid.tree());
+        range = glm::dvec2(std::min(range.x, double(float(m.min()))),
+                           std::max(range.y, double(float(m.max()))));
+    };
+    if (g->grid->isType<openvdb::FloatGrid>())
+        widen(static_cast<const openvdb::FloatGrid&>(*g->grid));
+    else
+        widen(static_cast<const openvdb::DoubleGrid&>(*g->grid));
+    return range;
+}
+
+bool vdbBoxHoldsOnlyBackground(const fs::path& p, const LoadOptions& options,
+                               const glm::ivec3& lo, const glm::ivec3& hi) {
+    const std::shared_ptr<const OpenGrid> g = openGrid(p, options);
+    g->check(lo, hi);
+    const openvdb::CoordBBox box(g->origin + openvdb::Coord(lo.x, lo.y, lo.z),
+                                 g->origin + openvdb::Coord(hi.x - 1, hi.y - 1, hi.z - 1));
+    const double b = g->geometry.background;
+    if (g->grid->isType<openvdb::FloatGrid>())
+        return !holdsOtherThan(static_cast<const openvdb::FloatGrid&>(*g->grid), box, b);
+    return !holdsOtherThan(static_cast<const openvdb::DoubleGrid&>(*g->grid), box, b);
 }
 
 }  // namespace detail

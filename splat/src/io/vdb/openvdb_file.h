@@ -20,13 +20,22 @@ bool isVdbFile(const std::filesystem::path& p);
 /// The chosen grid as a volume over its active voxels' bounding box.
 Volume loadVdb(const std::filesystem::path& p, const LoadOptions& options);
 
-/// That volume's geometry and background (no samples), from the grid's metadata when the
-/// file records its bounding box, else from its tree.
+/// That volume's geometry and background (no samples). The grid's tree is read whole once
+/// and kept for the bricks of the same file and grid (memory follows its active voxels).
 Volume vdbGeometry(const std::filesystem::path& p, const LoadOptions& options);
 
-/// The samples [lo, hi) of that volume, origin at sample lo; only the part of the tree that
-/// intersects the box is read from the file.
+/// The samples [lo, hi) of that volume, origin at sample lo, filled from the kept tree: b,
+/// then the active voxels and tiles inside the box (only the leaves that meet it are read).
 Volume loadVdbBrick(const std::filesystem::path& p, const LoadOptions& options,
                     const glm::ivec3& lo, const glm::ivec3& hi);
+
+/// The smallest and largest of that volume's samples, from the tree: its active values, and
+/// b unless every voxel of the box is active.
+glm::dvec2 vdbValueRange(const std::filesystem::path& p, const LoadOptions& options);
+
+/// Whether the samples [lo, hi) of that volume all equal b: no active voxel or tile of
+/// another value meets the box (from the tree, no samples filled).
+bool vdbBoxHoldsOnlyBackground(const std::filesystem::path& p, const LoadOptions& options,
+                               const glm::ivec3& lo, const glm::ivec3& hi);
 
 }  // namespace splat::detail
