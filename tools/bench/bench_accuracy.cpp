@@ -12,8 +12,8 @@
 // built once per configuration; the time is that of render() alone). The splatters use the
 // default front-to-back early termination (1/256) unless --early-termination says otherwise.
 // --lod L adds the axis-aligned and slab-1 image-aligned splatters at level of detail L
-// (Quality::lod) and their level; --lod auto the same with Quality::lodAuto, --lod brick with
-// Quality::lodBrick (docs/speed-vs-accuracy.md "Level of detail"); with --ewa also both with EWA
+// (Quality::lod, a pixel threshold) and their level; --lod auto and --lod brick the same with
+// those kinds of LevelOfDetail (docs/speed-vs-accuracy.md "Level of detail"); with --ewa also both with EWA
 // on; a list (--lod 1,auto) adds each in turn. --axis-only leaves out the image-aligned rows.
 // --supersample N renders the reference with N x N rays per pixel (at N times the size) and
 // box-filters it: the pixel's area average rather than its centre's value.

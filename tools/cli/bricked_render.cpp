@@ -157,7 +157,7 @@ int automaticBricks(const VolumeArgs& volume, const RenderSettings& settings) {
     if (settings.mode == RenderMode::Dvr && settings.classification == Classification::Post)
         return 0;
     const Quality& q = settings.quality;
-    if (q.lod > 0 || q.lodAuto || q.lodBrick) return 0;
+    if (q.lod.kind != LevelOfDetail::Kind::Off) return 0;
     if (settings.renderer == RendererKind::Sheet &&  // its exact bricks refuse these
         (settings.clipping.enabled() || settings.camera.projection == Projection::Perspective))
         return 0;

@@ -248,7 +248,7 @@ struct RenderStats {
     /// Level of detail the splatters used (Quality::lod): 0 the full-resolution list, L the
     /// list of 2^L x 2^L x 2^L voxels merged per splat, holding lodSplats splats (= splats at
     /// level 0; 0 for frames of the reference ray caster).
-    /// With `--lod auto` a frame mixes levels, a level per brick (Quality::lodAuto): lodLevel
+    /// With `--lod auto` a frame mixes levels, a level per brick (LevelOfDetail::Kind::Auto): lodLevel
     /// is then the coarsest level splatted, lodSplats the splats splatted over all levels and
     /// lodLevelSplats[L] those of level L (empty for frames of the reference ray caster).
     int lodLevel = 0;
