@@ -29,6 +29,9 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
     budget.height = settings.camera.height;
     budget.ghost = ghostLayers(kernel.radius(), geometry.spacing);
     budget.extraSampleBytes = extraSampleBytes;
+    // Outside dvr every sample that differs from b becomes a splat (classify keeps them all),
+    // so the estimate cannot assume the transfer function drops most of them.
+    if (settings.mode != RenderMode::Dvr) budget.splatShare = 1.0;
     const BrickChoice c = chooseBricks(geometry.dims, budget);
     if (wholeFits) *wholeFits = c.wholeFits;
     if (!workerProcess() && !quiet) {
