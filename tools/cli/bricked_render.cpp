@@ -173,6 +173,11 @@ int automaticBricks(const VolumeArgs& volume, const RenderSettings& settings) {
     } catch (const std::exception&) {
         return 0;  // the whole volume's load says what is wrong, as without bricks
     }
+    // Bricks make the samples per process smaller, never the images: a frame whose images
+    // alone exceed the budget renders whole (and its own checks say what is wrong).
+    if (brickMemoryEstimate(0, settings.camera.width, settings.camera.height, 1, 0.0) >
+        defaultRankBytes(1))
+        return 0;
     bool fits = true;
     const int needed = bricksFromBudget(geometry, settings, 1, 0, &fits, true);
     const std::size_t cap = std::min<std::size_t>(geometry.voxelCount(), 4096);
