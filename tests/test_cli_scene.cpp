@@ -4,7 +4,9 @@
 // the metadata of written images; normalized and absolute iso levels.
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -269,4 +271,34 @@ TEST_CASE("a scene file as VOLUME, and a Gaussian scene as a scene's input", "[c
     const RunResult e = runSplat({"render", empty.string(), "-o", c.string()});
     CHECK(e.status == 2);
     CHECK(e.err.find("needs VOLUME") != std::string::npos);
+}
+
+TEST_CASE("a Gaussian scene's --slab and --ref-tolerance reach its renderers, from flags and "
+          "scenes", "[cli][scene]") {
+    const fs::path dir = testTmpDir("scene_gaussian_slab");
+    const fs::path thin = dir / "thin.exr", thick = dir / "thick.exr", fromScene = dir / "s.exr";
+    const fs::path scene = dir / "thin.json";
+    const std::vector<std::string> common = {"gaussians:pop", "--renderer", "sheet", "--size",
+                                             "32x24", "--azimuth", "20"};
+    auto render = [&](const fs::path& out, std::vector<std::string> extra) {
+        std::vector<std::string> a = {"render"};
+        a.insert(a.end(), common.begin(), common.end());
+        a.insert(a.end(), extra.begin(), extra.end());
+        a.insert(a.end(), {"-o", out.string()});
+        return runSplat(a);
+    };
+    REQUIRE(render(thin, {"--slab", "0.05", "--write-scene", scene.string()}).status == 0);
+    REQUIRE(render(thick, {"--slab", "2"}).status == 0);
+    // Slabs of 0.05 and 2 (the sheets' error falls as the slab thins): different images.
+    const splat::Image a = splat::readImage(thin.string()), b = splat::readImage(thick.string());
+    REQUIRE(a.pixels.size() == b.pixels.size());
+    float largest = 0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i)
+        for (int c = 0; c < 4; ++c)
+            largest = std::max(largest, std::abs(a.pixels[i][c] - b.pixels[i][c]));
+    CHECK(largest > 1e-3f);
+    const RunResult r = runSplat({"render", "--scene", scene.string(), "-o", fromScene.string()});
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(samePixels(thin, fromScene));
 }

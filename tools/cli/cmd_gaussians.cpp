@@ -17,6 +17,9 @@ namespace splat::cli {
 
 RenderSettings gaussianViewOf(const RenderArgs& a) {
     OptionValues values = a.values;
+    // What the run set (flags, a scene's keys) is marked given, so that the quality preset
+    // keeps it (--slab, --ref-tolerance).
+    if (a.cmd) readGiven(*a.cmd, values);
     values.set("renderer", "axis");
     return asOptionUsage([&] { return parseRenderOptions(values); });
 }
