@@ -30,8 +30,7 @@ bool sameQuality(const Quality& a, const Quality& b) {
     return a.slab == b.slab && a.earlyTermination == b.earlyTermination &&
            a.referenceStep == b.referenceStep && a.referenceTolerance == b.referenceTolerance &&
            a.factorisedSheets == b.factorisedSheets && a.tileSize == b.tileSize && a.lod == b.lod &&
-           a.lodAuto == b.lodAuto && a.lodBrick == b.lodBrick && a.ewa == b.ewa &&
-           a.pixelFilter == b.pixelFilter;
+           a.ewa == b.ewa && a.pixelFilter == b.pixelFilter;
 }
 
 }  // namespace
