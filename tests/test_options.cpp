@@ -5,7 +5,6 @@
 #include <catch2/catch.hpp>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <set>
 
 #include "cli_util.h"
 #include "splat/options.h"
@@ -77,10 +76,12 @@ std::string lastErrorLine(const RunResult& r) {
 }  // namespace
 
 TEST_CASE("the option table's defaults are the library's defaults", "[options]") {
-    std::set<std::string_view> names;
     for (const OptionSpec& o : optionTable()) {
         INFO(o.name);
-        CHECK(names.insert(o.name).second);  // every option once
+        // Every option once: entries share a name only when no command takes both.
+        CHECK(findOption(o.name, o.set) == &o);
+        for (const OptionSpec& other : optionTable())
+            if (&other != &o && other.name == o.name) CHECK((other.set & o.set) == 0);
         CHECK(!o.help.empty());
         CHECK(!o.group.empty());
         CHECK(checkOptionText(o, std::string(o.defaultText.empty() && o.type != OptionType::Text &&
@@ -137,6 +138,7 @@ TEST_CASE("flag, scene key and library accept and refuse the same values alike",
     int refused = 0;
     for (const OptionSpec& o : optionTable()) {
         if (o.set == kStudyOnlyOptions) continue;  // no flag: swept by a study only
+        if (!(o.set & kSharedOptions)) continue;    // a command's own: walked below
         for (const std::string& value : trialValues(o)) {
             const std::string name(o.name);
             INFO("--" << name << " " << value);
@@ -195,4 +197,123 @@ TEST_CASE("flag, scene key and library accept and refuse the same values alike",
         }
     }
     CHECK(refused > 40);
+}
+
+namespace {
+
+// A command's run with `extra` after `base` (the pairs of `base` naming `drop` left out).
+std::vector<std::string> commandLine(const std::vector<std::string>& base, const std::string& drop,
+                                     const std::vector<std::string>& extra) {
+    std::vector<std::string> args;
+    for (std::size_t i = 0; i < base.size(); ++i) {
+        if (base[i] == "--" + drop) {
+            ++i;
+            continue;
+        }
+        args.push_back(base[i]);
+    }
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+}
+
+// Walks the options of `sets` (a command's own) on `base`: a value the table refuses is
+// refused by the flag and the scene key, exit 2, with the same "--NAME: why"; the default
+// runs; text the command itself checks gets the same line from the flag and the key (only
+// refusals when `refusalsOnly`: the command's runs are long). `scene` "": the command reads no
+// scene file (the view commands), only its flags are walked.
+void walkCommandOptions(unsigned sets, const std::vector<std::string>& base,
+                        const std::string& scene, int& refused, int& same,
+                        bool refusalsOnly = false) {
+    for (const OptionSpec* o : optionsOf(sets)) {
+        CHECK(findOption(o->name, sets) == o);
+        if (o->type == OptionType::Flag || o->path != OptionPath::None) continue;
+        for (const std::string& value : trialValues(*o)) {
+            const std::string name(o->name), why = checkOptionText(*o, value);
+            INFO(base[0] << " --" << name << " " << value);
+            // A value the table accepts runs only when it is the default or text the command
+            // itself checks (a number like 100000 frames would be a long run).
+            if (why.empty() && value != o->defaultText && o->type != OptionType::Text) continue;
+            if (why.empty() && refusalsOnly) continue;
+            const RunResult a = runSplat(commandLine(base, name, {"--" + name, value}));
+            INFO(a.err);
+            if (scene.empty()) {
+                if (!why.empty()) {
+                    ++refused;
+                    CHECK(a.status == 2);
+                    CHECK(lastErrorLine(a) == "splat: error: --" + name + ": " + why);
+                } else if (value == o->defaultText) {
+                    CHECK(a.status == 0);
+                } else {  // text the command refuses, in one line of its own
+                    ++same;
+                    CHECK(a.status != 0);
+                    CHECK(a.errLines().size() == 1);
+                }
+                continue;
+            }
+            nlohmann::json j = {{"command", base[0]}};
+            j[name] = value;
+            std::ofstream(scene) << j.dump();
+            const RunResult b = runSplat(commandLine(base, name, {"--scene", scene}));
+            INFO(b.err);
+            CHECK(a.status == b.status);
+            if (!why.empty()) {
+                ++refused;
+                const std::string verdict = "--" + name + ": " + why;
+                CHECK(a.status == 2);
+                CHECK(lastErrorLine(a) == "splat: error: " + verdict);
+                const std::string sceneLine = lastErrorLine(b);
+                CHECK(sceneLine.find(verdict) != std::string::npos);
+                CHECK(sceneLine.find(scene) != std::string::npos);
+                CHECK(sceneLine.find("\"" + name + "\"") != std::string::npos);
+            } else if (value == o->defaultText) {
+                CHECK(a.status == 0);
+            } else {  // text the command refuses: the same line from the flag and the key
+                ++same;
+                CHECK(a.status != 0);
+                CHECK(lastErrorLine(a) == lastErrorLine(b));
+            }
+        }
+    }
+}
+
+}  // namespace
+
+TEST_CASE("the commands' own options: flag and scene key accept and refuse alike, in one line",
+          "[options][cli][scene]") {
+    const auto dir = testTmpDir("options_walk_commands");
+    const std::string scene = (dir / "scene.json").string(), curve = (dir / "curve.json").string();
+    std::ofstream(curve) << R"({"points": [[-2, 0, 0], [2, 0, 0]]})";
+    const std::string in = "synthetic:phantom:8";
+    int refused = 0, same = 0;
+    walkCommandOptions(kRotateOptions,
+                       {"rotate", in, "--size", "8x8", "--frames", "2", "-q", "--overwrite", "-o",
+                        (dir / "frames").string()},
+                       scene, refused, same);
+    // The view commands read no scene file: their flags against the table.
+    walkCommandOptions(kSlicesOptions | kViewOptions,
+                       {"slices", in, "--every", "4", "-o", (dir / "slices").string()}, "",
+                       refused, same);
+    walkCommandOptions(kMprOptions,
+                       {"mpr", in, "--plane", "0,0,0,0,0,1", "--size", "8x8", "-o",
+                        (dir / "mpr.png").string()},
+                       "", refused, same);
+    walkCommandOptions(kCprOptions,
+                       {"cpr", in, "--curve", curve, "--width", "8", "-o",
+                        (dir / "cpr.png").string()},
+                       "", refused, same);
+    walkCommandOptions(kIsoOptions, {"iso", in, "--level", "0.5", "-o", (dir / "s.ply").string()},
+                       "", refused, same);
+    walkCommandOptions(kRenderCommandOptions,
+                       {"render", in, "--size", "8x8", "-o", (dir / "r.exr").string()}, scene,
+                       refused, same);
+    walkCommandOptions(kBenchOptions, {"bench", in, "--size", "8x8", "--repeats", "1"}, scene,
+                       refused, same);
+    walkCommandOptions(kPoppingOptions,
+                       {"popping", in, "--size", "8x8", "--report", (dir / "pop").string()},
+                       scene, refused, same, true);
+    walkCommandOptions(kStudyOptions,
+                       {"study", in, "--size", "8x8", "--report", (dir / "study").string()},
+                       scene, refused, same, true);
+    CHECK(refused >= 30);
+    CHECK(same >= 10);
 }

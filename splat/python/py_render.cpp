@@ -111,7 +111,8 @@ void bindRender(py::module_& m) {
             static const char* const types[] = {"flag", "integer", "unsigned",
                                                 "real", "text",    "list"};
             std::vector<std::tuple<std::string, std::string, std::string, std::string, bool>> out;
-            for (const OptionSpec& o : optionTable()) {
+            for (const OptionSpec* spec : optionsOf(kSharedOptions)) {
+                const OptionSpec& o = *spec;
                 const char* set = o.set == kVolumeOptions  ? "volume"
                                   : o.set == kRenderOptions ? "render"
                                   : o.set == kImageOptions  ? "image"

@@ -50,25 +50,11 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
     return c.bricks;
 }
 
-void addSequenceBrickOptions(CLI::App& cmd, SequenceBrickArgs& b, const std::string& group,
-                             const std::string& frames) {
-    addOption(cmd, "--bricks", b.bricks,
-              "sort-last: cut the volume into K bricks, loaded and built once, " + frames +
-                  " rendered by them and composited (0: off; under mpirun chosen from "
-                  "--rank-memory when the volume does not fit one process)",
-              group);
-    addOption(cmd, "--rank-memory", b.rankMemory,
-              "bricks: memory per process in MiB (default under mpirun: 80% of the physical "
-              "memory / processes on the node); frames in parallel when the volume fits",
-              group);
-    addOption(cmd, "--brick-composite", b.composite,
-              "bricks of the image-aligned splatter: exact (slab sheets summed across bricks: "
-              "the same as one process) or fast (partial images, approximate at brick faces)",
-              group);
-    addOption(cmd, "--compositor", b.compositor,
-              "bricks under mpirun: direct (sparse direct-send, the default) | icet (IceT "
-              "radix-k, when built with it) | auto (icet when built with it, else direct)",
-              group);
+void addSequenceBrickOptions(CLI::App& cmd, SequenceBrickArgs& b, unsigned sets) {
+    addTableOption(cmd, "bricks", b.bricks, sets);
+    addTableOption(cmd, "rank-memory", b.rankMemory, sets);
+    addTableOption(cmd, "brick-composite", b.composite, sets);
+    addTableOption(cmd, "compositor", b.compositor, sets);
 }
 
 void checkSequenceBrickOptions(const CLI::App& cmd, const SequenceBrickArgs& b) {

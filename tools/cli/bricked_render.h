@@ -54,10 +54,10 @@ struct SequenceBrickArgs {
     std::string composite = "exact";    ///< --brick-composite exact|fast
     std::string compositor = "direct";  ///< --compositor (parallel.h)
 };
-/// Registers --bricks, --rank-memory, --brick-composite and --compositor in `group`;
-/// `frames`: what the bricks render ("every frame", "every frame of the analysis").
-void addSequenceBrickOptions(CLI::App& cmd, SequenceBrickArgs& b, const std::string& group,
-                             const std::string& frames);
+/// Registers --bricks, --rank-memory, --brick-composite and --compositor from the option
+/// table's entries of `sets` (kRotateOptions, kPoppingOptions: their help says what the
+/// bricks render).
+void addSequenceBrickOptions(CLI::App& cmd, SequenceBrickArgs& b, unsigned sets);
 /// Their values' checks (UsageError), and the warning for --compositor without mpirun.
 void checkSequenceBrickOptions(const CLI::App& cmd, const SequenceBrickArgs& b);
 

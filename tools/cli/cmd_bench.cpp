@@ -50,9 +50,9 @@ void registerBench(CLI::App& app) {
         app.add_subcommand("bench", "time rendering (median of repeats) per thread count");
     addVolumeOptions(*cmd, a->volume);
     addRenderOptions(*cmd, a->render, false);
-    addOption(*cmd, "--repeats", a->repeats, "timed frames per configuration", "Benchmark");
-    addOption(*cmd, "--thread-list", a->threadList, "thread counts to time, e.g. 1,2", "Benchmark");
-    addOption(*cmd, "--json", a->json, "write the results as JSON", "Output", PathKind::Output);
+    addTableOption(*cmd, "repeats", a->repeats, kBenchOptions);
+    addTableOption(*cmd, "thread-list", a->threadList, kBenchOptions);
+    addTableOption(*cmd, "json", a->json, kBenchOptions);
     cmd->footer(
         "Examples:\n"
         "  splat bench synthetic:phantom:64 --renderer sheet --thread-list 1,2,4\n"

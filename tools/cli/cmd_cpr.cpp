@@ -35,16 +35,11 @@ void registerCpr(CLI::App& app) {
         app.add_subcommand("cpr", "curved planar reformation along a polyline (straightened)");
     addVolumeOptions(*cmd, a->volume);
     addViewOptions(*cmd, a->view);
-    addOption(*cmd, "--curve", a->curve, "curve FILE.json {\"points\": [[x,y,z], ...]}", "Curve",
-              PathKind::Input)
-        ->required();
-    addOption(*cmd, "--lateral", a->lateral, "lateral direction X,Y,Z (default 0,0,1)", "Curve");
-    addOption(*cmd, "--width", a->width, "image width, pixels (0: the curve file's, or 128)",
-              "Curve");
-    addOption(*cmd, "--pixel-size", a->pixelSize,
-              "world units per pixel (0: the curve file's, or the spacing)", "Curve");
-    addOption(*cmd, "-o,--output", a->output, "output image", "Output", PathKind::Output)
-        ->required();
+    addTableOption(*cmd, "curve", a->curve, kCprOptions)->required();
+    addTableOption(*cmd, "lateral", a->lateral, kCprOptions);
+    addTableOption(*cmd, "width", a->width, kCprOptions);
+    addTableOption(*cmd, "pixel-size", a->pixelSize, kCprOptions);
+    addTableOption(*cmd, "output", a->output, kCprOptions)->required();
     cmd->footer(
         "Examples:\n"
         "  splat cpr ct.nrrd --curve vessel.json -o vessel.png\n"

@@ -29,17 +29,12 @@ void registerIso(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "iso", "iso surface of the reconstructed field as a mesh (.ply, .obj, .stl)");
     addVolumeOptions(*cmd, a->volume);
-    addOption(*cmd, "--level", a->level, "the level L of the surface f = L (data units)", "Surface")
-        ->required();
-    addOption(*cmd, "--kernel", a->kernel, "reconstruction kernel (as for render)", "Surface");
-    addOption(*cmd, "--sigma", a->sigma, "kernel sigma, voxels (0 = the kernel's default)",
-              "Surface");
-    addOption(*cmd, "--radius", a->radius, "kernel radius, voxels (0 = the kernel's default)",
-              "Surface");
-    addOption(*cmd, "--threads", a->threads, "threads (0 = all cores)", "Surface");
-    addOption(*cmd, "-o,--output", a->output, "mesh file: .ply (binary), .obj or .stl (binary)",
-              "Output", PathKind::Output)
-        ->required();
+    addTableOption(*cmd, "level", a->level, kIsoOptions)->required();
+    addTableOption(*cmd, "kernel", a->kernel, kIsoOptions);
+    addTableOption(*cmd, "sigma", a->sigma, kIsoOptions);
+    addTableOption(*cmd, "radius", a->radius, kIsoOptions);
+    addTableOption(*cmd, "threads", a->threads, kIsoOptions);
+    addTableOption(*cmd, "output", a->output, kIsoOptions)->required();
     cmd->footer(
         "Examples:\n"
         "  splat iso synthetic:ct-phantom --level -500 -o skin.ply\n"

@@ -29,16 +29,11 @@ void registerMpr(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("mpr", "a cut plane through the reconstructed field");
     addVolumeOptions(*cmd, a->volume);
     addViewOptions(*cmd, a->view);
-    addOption(*cmd, "--plane", a->plane, "plane POINT,NORMAL: X,Y,Z,NX,NY,NZ (world)", "Plane")
-        ->required();
-    addOption(*cmd, "--up", a->up, "image up direction X,Y,Z (auto: +z, or +y for axial planes)",
-              "Plane");
-    addOption(*cmd, "--size", a->size, "image size WxH", "Plane");
-    addOption(*cmd, "--pixel-size", a->pixelSize, "world units per pixel (0 = smallest spacing)",
-              "Plane");
-    addOption(*cmd, "-o,--output", a->output, "output image (.png windowed, .exr/.tif values)",
-              "Output", PathKind::Output)
-        ->required();
+    addTableOption(*cmd, "plane", a->plane, kMprOptions)->required();
+    addTableOption(*cmd, "up", a->up, kMprOptions);
+    addTableOption(*cmd, "size", a->size, kMprOptions);
+    addTableOption(*cmd, "pixel-size", a->pixelSize, kMprOptions);
+    addTableOption(*cmd, "output", a->output, kMprOptions)->required();
     cmd->footer(
         "Examples:\n"
         "  splat mpr ch2.nii.gz --plane 0,0,10,0,0,1 --size 256x256 -o axial.png\n"

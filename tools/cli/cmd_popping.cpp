@@ -103,13 +103,10 @@ void registerPopping(CLI::App& app) {
     addVolumeOptions(*cmd, a->volume);
     addRenderOptions(*cmd, a->render, false);
     addPoppingOptions(*cmd, a->popping);
-    const std::string out = "Output";
-    addOption(*cmd, "--report", a->report, "report folder (report.html, metrics.csv, summary.json)",
-              out, PathKind::Output);
-    addFlag(*cmd, "--resume", a->resume,
-            "finish an interrupted run: reuse the frames it left in REPORT/.frames", out);
-    addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
-    addSequenceBrickOptions(*cmd, a->brick, out, "every frame of the analysis");
+    addTableOption(*cmd, "report", a->report, kPoppingOptions);
+    addTableOption(*cmd, "resume", a->resume, kPoppingOptions);
+    addTableOption(*cmd, "quiet", a->quiet, kPoppingOptions);
+    addSequenceBrickOptions(*cmd, a->brick, kPoppingOptions);
     cmd->footer(
         "Examples:\n"
         "  splat popping synthetic:phantom:64 --from 40 --to 50 --step 0.5 --report pop\n"

@@ -47,28 +47,12 @@ void registerRender(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("render", "render one image of a volume");
     addVolumeOptions(*cmd, args->volume);
     addRenderOptions(*cmd, args->render, true);
-    addOption(*cmd, "-o,--output", args->output,
-              "output image: .png (8-bit display), .exr or .tif (float, values as computed)",
-              "Output", PathKind::Output);
-    addOption(*cmd, "--bricks", args->bricks,
-              "sort-last: cut the volume into K bricks, each loaded alone, rendered and "
-              "composited (0: off; under mpirun chosen from --rank-memory)",
-              "Output");
-    addOption(*cmd, "--rank-memory", args->rankMemory,
-              "bricks: memory per process in MiB; the fewest bricks, a multiple of the "
-              "processes, whose estimate fits it (default under mpirun: 80% of the physical "
-              "memory / processes on the node)",
-              "Output");
-    addOption(*cmd, "--brick-composite", args->brickComposite,
-              "bricks of --renderer sheet: exact (every slab's sheets summed across bricks, the "
-              "one-process image; exchanges sheets) | fast (partial images, a seam of a few "
-              "percent)",
-              "Output");
-    addOption(*cmd, "--compositor", args->compositor,
-              "bricks under mpirun: how the ranks composite the partial images: direct "
-              "(sparse direct-send, the default) | icet (IceT radix-k, when built with it) | auto "
-              "(icet when built with it, else direct)",
-              "Output");
+    constexpr unsigned R = kRenderCommandOptions;
+    addTableOption(*cmd, "output", args->output, R);
+    addTableOption(*cmd, "bricks", args->bricks, R);
+    addTableOption(*cmd, "rank-memory", args->rankMemory, R);
+    addTableOption(*cmd, "brick-composite", args->brickComposite, R);
+    addTableOption(*cmd, "compositor", args->compositor, R);
     cmd->footer(
         "Examples:\n"
         "  splat render ch2.nii.gz --tf mri-head --azimuth 30 -o head.png\n"

@@ -347,40 +347,25 @@ namespace {
 
 /// The options of `splat rotate` besides the volume and rendering options.
 void addRotateOptions(CLI::App& cmd, RotateCommand& a) {
-    const std::string seq = "Sequence", out = "Output";
-    addOption(cmd, "--frames", a.frames, "number of frames", seq);
-    addOption(cmd, "--from", a.from, "first angle, degrees", seq);
-    addOption(cmd, "--to", a.to,
-              "last angle, degrees (inclusive: the last frame is at --to). Default: a full "
-              "turn that loops without repeating a view, from + 360 (frames - 1) / frames",
-              seq);
-    addOption(cmd, "--sweep", a.sweep, "the angle turned: azimuth or elevation", seq);
-    addOption(cmd, "--path", a.path,
-              "camera path JSON {\"keys\": [{\"azimuth\", \"elevation\", \"distance\", "
-              "\"pixel_size\"}, ...]}, interpolated over --frames (instead of --sweep)",
-              seq, PathKind::Input);
-    addOption(cmd, "--time-steps", a.timeSteps,
-              "time series: one frame per time step A..B (inclusive, e.g. 0:19; sets --frames); "
-              "the camera stays unless --from/--to or --path turn it over the sequence",
-              seq);
-    addOption(cmd, "--parallel-frames", a.parallelFrames,
-              "frames rendered at once, one thread each (0: automatic)", seq);
-    addSequenceBrickOptions(cmd, a.brick, seq, "every frame");
-    addOption(cmd, "-o,--output", a.outDir, "output folder for the frames (created)", out,
-              PathKind::Output);
-    addOption(cmd, "--name", a.name, "frame file name pattern (printf %d of the frame index)",
-              out);
-    addOption(cmd, "--format", a.format, "frame format: png, exr or tif", out);
-    addFlag(cmd, "--resume", a.resume, "render only the frames missing from the folder", out);
-    addFlag(cmd, "--overwrite", a.overwrite, "replace the frames the folder holds", out);
-    addOption(cmd, "--gif", a.gif, "also write an animated GIF", out, PathKind::Output);
-    addOption(cmd, "--contact-sheet", a.contact, "also write a contact sheet (all frames, tiled)",
-              out, PathKind::Output);
-    addOption(cmd, "--mp4", a.mp4,
-              "also write an MP4 video (needs the ffmpeg program; png frames)", out,
-              PathKind::Output);
-    addOption(cmd, "--fps", a.fps, "GIF and MP4 frames per second (1..100)", out);
-    addFlag(cmd, "-q,--quiet", a.quiet, "no progress output", out);
+    constexpr unsigned R = kRotateOptions;
+    addTableOption(cmd, "frames", a.frames, R);
+    addTableOption(cmd, "from", a.from, R);
+    addTableOption(cmd, "to", a.to, R);
+    addTableOption(cmd, "sweep", a.sweep, R);
+    addTableOption(cmd, "path", a.path, R);
+    addTableOption(cmd, "time-steps", a.timeSteps, R);
+    addTableOption(cmd, "parallel-frames", a.parallelFrames, R);
+    addSequenceBrickOptions(cmd, a.brick, R);
+    addTableOption(cmd, "output", a.outDir, R);
+    addTableOption(cmd, "name", a.name, R);
+    addTableOption(cmd, "format", a.format, R);
+    addTableOption(cmd, "resume", a.resume, R);
+    addTableOption(cmd, "overwrite", a.overwrite, R);
+    addTableOption(cmd, "gif", a.gif, R);
+    addTableOption(cmd, "contact-sheet", a.contact, R);
+    addTableOption(cmd, "mp4", a.mp4, R);
+    addTableOption(cmd, "fps", a.fps, R);
+    addTableOption(cmd, "quiet", a.quiet, R);
 }
 
 /// --time-steps A:B: sets --frames and the first frame's --time; refuses --time, a --frames

@@ -29,12 +29,11 @@ void registerSlices(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("slices", "slices as images plus a mosaic");
     addVolumeOptions(*cmd, a->volume);
     addViewOptions(*cmd, a->view);
-    addOption(*cmd, "--axis", a->axis, "x | y | z", "Slices");
-    addOption(*cmd, "--every", a->every, "every Nth slice", "Slices");
-    addOption(*cmd, "--columns", a->columns, "mosaic columns (0 = square)", "Output");
-    addOption(*cmd, "--format", a->format, "png | exr | tif", "Output");
-    addOption(*cmd, "-o,--output", a->output, "output folder (created)", "Output", PathKind::Output)
-        ->required();
+    addTableOption(*cmd, "axis", a->axis, kSlicesOptions);
+    addTableOption(*cmd, "every", a->every, kSlicesOptions);
+    addTableOption(*cmd, "columns", a->columns, kSlicesOptions);
+    addTableOption(*cmd, "format", a->format, kSlicesOptions);
+    addTableOption(*cmd, "output", a->output, kSlicesOptions)->required();
     cmd->footer(
         "Examples:\n"
         "  splat slices ch2.nii.gz --axis z --every 4 -o slices\n"

@@ -76,39 +76,20 @@ void registerStudy(CLI::App& app) {
         "study", "speed vs accuracy: sweep quality knobs, time them, compare with the reference");
     addVolumeOptions(*cmd, a->volume);
     addRenderOptions(*cmd, a->render, false);
-    const std::string st = "Study", out = "Output";
-    addOption(
-        *cmd, "--sweep", a->sweeps,
-        "KNOB=V1,V2,... (repeatable): renderer, quality, slab, early-termination, size, order, "
-        "classify, kernel, sigma, radius, footprint-res, slab-radial-res, slab-depth-res, "
-        "poly-tol, lod, ewa, pixel-filter",
-        st);
-    addOption(*cmd, "--repeats", a->repeats, "timed frames per setting and view", st);
-    addOption(*cmd, "--warmup", a->warmup, "untimed frames before them", st);
-    addOption(*cmd, "--views", a->views, "views AZ[:EL],... (default: the camera options)", st);
-    addOption(*cmd, "--truth-step", a->truthStep, "reference ray caster step for the ground truth",
-              st);
-    addOption(*cmd, "--truth-tolerance", a->truthTolerance, "... and its refinement tolerance", st);
-    addOption(*cmd, "--truth", a->truth,
-              "the ground truth each setting is judged against: point (one ray per pixel "
-              "centre) | filtered (through the pixel filter, pixel-filter or 0.5) | auto "
-              "(filtered where the setting's frames are: EWA on, e.g. xray below a pixel per "
-              "voxel, or a pixel filter); default auto",
-              st);
-    addOption(*cmd, "--ppd", a->ppd, "LDR-FLIP pixels per degree", st);
-    addFlag(*cmd, "--no-presets", a->noPresets,
-            "do not measure the three --quality presets beside the sweep (by default they are "
-            "points of their own, marked on the plot)",
-            st);
-    addFlag(*cmd, "--convergence", a->convergence,
-            "also fit the observed convergence orders (slab, reference step, pixel size)", st);
-    addOption(*cmd, "--report", a->report,
-              "report folder (study.csv, study.json, pareto.svg, pareto.png; references cached "
-              "there)",
-              out, PathKind::Output);
-    addFlag(*cmd, "--resume", a->resume,
-            "finish an interrupted run: keep the points it measured (REPORT/.points)", out);
-    addFlag(*cmd, "-q,--quiet", a->quiet, "no progress output", out);
+    constexpr unsigned S = kStudyOptions;
+    addTableOption(*cmd, "sweep", a->sweeps, S);
+    addTableOption(*cmd, "repeats", a->repeats, S);
+    addTableOption(*cmd, "warmup", a->warmup, S);
+    addTableOption(*cmd, "views", a->views, S);
+    addTableOption(*cmd, "truth-step", a->truthStep, S);
+    addTableOption(*cmd, "truth-tolerance", a->truthTolerance, S);
+    addTableOption(*cmd, "truth", a->truth, S);
+    addTableOption(*cmd, "ppd", a->ppd, S);
+    addTableOption(*cmd, "no-presets", a->noPresets, S);
+    addTableOption(*cmd, "convergence", a->convergence, S);
+    addTableOption(*cmd, "report", a->report, S);
+    addTableOption(*cmd, "resume", a->resume, S);
+    addTableOption(*cmd, "quiet", a->quiet, S);
     cmd->footer(
         "Examples:\n"
         "  splat study synthetic:phantom:48 --sweep renderer=axis,sheet --sweep slab=0.5,1,2 "

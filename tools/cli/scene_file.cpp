@@ -33,6 +33,7 @@ struct Entry {
     std::function<json()> getObject;
     /// An option of the library's table: why a value's text is not of its type ("" if it is).
     std::function<std::string(const std::string&)> check;
+    const OptionSpec* spec = nullptr;  ///< its entry
 };
 
 struct CommandTable {
@@ -64,7 +65,7 @@ std::string keyOf(const CLI::Option* o) {
 
 /// How the library reads `e`'s scene value (splat/scene_file.h).
 SceneKey sceneKeyOf(const Entry& e) {
-    return SceneKey{e.kind, e.path, bool(e.check), e.opt->count() == 0};
+    return SceneKey{e.kind, e.path, bool(e.check), e.opt->count() == 0, e.spec};
 }
 
 void applyEntry(CommandTable& t, Entry& e, const SceneEntry& value, const std::string& file) {
@@ -170,8 +171,45 @@ void addTableOptions(CLI::App& cmd, OptionValues& values, unsigned sets) {
         tableOf(cmd).entries.back().check = [spec](const std::string& text) {
             return checkOptionText(*spec, text);
         };
+        tableOf(cmd).entries.back().spec = spec;
     }
 }
+
+namespace detail {
+const OptionSpec& tableEntry(std::string_view name, unsigned sets, OptionType type) {
+    const OptionSpec* spec = findOption(name, sets);
+    if (!spec) throw std::logic_error("no option --" + std::string(name) + " in the table");
+    if (spec->type != type)
+        throw std::logic_error("--" + std::string(name) + " is bound to a variable of another type");
+    return *spec;
+}
+
+std::string flagNames(const OptionSpec& spec) {
+    const std::string flag = "--" + std::string(spec.name);
+    return spec.shortName.empty() ? flag : "-" + std::string(spec.shortName) + "," + flag;
+}
+
+void checkedByTable(CLI::App& cmd, CLI::Option* o, const OptionSpec& spec) {
+    if (!spec.defaultText.empty() && o->get_default_str() != spec.defaultText)
+        throw std::logic_error("--" + std::string(spec.name) + ": the default " +
+                               o->get_default_str() + " is not the table's " +
+                               std::string(spec.defaultText));
+    if (spec.type != OptionType::Flag && spec.type != OptionType::Text &&
+        spec.type != OptionType::TextList)
+        o->check(CLI::Validator(
+            [&spec](std::string& text) -> std::string {
+                // Thrown past CLI11, as the table's other options are refused: one line
+                // "--NAME: why", the line a scene key's value gets in brackets.
+                if (const std::string why = checkOptionText(spec, text); !why.empty())
+                    throw OptionError("--" + std::string(spec.name) + ": " + why);
+                return {};
+            },
+            ""));
+    Entry& e = tableOf(cmd).entries.back();
+    e.check = [&spec](const std::string& text) { return checkOptionText(spec, text); };
+    e.spec = &spec;
+}
+}  // namespace detail
 
 void readGiven(const CLI::App& cmd, OptionValues& values) {
     for (const OptionSpec* spec : values.specs())

@@ -11,6 +11,8 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <initializer_list>
+#include <stdexcept>
+#include <string_view>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <type_traits>
@@ -63,6 +65,34 @@ CLI::Option* addOption(CLI::App& cmd, const std::string& names, T& var, const st
 
 CLI::Option* addFlag(CLI::App& cmd, const std::string& names, bool& var, const std::string& help,
                      const std::string& group);
+
+namespace detail {
+/// The entry `name` of `sets`; throws std::logic_error when there is none or its type is not
+/// `type` (a registration that disagrees with the table).
+const OptionSpec& tableEntry(std::string_view name, unsigned sets, OptionType type);
+/// "-o,--output" for the entry's flag names.
+std::string flagNames(const OptionSpec& spec);
+/// Shows the entry's default in --help (std::logic_error when the bound variable's default
+/// differs) and checks values with the table: a flag's value before CLI11 converts it, a
+/// scene key's by the library's reader, with the same message.
+void checkedByTable(CLI::App& cmd, CLI::Option* o, const OptionSpec& spec);
+}  // namespace detail
+
+/// The option `name` of `sets` (OptionSet bits) from the library's option table, bound to
+/// `var`: flag names, help text, --help group, default, type and path come from the entry.
+template <class T>
+CLI::Option* addTableOption(CLI::App& cmd, std::string_view name, T& var, unsigned sets) {
+    const OptionSpec& spec = detail::tableEntry(name, sets, detail::valueKindOf<T>());
+    CLI::Option* o = nullptr;
+    if constexpr (std::is_same_v<T, bool>)
+        o = addFlag(cmd, detail::flagNames(spec), var, std::string(spec.help),
+                    std::string(spec.group));
+    else
+        o = addOption(cmd, detail::flagNames(spec), var, std::string(spec.help),
+                      std::string(spec.group), spec.path);
+    detail::checkedByTable(cmd, o, spec);
+    return o;
+}
 
 /// The options of `sets` (OptionSet bits) from the library's option table, in its order:
 /// each bound to its slot in `values`, shown in its --help group with its default, and

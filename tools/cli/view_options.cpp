@@ -13,19 +13,15 @@
 namespace splat::cli {
 
 void addViewOptions(CLI::App& cmd, ViewArgs& a) {
-    const std::string ren = "Renderer", out = "Output";
-    addOption(cmd, "--kernel", a.kernel, "reconstruction kernel: gaussian | bspline", ren);
-    addOption(cmd, "--sigma", a.sigma, "Gaussian sigma in voxels (0 = default)", ren);
-    addOption(cmd, "--radius", a.radius, "kernel radius in voxels (0 = default)", ren);
-    addOption(cmd, "--threads", a.threads, "worker threads (0 = all cores)", ren);
-    addOption(cmd, "--window", a.window, "display window LO,HI (data units)", out);
-    addOption(cmd, "--window-preset", a.windowPreset,
-              "display window: full (min..max, default), ct-brain (L40 W80), ct-soft (L50 W400), "
-              "ct-bone (L500 W2000), ct-lung (L-600 W1500)",
-              out);
-    addOption(cmd, "--scale-bar", a.scaleBar, "draw a scale bar of this many world units (mm)",
-              out);
-    addOption(cmd, "--bit-depth", a.bitDepth, "PNG bits per channel: 8 or 16", out);
+    constexpr unsigned V = kViewOptions;
+    addTableOption(cmd, "kernel", a.kernel, V);
+    addTableOption(cmd, "sigma", a.sigma, V);
+    addTableOption(cmd, "radius", a.radius, V);
+    addTableOption(cmd, "threads", a.threads, V);
+    addTableOption(cmd, "window", a.window, V);
+    addTableOption(cmd, "window-preset", a.windowPreset, V);
+    addTableOption(cmd, "scale-bar", a.scaleBar, V);
+    addTableOption(cmd, "bit-depth", a.bitDepth, V);
 }
 
 void checkViewArgs(const ViewArgs& a) {

@@ -28,14 +28,31 @@ enum class OptionPath { None, Input, Output };
 enum class OptionScope { Volume, Scene, Frame, Output, Sweep };
 /// The option groups commands take (bits): how to read VOLUME; the rendering options (render,
 /// rotate, bench, popping, study); the written image's (render, rotate); popping's sweep; the
-/// Quality knobs only a study sweeps (no flag: the kernel tables' resolutions).
+/// Quality knobs only a study sweeps (no flag: the kernel tables' resolutions); rotate's own
+/// (the sequence and where its frames go); the view commands' shared options (slices, mpr,
+/// cpr: reconstruction and display window) and each view command's own; render's, popping's,
+/// study's and bench's own (output, bricks, reports). Two entries may share a name only when their sets
+/// are disjoint (popping's --frames and rotate's mean different things).
 enum OptionSet : unsigned {
     kVolumeOptions = 1,
     kRenderOptions = 2,
     kImageOptions = 4,
     kSweepOptions = 8,
     kStudyOnlyOptions = 16,
+    kRotateOptions = 32,
+    kViewOptions = 64,
+    kSlicesOptions = 128,
+    kMprOptions = 256,
+    kCprOptions = 512,
+    kIsoOptions = 1024,
+    kRenderCommandOptions = 2048,
+    kPoppingOptions = 4096,
+    kStudyOptions = 8192,
+    kBenchOptions = 16384,
 };
+/// The sets of the options shared by several commands (what findOption(name) searches).
+constexpr unsigned kSharedOptions =
+    kVolumeOptions | kRenderOptions | kImageOptions | kSweepOptions | kStudyOnlyOptions;
 
 /// What a command does with its frames, for the options only some runs use.
 struct RenderUse {
@@ -61,14 +78,17 @@ struct OptionSpec {
     OptionSet set;
     OptionPath path = OptionPath::None;
     IgnoredRule ignored = nullptr;  ///< null: every run that takes the option uses it
+    std::string_view shortName = {};  ///< one letter: flag -L beside --NAME ("" for none)
 };
 
 /// Every option, in the order --help lists them and scene files hold them.
 const std::vector<OptionSpec>& optionTable();
 /// The options of `sets` (OptionSet bits), in table order.
 std::vector<const OptionSpec*> optionsOf(unsigned sets);
-/// The option named `name`, or null.
+/// The option named `name` among the shared options (kSharedOptions), or null.
 const OptionSpec* findOption(std::string_view name);
+/// The option named `name` among the options of `sets` (OptionSet bits), or null.
+const OptionSpec* findOption(std::string_view name, unsigned sets);
 /// The knobs `study --sweep NAME=V1,V2,...` sweeps, options of the table (their scope says
 /// whether a value needs a new Scene).
 const std::vector<std::string_view>& studyKnobs();

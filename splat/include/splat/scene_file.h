@@ -26,6 +26,8 @@ struct SceneKey {
     OptionPath path = OptionPath::None;
     bool checked = false;
     bool read = true;
+    /// The entry that checks the value (null: the shared option named like the key).
+    const OptionSpec* spec = nullptr;
 };
 /// The SceneKey of `key`, or nothing for a key the reader does not know.
 using SceneKeyLookup = std::function<std::optional<SceneKey>(std::string_view key)>;

@@ -136,7 +136,12 @@ constexpr OptionScope kVolume = OptionScope::Volume, kScene = OptionScope::Scene
 constexpr const char *kCls = "Classification", *kCam = "Camera", *kRen = "Renderer",
                      *kQ = "Quality", *kOut = "Output", *kVol = "Volume", *kSw = "Sweep";
 constexpr OptionSet R = kRenderOptions, I = kImageOptions, W = kSweepOptions, L = kVolumeOptions,
-                    K = kStudyOnlyOptions;
+                    K = kStudyOnlyOptions, Rot = kRotateOptions, Vw = kViewOptions,
+                    Sl = kSlicesOptions, Mpr = kMprOptions, Cpr = kCprOptions, Iso = kIsoOptions,
+                    Rnd = kRenderCommandOptions, Pop = kPoppingOptions, St = kStudyOptions,
+                    Bn = kBenchOptions;
+constexpr const char *kSeq = "Sequence", *kStudy = "Study", *kBench = "Benchmark", *kSlices = "Slices", *kPlane = "Plane",
+                     *kCurve = "Curve", *kSurf = "Surface";
 
 std::vector<OptionSpec> makeTable() {
     return {
@@ -344,6 +349,191 @@ std::vector<OptionSpec> makeTable() {
          "(filtered where the splatters' frames are: EWA on, e.g. xray below a pixel per "
          "voxel); default auto",
          kSw, kSweep, W},
+        // ---- rotate: the sequence of frames and where they go
+        {"frames", T::Integer, "36", "number of frames", kSeq, kSweep, Rot},
+        {"from", T::Real, "0", "first angle, degrees", kSeq, kSweep, Rot},
+        {"to", T::Real, "360",
+         "last angle, degrees (inclusive: the last frame is at --to). Default: a full "
+         "turn that loops without repeating a view, from + 360 (frames - 1) / frames",
+         kSeq, kSweep, Rot},
+        {"sweep", T::Text, "azimuth", "the angle turned: azimuth or elevation", kSeq, kSweep, Rot},
+        {"path", T::Text, "",
+         "camera path JSON {\"keys\": [{\"azimuth\", \"elevation\", \"distance\", "
+         "\"pixel_size\"}, ...]}, interpolated over --frames (instead of --sweep)",
+         kSeq, kSweep, Rot, P::Input},
+        {"time-steps", T::Text, "",
+         "time series: one frame per time step A..B (inclusive, e.g. 0:19; sets --frames); "
+         "the camera stays unless --from/--to or --path turn it over the sequence",
+         kSeq, kSweep, Rot},
+        {"parallel-frames", T::Integer, "0",
+         "frames rendered at once, one thread each (0: automatic)", kSeq, kSweep, Rot},
+        {"bricks", T::Integer, "0",
+         "sort-last: cut the volume into K bricks, loaded and built once, every frame rendered "
+         "by them and composited (0: off; under mpirun chosen from --rank-memory when the "
+         "volume does not fit one process)",
+         kSeq, kScene, Rot},
+        {"rank-memory", T::Real, "0",
+         "bricks: memory per process in MiB (default under mpirun: 80% of the physical memory "
+         "/ processes on the node); frames in parallel when the volume fits",
+         kSeq, kScene, Rot},
+        {"brick-composite", T::Text, "exact",
+         "bricks of the image-aligned splatter: exact (slab sheets summed across bricks: the "
+         "same as one process) or fast (partial images, approximate at brick faces)",
+         kSeq, kScene, Rot},
+        {"compositor", T::Text, "direct",
+         "bricks under mpirun: direct (sparse direct-send, the default) | icet (IceT radix-k, "
+         "when built with it) | auto (icet when built with it, else direct)",
+         kSeq, kScene, Rot},
+        {"output", T::Text, "", "output folder for the frames (created)", kOut, kOutput, Rot,
+         P::Output, nullptr, "o"},
+        {"name", T::Text, "frame_%04d", "frame file name pattern (printf %d of the frame index)",
+         kOut, kOutput, Rot},
+        {"format", T::Text, "png", "frame format: png, exr or tif", kOut, kOutput, Rot},
+        {"resume", T::Flag, "", "render only the frames missing from the folder", kOut, kOutput,
+         Rot},
+        {"overwrite", T::Flag, "", "replace the frames the folder holds", kOut, kOutput, Rot},
+        {"gif", T::Text, "", "also write an animated GIF", kOut, kOutput, Rot, P::Output},
+        {"contact-sheet", T::Text, "", "also write a contact sheet (all frames, tiled)", kOut,
+         kOutput, Rot, P::Output},
+        {"mp4", T::Text, "", "also write an MP4 video (needs the ffmpeg program; png frames)",
+         kOut, kOutput, Rot, P::Output},
+        {"fps", T::Integer, "12", "GIF and MP4 frames per second (1..100)", kOut, kOutput, Rot},
+        {"quiet", T::Flag, "", "no progress output", kOut, kOutput, Rot, P::None, nullptr, "q"},
+        // ---- the view commands (slices, mpr, cpr): the reconstruction and the display window
+        {"kernel", T::Text, "gaussian", "reconstruction kernel: gaussian | bspline", kRen, kScene,
+         Vw},
+        {"sigma", T::Real, "0", "Gaussian sigma in voxels (0 = default)", kRen, kScene, Vw},
+        {"radius", T::Real, "0", "kernel radius in voxels (0 = default)", kRen, kScene, Vw},
+        {"threads", T::Integer, "0", "worker threads (0 = all cores)", kRen, kFrame, Vw},
+        {"window", T::Text, "", "display window LO,HI (data units)", kOut, kOutput, Vw},
+        {"window-preset", T::Text, "",
+         "display window: full (min..max, default), ct-brain (L40 W80), ct-soft (L50 W400), "
+         "ct-bone (L500 W2000), ct-lung (L-600 W1500)",
+         kOut, kOutput, Vw},
+        {"scale-bar", T::Real, "0", "draw a scale bar of this many world units (mm)", kOut, kOutput,
+         Vw},
+        {"bit-depth", T::Integer, "8", "PNG bits per channel: 8 or 16", kOut, kOutput, Vw},
+        // ---- slices
+        {"axis", T::Text, "z", "x | y | z", kSlices, kFrame, Sl},
+        {"every", T::Integer, "1", "every Nth slice", kSlices, kFrame, Sl},
+        {"columns", T::Integer, "0", "mosaic columns (0 = square)", kOut, kOutput, Sl},
+        {"format", T::Text, "png", "png | exr | tif", kOut, kOutput, Sl},
+        {"output", T::Text, "", "output folder (created)", kOut, kOutput, Sl, P::Output, nullptr,
+         "o"},
+        // ---- mpr
+        {"plane", T::Text, "", "plane POINT,NORMAL: X,Y,Z,NX,NY,NZ (world)", kPlane, kFrame, Mpr},
+        {"up", T::Text, "auto", "image up direction X,Y,Z (auto: +z, or +y for axial planes)",
+         kPlane, kFrame, Mpr},
+        {"size", T::Text, "256x256", "image size WxH", kPlane, kFrame, Mpr},
+        {"pixel-size", T::Real, "0", "world units per pixel (0 = smallest spacing)", kPlane, kFrame,
+         Mpr},
+        {"output", T::Text, "", "output image (.png windowed, .exr/.tif values)", kOut, kOutput,
+         Mpr, P::Output, nullptr, "o"},
+        // ---- cpr
+        {"curve", T::Text, "", "curve FILE.json {\"points\": [[x,y,z], ...]}", kCurve, kFrame, Cpr,
+         P::Input},
+        {"lateral", T::Text, "", "lateral direction X,Y,Z (default 0,0,1)", kCurve, kFrame, Cpr},
+        {"width", T::Integer, "0", "image width, pixels (0: the curve file's, or 128)", kCurve,
+         kFrame, Cpr},
+        {"pixel-size", T::Real, "0", "world units per pixel (0: the curve file's, or the spacing)",
+         kCurve, kFrame, Cpr},
+        {"output", T::Text, "", "output image", kOut, kOutput, Cpr, P::Output, nullptr, "o"},
+        // ---- iso: the surface as a mesh
+        {"level", T::Real, "", "the level L of the surface f = L (data units)", kSurf, kScene, Iso},
+        {"kernel", T::Text, "gaussian", "reconstruction kernel (as for render)", kSurf, kScene,
+         Iso},
+        {"sigma", T::Real, "0", "kernel sigma, voxels (0 = the kernel's default)", kSurf, kScene,
+         Iso},
+        {"radius", T::Real, "0", "kernel radius, voxels (0 = the kernel's default)", kSurf, kScene,
+         Iso},
+        {"threads", T::Integer, "0", "threads (0 = all cores)", kSurf, kFrame, Iso},
+        {"output", T::Text, "", "mesh file: .ply (binary), .obj or .stl (binary)", kOut, kOutput,
+         Iso, P::Output, nullptr, "o"},
+        // ---- render: the image and the sort-last bricks
+        {"output", T::Text, "",
+         "output image: .png (8-bit display), .exr or .tif (float, values as computed)", kOut,
+         kOutput, Rnd, P::Output, nullptr, "o"},
+        {"bricks", T::Integer, "0",
+         "sort-last: cut the volume into K bricks, each loaded alone, rendered and composited "
+         "(0: off; under mpirun chosen from --rank-memory)",
+         kOut, kScene, Rnd},
+        {"rank-memory", T::Real, "0",
+         "bricks: memory per process in MiB; the fewest bricks, a multiple of the processes, "
+         "whose estimate fits it (default under mpirun: 80% of the physical memory / processes "
+         "on the node)",
+         kOut, kScene, Rnd},
+        {"brick-composite", T::Text, "exact",
+         "bricks of --renderer sheet: exact (every slab's sheets summed across bricks, the "
+         "one-process image; exchanges sheets) | fast (partial images, a seam of a few percent)",
+         kOut, kScene, Rnd},
+        {"compositor", T::Text, "direct",
+         "bricks under mpirun: how the ranks composite the partial images: direct (sparse "
+         "direct-send, the default) | icet (IceT radix-k, when built with it) | auto (icet when "
+         "built with it, else direct)",
+         kOut, kScene, Rnd},
+        // ---- popping: the report and the bricks
+        {"report", T::Text, "", "report folder (report.html, metrics.csv, summary.json)", kOut,
+         kOutput, Pop, P::Output},
+        {"resume", T::Flag, "",
+         "finish an interrupted run: reuse the frames it left in REPORT/.frames", kOut, kOutput,
+         Pop},
+        {"quiet", T::Flag, "", "no progress output", kOut, kOutput, Pop, P::None, nullptr, "q"},
+        {"bricks", T::Integer, "0",
+         "sort-last: cut the volume into K bricks, loaded and built once, every frame of the "
+         "analysis rendered by them and composited (0: off; under mpirun chosen from "
+         "--rank-memory when the volume does not fit one process)",
+         kOut, kScene, Pop},
+        {"rank-memory", T::Real, "0",
+         "bricks: memory per process in MiB (default under mpirun: 80% of the physical memory "
+         "/ processes on the node); frames in parallel when the volume fits",
+         kOut, kScene, Pop},
+        {"brick-composite", T::Text, "exact",
+         "bricks of the image-aligned splatter: exact (slab sheets summed across bricks: the "
+         "same as one process) or fast (partial images, approximate at brick faces)",
+         kOut, kScene, Pop},
+        {"compositor", T::Text, "direct",
+         "bricks under mpirun: direct (sparse direct-send, the default) | icet (IceT radix-k, "
+         "when built with it) | auto (icet when built with it, else direct)",
+         kOut, kScene, Pop},
+        // ---- study: the sweep, its timing and its ground truth
+        {"sweep", T::TextList, "",
+         "KNOB=V1,V2,... (repeatable): renderer, quality, slab, early-termination, size, order, "
+         "classify, kernel, sigma, radius, footprint-res, slab-radial-res, slab-depth-res, "
+         "poly-tol, lod, ewa, pixel-filter",
+         kStudy, kSweep, St},
+        {"repeats", T::Integer, "5", "timed frames per setting and view", kStudy, kSweep, St},
+        {"warmup", T::Integer, "1", "untimed frames before them", kStudy, kSweep, St},
+        {"views", T::Text, "", "views AZ[:EL],... (default: the camera options)", kStudy, kSweep,
+         St},
+        {"truth-step", T::Real, "0.125", "reference ray caster step for the ground truth", kStudy,
+         kSweep, St},
+        {"truth-tolerance", T::Real, "1e-05", "... and its refinement tolerance", kStudy, kSweep,
+         St},
+        {"truth", T::Text, "auto",
+         "the ground truth each setting is judged against: point (one ray per pixel centre) | "
+         "filtered (through the pixel filter, pixel-filter or 0.5) | auto (filtered where the "
+         "setting's frames are: EWA on, e.g. xray below a pixel per voxel, or a pixel filter); "
+         "default auto",
+         kStudy, kSweep, St},
+        {"ppd", T::Real, "67", "LDR-FLIP pixels per degree", kStudy, kSweep, St},
+        {"no-presets", T::Flag, "",
+         "do not measure the three --quality presets beside the sweep (by default they are "
+         "points of their own, marked on the plot)",
+         kStudy, kSweep, St},
+        {"convergence", T::Flag, "",
+         "also fit the observed convergence orders (slab, reference step, pixel size)", kStudy,
+         kSweep, St},
+        {"report", T::Text, "",
+         "report folder (study.csv, study.json, pareto.svg, pareto.png; references cached there)",
+         kOut, kOutput, St, P::Output},
+        {"resume", T::Flag, "",
+         "finish an interrupted run: keep the points it measured (REPORT/.points)", kOut, kOutput,
+         St},
+        {"quiet", T::Flag, "", "no progress output", kOut, kOutput, St, P::None, nullptr, "q"},
+        // ---- bench
+        {"repeats", T::Integer, "5", "timed frames per configuration", kBench, kSweep, Bn},
+        {"thread-list", T::Text, "1,2", "thread counts to time, e.g. 1,2", kBench, kSweep, Bn},
+        {"json", T::Text, "", "write the results as JSON", kOut, kOutput, Bn, P::Output},
     };
 }
 
@@ -361,11 +551,13 @@ std::vector<const OptionSpec*> optionsOf(unsigned sets) {
     return out;
 }
 
-const OptionSpec* findOption(std::string_view name) {
+const OptionSpec* findOption(std::string_view name, unsigned sets) {
     for (const OptionSpec& o : optionTable())
-        if (o.name == name) return &o;
+        if (o.name == name && (sets & o.set)) return &o;
     return nullptr;
 }
+
+const OptionSpec* findOption(std::string_view name) { return findOption(name, kSharedOptions); }
 
 const std::vector<std::string_view>& studyKnobs() {
     static const std::vector<std::string_view> knobs = {"renderer",

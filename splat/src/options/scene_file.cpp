@@ -144,7 +144,7 @@ SceneEntry entryOf(const std::string& key, const SceneKey& how, const json& v,
     } else {
         e.texts.push_back(textOf(key, how, v, where, dir));
     }
-    if (const OptionSpec* spec = how.checked ? findOption(key) : nullptr)
+    if (const OptionSpec* spec = !how.checked ? nullptr : how.spec ? how.spec : findOption(key))
         for (const std::string& text : e.texts)
             if (const std::string why = checkOptionText(*spec, text); !why.empty())
                 throw OptionError(where + ": " + e.json + " is not a valid " +
