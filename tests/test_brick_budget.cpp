@@ -108,3 +108,23 @@ TEST_CASE("brick budget: bytes per sample beyond one splat list (popping's rende
     b.extraSampleBytes = 0;
     CHECK(chooseBricks(glm::ivec3(200), b).wholeFits);
 }
+
+TEST_CASE("brick budget: one process compositing as it renders holds one partial image",
+          "[bricks]") {
+    BrickBudget b;
+    b.width = b.height = 256;  // 1 MiB per RGBA float image
+    b.ghost = 2;
+    b.ranks = 1;
+    b.splatShare = 1.0;
+    b.rankBytes = 256 * MiB;
+    // 512^3 samples at 30 bytes each (a float and a splat): one image per brick held would
+    // need more bricks than 4096 images of 1 MiB allow; one image held fits with a few dozen.
+    const BrickChoice perBrick = chooseBricks(glm::ivec3(512), b);
+    CHECK_FALSE(perBrick.withinBudget);
+    b.oneImageHeld = true;
+    const BrickChoice one = chooseBricks(glm::ivec3(512), b);
+    CHECK(one.withinBudget);
+    CHECK(one.bricks < 200);
+    CHECK(one.rankBytes == brickMemoryEstimate(one.largestBrick, 256, 256, 1, 1.0));
+    CHECK(one.rankBytes <= b.rankBytes);
+}

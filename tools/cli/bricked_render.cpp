@@ -32,6 +32,7 @@ int bricksFromBudget(const Volume& geometry, const RenderSettings& settings, int
     // Outside dvr every sample that differs from b becomes a splat (classify keeps them all),
     // so the estimate cannot assume the transfer function drops most of them.
     if (settings.mode != RenderMode::Dvr) budget.splatShare = 1.0;
+    budget.oneImageHeld = ranks == 1 && settings.renderer != RendererKind::Sheet;
     const BrickChoice c = chooseBricks(geometry.dims, budget);
     if (wholeFits) *wholeFits = c.wholeFits;
     if (!workerProcess() && !quiet) {

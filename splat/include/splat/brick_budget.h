@@ -26,6 +26,10 @@ struct BrickBudget {
     /// list each, the reference's field grid of 20 bytes per sample, the image-aligned
     /// splatter's projected splats).
     double extraSampleBytes = 0;
+    /// One process that composites each brick's image into the frame as soon as it is
+    /// rendered (BrickedFrames on one process, every renderer but the image-aligned
+    /// splatter's slab composite): one partial image held, whatever the number of bricks.
+    bool oneImageHeld = false;
 };
 
 /// The estimated peak bytes of a process holding a brick of `samples` samples (ghost layers

@@ -50,7 +50,7 @@ BrickChoice chooseBricks(const glm::ivec3& dims, const BrickBudget& budget, int 
     int K = std::min(P, cap);
     while (K > 1 && largestOf(K) == 0) --K;  // more ranks than bricks: some stay idle
     for (;;) {
-        const int held = (K + P - 1) / P;
+        const int held = budget.oneImageHeld ? 1 : (K + P - 1) / P;
         c.bricks = K;
         c.largestBrick = largestOf(K);
         c.rankBytes = brickMemoryEstimate(c.largestBrick, budget.width, budget.height, held,
