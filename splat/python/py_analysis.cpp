@@ -119,9 +119,8 @@ py::dict pointDict(const StudyPoint& p) {
     return d;
 }
 
-}  // namespace
-
-void bindAnalysis(py::module_& m) {
+/// splat.popping and PoppingResult.
+void bindPopping(py::module_& m) {
     py::class_<PoppingResult>(m, "PoppingResult",
                               "The result of splat.popping: per-renderer series (NumPy arrays) "
                               "and events (dicts); write_report(folder) writes the CLI's report.")
@@ -220,7 +219,10 @@ void bindAnalysis(py::module_& m) {
             out.emplace_back(flag.substr(2), help);
         return out;
     });
+}
 
+/// splat.study, StudyResult and the study knobs.
+void bindStudy(py::module_& m) {
     py::class_<StudyResult>(m, "StudyResult",
                             "The result of splat.study: one dict per setting (time, memory, "
                             "error, Pareto flag), convergence orders; write_report(folder).")
@@ -302,7 +304,10 @@ void bindAnalysis(py::module_& m) {
         py::arg("ppd"), py::arg("convergence"), py::arg("cache_dir"), py::arg("truth"),
         py::arg("progress"));
     m.def("study_knobs", &studyKnobNames, "Knob names splat.study sweeps.");
+}
 
+/// Mesh and splat.iso_surface.
+void bindMesh(py::module_& m) {
     py::class_<Mesh>(m, "Mesh", "A triangle mesh in world coordinates (splat.iso_surface).")
         .def_property_readonly(
             "vertices",
@@ -350,6 +355,14 @@ void bindAnalysis(py::module_& m) {
         py::arg("volume"), py::arg("level"), py::kw_only(), py::arg("kernel") = "gaussian",
         py::arg("sigma") = 0.0, py::arg("radius") = 0.0, py::arg("threads") = 0,
         "The iso surface f = level of the reconstructed field (as `splat iso`), a Mesh.");
+}
+
+}  // namespace
+
+void bindAnalysis(py::module_& m) {
+    bindPopping(m);
+    bindStudy(m);
+    bindMesh(m);
 }
 
 }  // namespace splat::python

@@ -204,9 +204,8 @@ std::vector<std::string> notesOf(const Volume& v) {
     return out;
 }
 
-}  // namespace
-
-void bindVolume(py::module_& m) {
+/// splat.Volume: the samples as a NumPy view, the geometry, the background.
+void bindVolumeClass(py::module_& m) {
     py::class_<PyVolume>(m, "Volume", R"doc(
 A scalar volume: samples on a regular grid, world position x = origin + spacing * (i, j, k).
 
@@ -363,7 +362,10 @@ background_value: the field's value where nothing is (default: the median of the
               << "), source='" << v.source << "')";
             return s.str();
         });
+}
 
+/// splat.load and the other ways to obtain a Volume (synthetic, DICOM series, nibabel).
+void bindLoaders(py::module_& m) {
     m.def(
         "_load",
         [](const std::string& spec, const Keywords& options) {
@@ -422,6 +424,13 @@ background_value: the field's value where nothing is (default: the median of the
             return out;
         },
         py::arg("folder"), "The DICOM series of a folder (as `splat info FOLDER`), as dicts.");
+}
+
+}  // namespace
+
+void bindVolume(py::module_& m) {
+    bindVolumeClass(m);
+    bindLoaders(m);
 }
 
 }  // namespace splat::python
