@@ -10,10 +10,13 @@
 #include "splat/sparse_files.h"
 
 #if SPLAT_HAVE_OPENVDB
-#include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Count.h>
 
+#include <array>
+#include <fstream>
+#include <istream>
 #include <mutex>
 #endif
 
@@ -74,45 +77,103 @@ auto guarded(const std::string& name, F&& f) {
     }
 }
 
-/// A file opened for reading (OpenVDB's errors become one splat::Error line).
+/// A file's bytes as a stream whose reads never fail: past the last byte it serves zeros and
+/// remembers that it did. OpenVDB reads lengths into uninitialised locals without checking
+/// the stream (a truncated compressed block's size is whatever the stack held, and the next
+/// `new[]` asks for it), so on a truncated file two processes could read different sizes.
+/// Served zeros, every process reads the same values, and the reader refuses the file
+/// afterwards because `overran()`.
+class ZeroPaddedFile : public std::streambuf {
+public:
+    ZeroPaddedFile(const fs::path& p, const std::string& name) : size_(detail::regularFileSize(p)) {
+        if (!file_.open(p, std::ios::in | std::ios::binary))
+            throw Error(name + ": cannot open the file");
+    }
+    bool overran() const { return overran_; }
+
+protected:
+    int_type underflow() override {
+        if (gptr() < egptr()) return traits_type::to_int_type(*gptr());
+        start_ += std::uint64_t(egptr() - eback());
+        std::streamsize n = 0;
+        if (start_ < size_ && file_.pubseekpos(std::streamoff(start_), std::ios::in) !=
+                                  std::streampos(std::streamoff(-1)))
+            n = file_.sgetn(buf_.data(),
+                            std::streamsize(std::min<std::uint64_t>(buf_.size(), size_ - start_)));
+        if (n <= 0) {
+            overran_ = true;
+            std::fill(buf_.begin(), buf_.end(), char(0));
+            n = std::streamsize(buf_.size());
+        }
+        setg(buf_.data(), buf_.data(), buf_.data() + n);
+        return traits_type::to_int_type(buf_[0]);
+    }
+    pos_type seekoff(off_type off, std::ios::seekdir dir, std::ios::openmode which) override {
+        const auto here = off_type(start_) + off_type(gptr() - eback());
+        const off_type base = dir == std::ios::beg   ? 0
+                              : dir == std::ios::cur ? here
+                                                     : off_type(size_);
+        return seekpos(pos_type(base + off), which);
+    }
+    pos_type seekpos(pos_type pos, std::ios::openmode which) override {
+        if (!(which & std::ios::in) || off_type(pos) < 0) return pos_type(off_type(-1));
+        start_ = std::uint64_t(off_type(pos));
+        setg(buf_.data(), buf_.data(), buf_.data());  // the next read starts at `start_`
+        return pos;
+    }
+
+private:
+    std::filebuf file_;
+    std::uint64_t size_ = 0, start_ = 0;  ///< the file's size; the offset of eback()
+    std::array<char, 1 << 16> buf_{};
+    bool overran_ = false;
+};
+
+/// Every grid of the file, read whole and in order through a ZeroPaddedFile; a file whose
+/// grids run past its last byte is refused.
+openvdb::GridPtrVecPtr readGrids(const fs::path& p, const std::string& name) {
+    ZeroPaddedFile bytes(p, name);
+    std::istream in(&bytes);
+    const auto truncated = [&] {
+        return Error(name + ": malformed OpenVDB file (its grids run past its last byte: "
+                            "truncated or damaged)");
+    };
+    try {
+        openvdb::io::Stream stream(in, /*delayLoad=*/false);
+        if (bytes.overran()) throw truncated();
+        return stream.getGrids();
+    } catch (const Error&) {
+        throw;
+    } catch (...) {
+        if (bytes.overran()) throw truncated();
+        throw;
+    }
+}
+
+/// A file's grids (OpenVDB's errors become one splat::Error line).
 struct VdbFile {
     std::string name;
-    std::unique_ptr<openvdb::io::File> file;
+    openvdb::GridPtrVecPtr grids;
 
     explicit VdbFile(const fs::path& p) : name(detail::displayName(p)) {
         static std::once_flag once;
         std::call_once(once, [] { openvdb::initialize(); });
         detail::regularFileSize(p);
         // OpenVDB can corrupt the heap or abort on a damaged tree (a byte changed in a leaf's
-        // header): every float and double grid is read once in a child process first.
-        detail::parseInChild(name, "OpenVDB", "OpenVDB", [&] {
-            openvdb::io::File file(p.string());
-            file.open(false);
-            const openvdb::GridPtrVecPtr grids = file.readAllGridMetadata();
-            for (const auto& g : *grids)
-                if (scalarGrid(*g)) file.readGrid(g->getName());
-        });
-        guarded(name, [&] {
-            file = std::make_unique<openvdb::io::File>(p.string());
-            file->open(false);  // read grids whole when asked, no delayed loading
-        });
-    }
-    ~VdbFile() {
-        if (file && file->isOpen()) file->close();
-    }
-    template <typename F>
-    auto guard(F&& f) const {
-        return guarded(name, std::forward<F>(f));
+        // header): the file is read once in a child process first, the same way.
+        detail::parseInChild(name, "OpenVDB", "OpenVDB", [&] { readGrids(p, name); });
+        grids = guarded(name, [&] { return readGrids(p, name); });
+        if (!grids) throw Error(name + ": not a readable OpenVDB file");
     }
 };
 
-/// The grid LoadOptions::grid names (metadata only), or the default.
-openvdb::GridBase::ConstPtr chooseGrid(const VdbFile& f, const std::string& wanted) {
-    const openvdb::GridPtrVecPtr grids = f.guard([&] { return f.file->readAllGridMetadata(); });
+/// The grid LoadOptions::grid names, or the default.
+openvdb::GridBase::Ptr chooseGrid(const VdbFile& f, const std::string& wanted) {
+    const openvdb::GridPtrVecPtr& grids = f.grids;
     std::string names;
     for (const auto& g : *grids) names += (names.empty() ? "" : ", ") + g->getName();
     if (grids->empty()) throw Error(f.name + ": holds no grids");
-    const auto byName = [&](const std::string& n) -> openvdb::GridBase::ConstPtr {
+    const auto byName = [&](const std::string& n) -> openvdb::GridBase::Ptr {
         for (const auto& g : *grids)
             if (g->getName() == n) return g;
         return nullptr;
@@ -281,8 +342,7 @@ struct Chosen {
 /// The chosen grid's geometry; `grid` receives the whole grid.
 Chosen choose(const VdbFile& f, const LoadOptions& options, openvdb::GridBase::Ptr* grid) {
     Chosen c;
-    c.meta = chooseGrid(f, options.grid);
-    *grid = f.guard([&] { return f.file->readGrid(c.meta->getName()); });
+    *grid = chooseGrid(f, options.grid);
     c.meta = *grid;
     c.box = (*grid)->evalActiveVoxelBoundingBox();
     c.geometry = geometry(f.name, **grid, c.box, (*grid)->activeVoxelCount());
@@ -338,16 +398,14 @@ bool openVdbAvailable() { return true; }
 
 std::vector<VdbGridInfo> listVdbGrids(const std::string& path) {
     const VdbFile f(path);
-    const openvdb::GridPtrVecPtr grids = f.guard([&] { return f.file->readAllGridMetadata(); });
     std::vector<VdbGridInfo> out;
-    for (const auto& meta : *grids) {
+    for (const auto& meta : *f.grids) {
         VdbGridInfo info;
         info.name = meta->getName();
         info.valueType = meta->valueType();
-        openvdb::GridBase::ConstPtr g = meta;
-        if (scalarGrid(*meta)) g = f.guard([&] { return f.file->readGrid(info.name); });
+        const openvdb::GridBase::ConstPtr g = meta;
         openvdb::CoordBBox box;
-        if (g != meta) {
+        if (scalarGrid(*g)) {
             box = g->evalActiveVoxelBoundingBox();
             info.activeVoxels = g->activeVoxelCount();
             info.background = background(*g);
