@@ -49,19 +49,12 @@ Image gaussianReferenceDepth(const GaussianScene& scene, const CameraParams& par
     constexpr double kEpsilon = 1e-6;
     const Projected p = project(scene, viewFrame(camera), Footprint::Volume, kEpsilon, true);
     const TileLists tiles = binToTiles(p, camera.width(), camera.height());
-    const int width = camera.width(), height = camera.height();
-    Image depth(width, height);
-    forEachTile(tiles, [&](int tx, int ty) {
-        const int tile = ty * tiles.tilesX + tx;
-        std::vector<RayGaussian> gs;
-        for (int y = ty * kTile; y < std::min(height, (ty + 1) * kTile); ++y)
-            for (int x = tx * kTile; x < std::min(width, (tx + 1) * kTile); ++x) {
-                const Ray ray = camera.ray(x + 0.5, y + 0.5);
-                gaussiansOnRay(scene, p, tiles.begin(tile), tiles.end(tile), ray, kEpsilon, gs);
-                const double t = gs.empty() ? -1 : medianOpacityDepth(gs);
-                if (t >= 0) depth.at(x, y) = glm::vec4(float(t), float(t), float(t), 1.0f);
-            }
-    });
+    Image depth(camera.width(), camera.height());
+    forEachPixelRay(scene, p, tiles, camera, kEpsilon,
+                    [&](int x, int y, const std::vector<RayGaussian>& gs) {
+                        const double t = medianOpacityDepth(gs);
+                        if (t >= 0) depth.at(x, y) = glm::vec4(float(t), float(t), float(t), 1.0f);
+                    });
     return depth;
 }
 

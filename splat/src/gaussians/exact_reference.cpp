@@ -80,18 +80,11 @@ class RayIntegral {
 
 Image renderReference(const GaussianScene& scene, const Projected& p, const TileLists& tiles,
                       const Camera& camera, double tolerance, double epsilon) {
-    const int width = camera.width(), height = camera.height();
-    Image image(width, height);
-    forEachTile(tiles, [&](int tx, int ty) {
-        const int tile = ty * tiles.tilesX + tx;
-        std::vector<RayGaussian> gs;
-        for (int y = ty * kTile; y < std::min(height, (ty + 1) * kTile); ++y)
-            for (int x = tx * kTile; x < std::min(width, (tx + 1) * kTile); ++x) {
-                const Ray ray = camera.ray(x + 0.5, y + 0.5);
-                gaussiansOnRay(scene, p, tiles.begin(tile), tiles.end(tile), ray, epsilon, gs);
-                if (!gs.empty()) image.at(x, y) = RayIntegral(gs, tolerance).run();
-            }
-    });
+    Image image(camera.width(), camera.height());
+    forEachPixelRay(scene, p, tiles, camera, epsilon,
+                    [&](int x, int y, const std::vector<RayGaussian>& gs) {
+                        image.at(x, y) = RayIntegral(gs, tolerance).run();
+                    });
     return image;
 }
 

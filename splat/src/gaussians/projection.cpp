@@ -174,6 +174,23 @@ void forEachTile(const TileLists& tiles, const std::function<void(int, int)>& fn
                       [&](int k) { fn(k % tiles.tilesX, k / tiles.tilesX); });
 }
 
+void forEachPixelRay(const GaussianScene& scene, const Projected& projected,
+                     const TileLists& tiles, const Camera& camera, double epsilon,
+                     const std::function<void(int, int, const std::vector<RayGaussian>&)>& fn) {
+    const int width = camera.width(), height = camera.height();
+    forEachTile(tiles, [&](int tx, int ty) {
+        const int tile = ty * tiles.tilesX + tx;
+        std::vector<RayGaussian> gs;
+        for (int y = ty * kTile; y < std::min(height, (ty + 1) * kTile); ++y)
+            for (int x = tx * kTile; x < std::min(width, (tx + 1) * kTile); ++x) {
+                const Ray ray = camera.ray(x + 0.5, y + 0.5);
+                gaussiansOnRay(scene, projected, tiles.begin(tile), tiles.end(tile), ray, epsilon,
+                               gs);
+                if (!gs.empty()) fn(x, y, gs);
+            }
+    });
+}
+
 std::vector<RayGaussian>& gaussiansOnRay(const GaussianScene& scene, const Projected& projected,
                                          const std::uint32_t* begin, const std::uint32_t* end,
                                          const Ray& ray, double epsilon,

@@ -86,4 +86,11 @@ std::vector<RayGaussian>& gaussiansOnRay(const GaussianScene& scene, const Proje
                                          const Ray& ray, double epsilon,
                                          std::vector<RayGaussian>& out);
 
+/// Calls fn(x, y, gaussians) for every pixel whose centre ray meets a Gaussian of optical
+/// depth above `epsilon` (gaussiansOnRay over its tile's list), tiles in parallel: the
+/// per-ray loop of the exact reference and of its depth image.
+void forEachPixelRay(const GaussianScene& scene, const Projected& projected,
+                     const TileLists& tiles, const Camera& camera, double epsilon,
+                     const std::function<void(int, int, const std::vector<RayGaussian>&)>& fn);
+
 }  // namespace splat::gaussians
