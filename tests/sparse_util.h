@@ -11,7 +11,12 @@
 #include <optional>
 #include <string>
 
+#include <catch2/catch.hpp>
+#include <glm/glm.hpp>
+
 #include "cli_util.h"
+#include "splat/bricks.h"
+#include "splat/volume_io.h"
 
 namespace splat::test {
 
@@ -41,6 +46,32 @@ inline std::optional<std::filesystem::path> sparseData() {
         if (status == 0) dir = out;
     });
     return dir;
+}
+
+/// A file's geometry (volumeGeometry, no samples) is the loaded volume's, the file is read
+/// brick by brick (`alone`), and the brick [lo, hi) read alone equals that crop of the whole
+/// volume, sample for sample.
+inline void checkBrickReadAlone(const std::string& spec, const LoadOptions& o,
+                                const glm::ivec3& lo, const glm::ivec3& hiFromEnd) {
+    const Volume whole = loadVolume(spec, o);
+    bool alone = false;
+    const Volume g = volumeGeometry(spec, o, &alone);
+    CHECK(alone);
+    CHECK(g.dims == whole.dims);
+    CHECK(g.spacing == whole.spacing);
+    CHECK(g.origin == whole.origin);
+    CHECK(g.background == whole.background);
+    CHECK(g.backgroundSource == whole.backgroundSource);
+    const glm::ivec3 hi = whole.dims - hiFromEnd;
+    const Volume b = loadVolumeBrick(spec, o, lo, hi);
+    REQUIRE(b.dims == hi - lo);
+    CHECK(b.origin == whole.world(glm::dvec3(lo)));
+    std::size_t wrong = 0;
+    for (int k = 0; k < b.dims.z; ++k)
+        for (int j = 0; j < b.dims.y; ++j)
+            for (int i = 0; i < b.dims.x; ++i)
+                wrong += b.at(i, j, k) != whole.at(lo.x + i, lo.y + j, lo.z + k);
+    CHECK(wrong == 0);
 }
 
 }  // namespace splat::test

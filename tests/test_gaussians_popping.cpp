@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "gaussian_pop_util.h"
 #include "splat/gaussian_popping.h"
 #include "splat/gaussians.h"
 #include "splat/popping.h"
@@ -18,18 +19,13 @@ namespace {
 // The pop scene's sweep through azimuth 0 with `slot` (the analyzer's axis slot) drawn by
 // `rasterizer`, sheet by the sheets and reference by the reference.
 PoppingResult sweepPop(GaussianRenderer rasterizer) {
-    static const GaussianScene scene = syntheticGaussians("gaussians:pop");
-    RenderSettings settings;
-    settings.camera.width = settings.camera.height = 48;
-    Sweep sweep;
-    sweep.base = settings.camera;
-    sweep.from = -5.5;
-    sweep.to = 5.5;
-    sweep.step = 1;
+    const GaussianScene& scene = test::popScene();
+    const RenderSettings settings = test::popSettings();
+    const Sweep sweep = test::popSweep(settings);
     PoppingOptions o;
     o.flip = false;
     o.refine = 8;
-    o.renderFrame = [rasterizer](const RenderSettings& s, RenderStats*) {
+    o.renderFrame = [rasterizer, &scene](const RenderSettings& s, RenderStats*) {
         GaussianRenderOptions g;
         g.renderer = s.renderer == RendererKind::Axis    ? rasterizer
                      : s.renderer == RendererKind::Sheet ? GaussianRenderer::Sheet

@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "image_diff.h"
 #include "sparse_util.h"
 #include "splat/bricks.h"
 #include "splat/render.h"
@@ -15,26 +16,6 @@
 
 using namespace splat;
 using namespace splat::test;
-
-namespace {
-
-double peak(const Image& im) {
-    double p = 0;
-    for (const auto& px : im.pixels)
-        for (int c = 0; c < 4; ++c) p = std::max(p, std::abs(double(px[c])));
-    return p;
-}
-
-double maxAbsDiff(const Image& a, const Image& b) {
-    REQUIRE(a.pixels.size() == b.pixels.size());
-    double worst = 0;
-    for (std::size_t n = 0; n < a.pixels.size(); ++n)
-        for (int c = 0; c < 4; ++c)
-            worst = std::max(worst, std::abs(double(a.pixels[n][c]) - double(b.pixels[n][c])));
-    return worst;
-}
-
-}  // namespace
 
 TEST_CASE("sparse files: NIfTI, OpenVDB and OME-Zarr of the same data render the same image",
           "[vdb][zarr][images]") {
@@ -65,12 +46,12 @@ TEST_CASE("sparse files: NIfTI, OpenVDB and OME-Zarr of the same data render the
                 s.isoNormalized = true;
                 s.threads = 2;
                 const Image ref = render(nii, s);
-                const double top = peak(ref);
+                const double top = peakOf(ref);
                 REQUIRE(top > 0);
                 for (const auto& [name, v] : others) {
                     INFO(name << " renderer " << int(r) << " mode " << int(m) << " classification "
                               << int(cl));
-                    CHECK(maxAbsDiff(render(*v, s), ref) <= 1e-5 * top);
+                    CHECK(maxDiff(render(*v, s), ref) <= 1e-5 * top);
                 }
             }
 }
@@ -103,10 +84,10 @@ TEST_CASE("sparse files: bricks read alone from VDB and OME-Zarr render the NIfT
             s, 3, group, &stats));
         CHECK(stats.bricks == 3);
     }
-    const double top = peak(images[0]);
+    const double top = peakOf(images[0]);
     REQUIRE(top > 0);
     for (std::size_t n = 1; n < images.size(); ++n) {
         INFO(files[n]);
-        CHECK(maxAbsDiff(images[n], images[0]) <= 1e-5 * top);
+        CHECK(maxDiff(images[n], images[0]) <= 1e-5 * top);
     }
 }

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.h"
+#include "gaussian_pop_util.h"
 #include "splat/depth.h"
 #include "splat/gaussians.h"
 #include "splat/popping.h"
@@ -290,24 +291,19 @@ TEST_CASE("temporal flip: 3dgs's FLIP_1 where two Gaussians swap is far above th
     // gaussians:pop swaps its centres' depth order at azimuth 0: measured FLIP_1 0.176 for
     // 3dgs on the interval [-0.5, 0.5] against 0.0078 for the reference (0.011 and 0.008 on
     // the other intervals).
-    static const GaussianScene scene = syntheticGaussians("gaussians:pop");
-    RenderSettings settings;
-    settings.camera.width = settings.camera.height = 48;
-    Sweep sweep;
-    sweep.base = settings.camera;
-    sweep.from = -5.5;
-    sweep.to = 5.5;
-    sweep.step = 1;
+    const GaussianScene& scene = test::popScene();
+    const RenderSettings settings = test::popSettings();
+    const Sweep sweep = test::popSweep(settings);
     PoppingOptions o;
     o.refine = 0;
     o.renderers = {RendererKind::Axis, RendererKind::Reference};
-    o.renderFrame = [](const RenderSettings& s, RenderStats*) {
+    o.renderFrame = [&scene](const RenderSettings& s, RenderStats*) {
         GaussianRenderOptions g;
         g.renderer = s.renderer == RendererKind::Axis ? GaussianRenderer::Rasterizer
                                                       : GaussianRenderer::Reference;
         return renderGaussians(scene, s.camera, g);
     };
-    o.depthFrame = [](const CameraParams& c) { return gaussianReferenceDepth(scene, c); };
+    o.depthFrame = [&scene](const CameraParams& c) { return gaussianReferenceDepth(scene, c); };
     const PoppingResult r = analyzePopping(scene.geometry(), settings, sweep, o);
     const RendererSeries& raster = seriesOf(r, RendererKind::Axis);
     const RendererSeries& ref = seriesOf(r, RendererKind::Reference);

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "image_diff.h"
 #include "sparse_util.h"
 #include "splat/bricks.h"
 #include "splat/image_io.h"
@@ -21,22 +22,6 @@ using namespace splat;
 using namespace splat::test;
 
 namespace {
-
-double peakOf(const Image& im) {
-    double p = 0;
-    for (const auto& px : im.pixels)
-        for (int c = 0; c < 4; ++c) p = std::max(p, std::abs(double(px[c])));
-    return p;
-}
-
-double maxAbsDiff(const Image& a, const Image& b) {
-    REQUIRE(a.pixels.size() == b.pixels.size());
-    double worst = 0;
-    for (std::size_t n = 0; n < a.pixels.size(); ++n)
-        for (int c = 0; c < 4; ++c)
-            worst = std::max(worst, std::abs(double(a.pixels[n][c]) - double(b.pixels[n][c])));
-    return worst;
-}
 
 /// The grid of `spec` in `bricks` bricks, its empty bricks told to BrickedFrames.
 Image renderSparse(const std::string& spec, const RenderSettings& s, int bricks, BrickStats* st) {
@@ -139,11 +124,11 @@ TEST_CASE("sparse VDB: bricks from the tree, empty ones skipped, render the dens
                                  << int(cl));
                 CHECK(st.empty >= 2);
                 // The skipped bricks change nothing: the same bricks all loaded and rendered.
-                CHECK(maxAbsDiff(sparse, renderDenseBricks(dense, s, 12)) <= 1e-6 * top);
+                CHECK(maxDiff(sparse, renderDenseBricks(dense, s, 12)) <= 1e-6 * top);
                 // And the dense copy's own image. The axis-aligned splatter's x-ray seam at
                 // brick faces reaches 6.4e-5 of the peak here (the NIfTI's bricks alike).
                 const double bound = r == RendererKind::Axis && m == RenderMode::Xray ? 1e-4 : 1e-5;
-                CHECK(maxAbsDiff(sparse, whole) <= bound * top);
+                CHECK(maxDiff(sparse, whole) <= bound * top);
             }
 }
 
@@ -168,7 +153,7 @@ TEST_CASE("sparse VDB: where b has opacity, no brick is skipped and splat render
     BrickStats st;
     const Image sparse = renderSparse(spec, s, 12, &st);
     CHECK(st.empty >= 2);  // known empty, rendered all the same
-    CHECK(maxAbsDiff(sparse, full) <= 1e-5 * peakOf(full));
+    CHECK(maxDiff(sparse, full) <= 1e-5 * peakOf(full));
 
     const auto dir = testTmpDir("vdb_sparse_haze");
     const std::string tf = (dir / "haze.json").string();
@@ -185,7 +170,7 @@ TEST_CASE("sparse VDB: where b has opacity, no brick is skipped and splat render
                       "-o", b})
                 .status == 0);
     const Image iv = readImage(a), in = readImage(b);
-    CHECK(maxAbsDiff(iv, in) <= 1e-5 * peakOf(in));
+    CHECK(maxDiff(iv, in) <= 1e-5 * peakOf(in));
 }
 
 TEST_CASE("sparse VDB: splat render of a .vdb goes through its bricks and equals the NIfTI's",
@@ -221,7 +206,7 @@ TEST_CASE("sparse VDB: splat render of a .vdb goes through its bricks and equals
         REQUIRE(runSplat(args).status == 0);
         const Image iv = readImage(a), in = readImage(b);
         INFO(mode);
-        CHECK(maxAbsDiff(iv, in) <= 1e-5 * peakOf(in));
+        CHECK(maxDiff(iv, in) <= 1e-5 * peakOf(in));
     }
 }
 
@@ -251,5 +236,5 @@ TEST_CASE("larger than memory: splat render beyond the budget renders bricks one
     CHECK(bricked.out.find(" bricks (ghost layers") != std::string::npos);
     const Image iw = readImage(a), ib = readImage(b);
     // The axis-aligned splatter's bricks composite exactly (test_bricks.cpp: <= 1e-5).
-    CHECK(maxAbsDiff(iw, ib) <= 1e-5 * peakOf(iw));
+    CHECK(maxDiff(iw, ib) <= 1e-5 * peakOf(iw));
 }
