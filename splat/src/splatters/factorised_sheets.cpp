@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <mutex>
 
@@ -113,9 +114,14 @@ Factorisation factorise(const Scene::Impl& scene, const Camera& camera, const Re
 }
 
 /// Sheet q's place on the grid: voxel (u, v) at sample (n u + a, n v + b) + phase, and its
-/// stamp (stampH rows of stampW weights, zero outside the footprint).
+/// stamp as rows of the footprint's support only: row y (of stampH, from dB) covers columns
+/// [x0[y], x0[y] + count[y]) (from dA; count even, its padding weighs 0) with weights from
+/// w[offset[y]], each repeated four times to meet a sample's (tau, E_r, E_g, E_b). Columns
+/// [xMin, xMax] hold every non-zero weight.
 struct SheetStamp {
     int a, b;
+    int xMin, xMax;
+    std::vector<int> x0, count, offset;
     std::vector<float> w;
 };
 
@@ -125,88 +131,83 @@ SheetStamp sheetStamp(const Factorisation& f, int q, const footprint::FootprintT
     st.a = int(std::floor(sU));
     st.b = int(std::floor(sV));
     const double phaseU = sU - st.a, phaseV = sV - st.b;
-    st.w.assign(std::size_t(f.stampW) * f.stampH, 0.0f);
-    for (int y = 0; y < f.stampH; ++y)
+    st.xMin = f.stampW;
+    st.xMax = -1;
+    std::vector<float> row(std::size_t(f.stampW) + 1);
+    for (int y = 0; y < f.stampH; ++y) {
+        int lo = f.stampW, hi = -1;
         for (int x = 0; x < f.stampW; ++x) {
             // The sample's offset from the voxel centre, sheet units, then screen pixels.
             const double dU = (f.dA + x - phaseU) / f.n, dV = (f.dB + y - phaseV) / f.n;
             const glm::dvec2 p = f.colU * dU + f.colV * dV;
             const float r2 = f.e.r2(float(p.x), float(p.y));
-            if (r2 < f.r2Max) st.w[std::size_t(y) * f.stampW + x] = table.lookup(r2) * f.e.scale;
+            row[std::size_t(x)] = r2 < f.r2Max ? table.lookup(r2) * f.e.scale : 0.0f;
+            if (row[std::size_t(x)] != 0.0f) {
+                lo = std::min(lo, x);
+                hi = x;
+            }
         }
+        row[std::size_t(f.stampW)] = 0.0f;
+        const int count = hi < lo ? 0 : (hi - lo + 2) / 2 * 2;
+        st.x0.push_back(hi < lo ? 0 : lo);
+        st.count.push_back(count);
+        st.offset.push_back(int(st.w.size()));
+        for (int x = 0; x < count; ++x) st.w.insert(st.w.end(), 4, row[std::size_t(lo + x)]);
+        if (hi >= lo) {
+            st.xMin = std::min(st.xMin, lo);
+            st.xMax = std::max(st.xMax, hi);
+        }
+    }
     return st;
 }
 
-/// The factorised sheets' state per scene (Scene::Impl::state), made on first use: the
-/// list's order along i (a counting sort on the slice index; the list is in (k, j, i) order,
-/// so sorting by i keeps rows by (k, j) within a slice) and where each slice starts in it.
-class SliceOrderI {
+/// The factorised sheets' state per scene (Scene::Impl::state), made on first use: the list
+/// in sheet order along i (a counting sort on the slice index; the list is in (k, j, i)
+/// order, so sorting by i keeps rows by (k, j) within a slice): position p holds splat
+/// id[p] at (u, v) = (j, k); slice q at positions [start[q], start[q + 1]). Made once, so a
+/// frame with sheets along i reads the list in sheet order without gathering it.
+class SheetsAlongI {
   public:
-    explicit SliceOrderI(const Scene::Impl& scene) : scene_(scene) {}
+    explicit SheetsAlongI(const Scene::Impl& scene) : scene_(scene) {}
     struct Order {
-        std::vector<std::uint32_t> order, start;
-        std::uint32_t at(std::size_t n) const { return order[n]; }
+        std::vector<std::uint32_t> id, start;
+        std::vector<std::uint16_t> u, v;
     };
     const Order& get() {
         std::lock_guard<std::mutex> lock(mutex_);
-        if (!order_) {
-            const std::vector<std::uint16_t>& index = scene_.splats.i;
-            auto o = std::make_unique<Order>();
-            o->start.assign(std::size_t(scene_.volume->dims.x) + 1, 0);
-            for (std::uint16_t q : index) ++o->start[std::size_t(q) + 1];
-            for (std::size_t q = 1; q < o->start.size(); ++q) o->start[q] += o->start[q - 1];
-            std::vector<std::uint32_t> next(o->start.begin(), o->start.end() - 1);
-            o->order.resize(index.size());
-            for (std::size_t n = 0; n < index.size(); ++n) o->order[next[index[n]]++] = std::uint32_t(n);
-            order_ = std::move(o);
-        }
+        if (!order_) order_ = make();
         return *order_;
     }
 
   private:
+    std::unique_ptr<Order> make() const {
+        const SplatList& s = scene_.splats;
+        auto o = std::make_unique<Order>();
+        o->start.assign(std::size_t(scene_.volume->dims.x) + 1, 0);
+        for (std::uint16_t q : s.i) ++o->start[std::size_t(q) + 1];
+        for (std::size_t q = 1; q < o->start.size(); ++q) o->start[q] += o->start[q - 1];
+        std::vector<std::uint32_t> next(o->start.begin(), o->start.end() - 1);
+        o->id.resize(s.size());
+        o->u.resize(s.size());
+        o->v.resize(s.size());
+        for (std::size_t n = 0; n < s.size(); ++n) {
+            const std::uint32_t p = next[s.i[n]]++;
+            o->id[p] = std::uint32_t(n);
+            o->u[p] = s.j[n];
+            o->v[p] = s.k[n];
+        }
+        return o;
+    }
+
     const Scene::Impl& scene_;
     std::mutex mutex_;
     std::unique_ptr<Order> order_;
 };
 
-/// The splats in sheet order: sheet q holds [start[q], start[q + 1]), by row v then u.
-struct SheetSplats {
-    std::vector<std::uint16_t> u, v;
-    std::vector<glm::vec4> value;  ///< (rho, e_r, e_g, e_b)
-    const std::vector<std::uint32_t>* start;
-};
-
-SheetSplats sheetSplats(const Scene::Impl& scene, int m, int u, int v, const float* er,
-                        const float* eg, const float* eb) {
-    const SplatList& s = scene.splats;
-    (void)m;  // sheets along i only: the other axes read the list in place (ListRows)
-    const SliceOrderI::Order& order = scene.state<SliceOrderI>().get();
-    const std::vector<std::uint16_t>* axes[3] = {&s.i, &s.j, &s.k};
-    const std::vector<std::uint16_t>&iu = *axes[u], &iv = *axes[v];
-    SheetSplats out;
-    out.start = &order.start;
-    const std::size_t n = s.size();
-    out.u.resize(n);
-    out.v.resize(n);
-    out.value.resize(n);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t p = r.begin(); p != r.end(); ++p) {
-                              const std::uint32_t id = order.at(p);
-                              out.u[p] = iu[id];
-                              out.v[p] = iv[id];
-                              glm::vec4 e = s.emission(id);
-                              if (er) e = glm::vec4(e.x, er[id], eg[id], eb[id]);
-                              out.value[p] = e;
-                          }
-                      });
-    return out;
-}
-
 /// The splats of row v of sheet q, list positions [first, second), by u, from one of two
 /// sources. Sheets along j or k (ListRows): a row (k, j) of the list is consecutive
-/// (CellIndex::cellStarts), read in place. Sheets along i (GatheredRows): the list
-/// gathered in sheet order (SheetSplats), rows found by bisection.
+/// (CellIndex::cellStarts), read in place. Sheets along i (GatheredRows): the list in sheet
+/// order (SheetsAlongI), rows found by bisection.
 struct ListRows {
     const SplatList& s;
     const std::vector<std::uint32_t>& cells;
@@ -219,6 +220,12 @@ struct ListRows {
         return {cells[c], cells[c + cx]};
     }
     int u(std::size_t p) const { return s.i[p]; }
+    /// The first of positions [p, end) whose u is at least `u`.
+    std::size_t seek(std::size_t p, std::size_t end, int u) const {
+        return std::size_t(std::lower_bound(s.i.begin() + std::ptrdiff_t(p),
+                                            s.i.begin() + std::ptrdiff_t(end), u) -
+                           s.i.begin());
+    }
     glm::vec4 value(std::size_t p) const {
         const glm::vec4 e = s.emission(p);
         return er ? glm::vec4(e.x, er[p], eg[p], eb[p]) : e;
@@ -226,18 +233,28 @@ struct ListRows {
 };
 
 struct GatheredRows {
-    const SheetSplats& list;
+    const SplatList& s;
+    const SheetsAlongI::Order& list;
     int rows;
+    const float *er, *eg, *eb;
     std::pair<std::size_t, std::size_t> range(int q, int v) const {
-        const std::vector<std::uint32_t>& start = *list.start;
-        const auto first = list.v.begin() + std::ptrdiff_t(start[std::size_t(q)]),
-                   last = list.v.begin() + std::ptrdiff_t(start[std::size_t(q) + 1]);
+        const auto first = list.v.begin() + std::ptrdiff_t(list.start[std::size_t(q)]),
+                   last = list.v.begin() + std::ptrdiff_t(list.start[std::size_t(q) + 1]);
         const auto lo = std::lower_bound(first, last, std::uint16_t(v));
         const auto hi = std::upper_bound(lo, last, std::uint16_t(v));
         return {std::size_t(lo - list.v.begin()), std::size_t(hi - list.v.begin())};
     }
     int u(std::size_t p) const { return list.u[p]; }
-    const glm::vec4& value(std::size_t p) const { return list.value[p]; }
+    std::size_t seek(std::size_t p, std::size_t end, int u) const {
+        return std::size_t(std::lower_bound(list.u.begin() + std::ptrdiff_t(p),
+                                            list.u.begin() + std::ptrdiff_t(end), u) -
+                           list.u.begin());
+    }
+    glm::vec4 value(std::size_t p) const {
+        const std::size_t id = list.id[p];
+        const glm::vec4 e = s.emission(id);
+        return er ? glm::vec4(e.x, er[id], eg[id], eb[id]) : e;
+    }
 };
 
 /// The composited intermediate window: premultiplied colour and opacity, row-major.
@@ -247,121 +264,181 @@ struct Composited {
 
 #if defined(FOOTPRINT_HAVE_LANES)
 FOOTPRINT_LANES_BEGIN
-/// Adds value * stamp row to the four planes at `p` (planes `plane` floats apart), eight
-/// weights at a time; `width` is a multiple of 8.
-inline void addStampRowLanes(float* p, std::size_t plane, const float* w, int width,
-                             const glm::vec4& value) {
-    const __m256 v0 = _mm256_set1_ps(value.x), v1 = _mm256_set1_ps(value.y),
-                 v2 = _mm256_set1_ps(value.z), v3 = _mm256_set1_ps(value.w);
-    float *p1 = p + plane, *p2 = p1 + plane, *p3 = p2 + plane;
-    for (int x = 0; x < width; x += 8) {
-        const __m256 wv = _mm256_loadu_ps(w + x);
-        _mm256_storeu_ps(p + x, _mm256_fmadd_ps(v0, wv, _mm256_loadu_ps(p + x)));
-        _mm256_storeu_ps(p1 + x, _mm256_fmadd_ps(v1, wv, _mm256_loadu_ps(p1 + x)));
-        _mm256_storeu_ps(p2 + x, _mm256_fmadd_ps(v2, wv, _mm256_loadu_ps(p2 + x)));
-        _mm256_storeu_ps(p3 + x, _mm256_fmadd_ps(v3, wv, _mm256_loadu_ps(p3 + x)));
-    }
+/// Adds value * stamp row to the interleaved samples at `p`, two samples (eight floats) at a
+/// time; `floats` is a multiple of 8.
+inline void addStampRowLanes(float* p, const float* w, int floats, const glm::vec4& value) {
+    const __m256 v = _mm256_setr_ps(value.x, value.y, value.z, value.w, value.x, value.y,
+                                    value.z, value.w);
+    for (int x = 0; x < floats; x += 8)
+        _mm256_storeu_ps(p + x, _mm256_fmadd_ps(v, _mm256_loadu_ps(w + x), _mm256_loadu_ps(p + x)));
 }
 FOOTPRINT_LANES_END
 #endif
 
-inline void addStampRow(float* p, std::size_t plane, const float* w, int width,
-                        const glm::vec4& value) {
+/// Adds value * stamp row (SheetStamp::w from a row's offset, `floats` of them) to the
+/// interleaved (tau, E_r, E_g, E_b) samples at `p`.
+inline void addStampRow(float* p, const float* w, int floats, const glm::vec4& value) {
 #if defined(FOOTPRINT_HAVE_LANES)
     if (footprint::cpuHasLanes()) {
-        addStampRowLanes(p, plane, w, width, value);
+        addStampRowLanes(p, w, floats, value);
         return;
     }
 #endif
-    for (int c = 0; c < 4; ++c, p += plane)
-        for (int x = 0; x < width; ++x) p[x] += value[c] * w[x];
+    for (int x = 0; x < floats; ++x) p[x] += value[x & 3] * w[x];
+}
+
+/// A row of a band's sheet buffer, interleaved (tau, E_r, E_g, E_b) per sample, `row` at
+/// window column 0: composites columns [c0, c1] into `out` (the window row starting at
+/// `out0`), then clears columns [x0, x1].
+void compositeAndClear(float* row, int x0, int x1, int c0, int c1, std::size_t out0,
+                       CompositeOrder order, Composited& out) {
+    if (c1 >= c0) {
+        const int n = c1 - c0 + 1;
+        float planes[4][256];
+        for (int done = 0; done < n; done += 256) {
+            const int m = std::min(256, n - done);
+            const float* s = row + 4 * std::ptrdiff_t(c0 + done);
+            for (int x = 0; x < m; ++x)
+                for (int c = 0; c < 4; ++c) planes[c][x] = s[4 * x + c];
+            const std::size_t o = out0 + std::size_t(c0 + done);
+            compositeOpticalDepthRow(&out.r[o], &out.g[o], &out.b[o], &out.a[o], order, m,
+                                     planes[0], planes[1], planes[2], planes[3]);
+        }
+    }
+    std::fill(row + 4 * std::ptrdiff_t(x0), row + 4 * std::ptrdiff_t(x1 + 1), 0.0f);
+}
+
+/// A band's state across sheets: the sheet buffer (interleaved tau, E_r, E_g, E_b per sample,
+/// `stride` samples a row with `margin` samples before the window's column 0) and, front to
+/// back with early termination, the 8-column blocks whose every pixel is opaque.
+struct BandBuffer {
+    int row0, rows, margin, stride;
+    std::vector<float> sheet;
+    bool terminates;
+    float threshold;
+    std::vector<std::uint8_t> opaque;
+    std::vector<int> nextOpen;  ///< per block, the first block at or after it that is not opaque
+    int opaqueCount = 0;
+    std::size_t weights = 0, hidden = 0;
+    float* at(int y, int x) { return &sheet[4 * (std::size_t(y) * stride + std::size_t(x + margin))]; }
+    /// The first column at or after c0 in a block that is not opaque (past c1: all of
+    /// [c0, c1] is hidden).
+    int firstOpen(int c0) const { return std::max(c0, nextOpen[std::size_t(c0 / kBlock)] * kBlock); }
+};
+
+/// The written rectangle of a band's sheet buffer: columns [x0, x1], band rows [y0, y1].
+struct Written {
+    int x0 = std::numeric_limits<int>::max(), x1 = -1, y0 = std::numeric_limits<int>::max(),
+        y1 = -1;
+};
+
+/// Adds the stamps of sheet q's splats that meet the band into its buffer (front to back
+/// with early termination, a splat whose non-zero columns are all opaque blocks is skipped).
+template <class Rows>
+Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetStamp& st,
+                 BandBuffer& band) {
+    const int n = f.n;
+    auto floorDiv = [](int x, int y) { return x >= 0 ? x / y : -((-x + y - 1) / y); };
+    // Voxel rows whose stamp rows n v + st.b + dB - b0 + [0, stampH) meet the band.
+    const int top = st.b + f.dB - f.b0;
+    const int vLo = std::max(0, -floorDiv(top + f.stampH - 1 - band.row0, n));
+    const int vHi = std::min(floorDiv(band.row0 + band.rows - 1 - top, n), list.rows - 1);
+    Written w;
+    for (int v = vLo; v <= vHi; ++v) {
+        const auto [pFirst, pEnd] = list.range(q, v);
+        const int row = n * v + top - band.row0;  // stamp row 0, band rows
+        const int ys = std::max(0, -row), ye = std::min(f.stampH, band.rows - row);
+        const int col0 = st.a + f.dA - f.a0;  // stamp column 0 of u = 0
+        for (std::size_t p = pFirst; p < pEnd; ++p) {
+            const int col = n * list.u(p) + col0;
+            const int lo = col + st.xMin, hi = col + st.xMax;
+            if (hi < 0 || lo >= f.width) continue;
+            if (band.terminates) {
+                const int open = band.firstOpen(std::max(lo, 0));
+                if (open > std::min(hi, f.width - 1)) {
+                    // Hidden: on to the first splat whose columns reach the open block.
+                    ++band.hidden;
+                    const std::size_t next =
+                        list.seek(p + 1, pEnd, floorDiv(open - st.xMax - col0 + n - 1, n));
+                    band.hidden += next - p - 1;
+                    p = next - 1;
+                    continue;
+                }
+            }
+            const glm::vec4 value = list.value(p);
+            for (int y = ys; y < ye; ++y) {
+                const std::size_t count = std::size_t(st.count[std::size_t(y)]);
+                addStampRow(band.at(row + y, col + st.x0[std::size_t(y)]),
+                            &st.w[std::size_t(st.offset[std::size_t(y)])], int(4 * count), value);
+                band.weights += count;
+            }
+            w.x0 = std::min(w.x0, lo);
+            w.x1 = std::max(w.x1, hi);
+            w.y0 = std::min(w.y0, row + ys);
+            w.y1 = std::max(w.y1, row + ye - 1);
+        }
+    }
+    return w;
+}
+
+/// Marks the blocks of columns [c0, c1] whose every pixel of the band is now opaque.
+void markOpaqueBlocks(const Factorisation& f, const Composited& out, int c0, int c1,
+                      BandBuffer& band) {
+    bool marked = false;
+    for (int b = c0 / kBlock; b <= c1 / kBlock; ++b) {
+        if (band.opaque[std::size_t(b)]) continue;
+        bool all = true;
+        const int xe = std::min(f.width, (b + 1) * kBlock);
+        for (int y = 0; y < band.rows && all; ++y)
+            for (int x = b * kBlock; x < xe; ++x)
+                if (out.a[std::size_t(band.row0 + y) * f.width + std::size_t(x)] < band.threshold) {
+                    all = false;
+                    break;
+                }
+        if (all) {
+            band.opaque[std::size_t(b)] = 1;
+            ++band.opaqueCount;
+            marked = true;
+        }
+    }
+    if (!marked) return;
+    for (int b = int(band.opaque.size()) - 1; b >= 0; --b)
+        band.nextOpen[std::size_t(b)] = band.opaque[std::size_t(b)] ? band.nextOpen[std::size_t(b) + 1] : b;
 }
 
 /// One band of the window, rows [row0, row0 + rows): every sheet in visiting order, its
-/// splats' stamps added into the band's sheet buffer (tau, E_r, E_g, E_b planes with the
-/// stamp's width of margin either side), then composited into `out`. Front to back, a
-/// splat whose columns are opaque (every pixel of the band in each 8-column block) is
-/// skipped, and the band ends when all are. Returns the weights added.
+/// splats' stamps added into the band's sheet buffer, then composited into `out`. Front to
+/// back, the band ends when all its column blocks are opaque. Returns the samples added and
+/// the splats skipped as hidden.
 template <class Rows>
-std::size_t renderBand(const Factorisation& f, const Rows& list, int sheets,
-                       const std::vector<SheetStamp>& stamps, int row0, int rows,
-                       CompositeOrder order, double earlyTermination, Composited& out) {
-    const int margin = f.stampW, stride = f.width + 2 * f.stampW + 8;
-    const std::size_t plane = std::size_t(stride) * rows;
-    std::vector<float> sheet(4 * plane, 0.0f);
-    const bool terminates = order == CompositeOrder::FrontToBack && earlyTermination > 0;
-    const float threshold = float(1.0 - earlyTermination);
+std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Rows& list,
+                                               int sheets, const std::vector<SheetStamp>& stamps,
+                                               int row0, int rows, CompositeOrder order,
+                                               double earlyTermination, Composited& out) {
+    BandBuffer band;
+    band.row0 = row0;
+    band.rows = rows;
+    band.margin = f.stampW;
+    band.stride = f.width + 2 * f.stampW + 8;
+    band.sheet.assign(4 * std::size_t(band.stride) * std::size_t(rows), 0.0f);
+    band.terminates = order == CompositeOrder::FrontToBack && earlyTermination > 0;
+    band.threshold = float(1.0 - earlyTermination);
     const int blocks = (f.width + kBlock - 1) / kBlock;
-    std::vector<std::uint8_t> opaque(std::size_t(blocks), 0);
-    int opaqueCount = 0;
-    std::size_t weights = 0;
-    const int n = f.n;
-    auto floorDiv = [](int x, int y) { return x >= 0 ? x / y : -((-x + y - 1) / y); };
-    for (int k = 0; k < sheets && !(terminates && opaqueCount == blocks); ++k) {
+    band.opaque.assign(std::size_t(blocks), 0);
+    band.nextOpen.resize(std::size_t(blocks) + 1);
+    for (int b = 0; b <= blocks; ++b) band.nextOpen[std::size_t(b)] = b;
+    for (int k = 0; k < sheets && !(band.terminates && band.opaqueCount == blocks); ++k) {
         const int q = f.ascending ? k : sheets - 1 - k;
-        const SheetStamp& st = stamps[std::size_t(q)];
-        // Voxel rows whose stamp rows n v + st.b + dB - b0 + [0, stampH) meet the band.
-        const int top = st.b + f.dB - f.b0;
-        const int vLo = std::max(0, -floorDiv(top + f.stampH - 1 - row0, n));
-        const int vHi = std::min(floorDiv(row0 + rows - 1 - top, n), list.rows - 1);
-        int x0 = stride, x1 = -1, y0 = rows, y1 = -1;
-        for (int v = vLo; v <= vHi; ++v) {
-            const auto [pFirst, pEnd] = list.range(q, v);
-            const int row = n * v + top - row0;  // stamp row 0, band rows
-            const int ys = std::max(0, -row), ye = std::min(f.stampH, rows - row);
-            for (std::size_t p = pFirst; p < pEnd; ++p) {
-                const int col = n * list.u(p) + st.a + f.dA - f.a0;  // stamp column 0
-                if (col + f.stampW <= 0 || col >= f.width) continue;
-                if (terminates) {
-                    const int c0 = std::max(col, 0) / kBlock,
-                              c1 = std::min(col + f.stampW - 1, f.width - 1) / kBlock;
-                    bool hidden = true;
-                    for (int c = c0; c <= c1 && hidden; ++c) hidden = opaque[std::size_t(c)] != 0;
-                    if (hidden) continue;
-                }
-                const glm::vec4 value = list.value(p);
-                for (int y = ys; y < ye; ++y)
-                    addStampRow(&sheet[std::size_t(row + y) * stride + std::size_t(col + margin)],
-                                plane, &st.w[std::size_t(y) * f.stampW], f.stampW, value);
-                weights += std::size_t(ye - ys) * std::size_t(f.stampW);
-                x0 = std::min(x0, col);
-                x1 = std::max(x1, col + f.stampW - 1);
-                y0 = std::min(y0, row + ys);
-                y1 = std::max(y1, row + ye - 1);
-            }
-        }
-        if (x1 < x0) continue;
+        const Written w = addSheet(f, list, q, stamps[std::size_t(q)], band);
+        if (w.x1 < w.x0) continue;
         // Composite the written rectangle (its part inside the window), then clear it.
-        const int c0 = std::max(x0, 0), c1 = std::min(x1, f.width - 1);
-        for (int y = y0; y <= y1; ++y) {
-            float* t = &sheet[std::size_t(y) * stride];
-            if (c1 >= c0) {
-                const std::size_t o = std::size_t(row0 + y) * f.width + std::size_t(c0);
-                compositeOpticalDepthRow(&out.r[o], &out.g[o], &out.b[o], &out.a[o], order,
-                                         c1 - c0 + 1, t + margin + c0, t + plane + margin + c0,
-                                         t + 2 * plane + margin + c0, t + 3 * plane + margin + c0);
-            }
-            for (int c = 0; c < 4; ++c)
-                std::fill(t + c * plane + margin + x0, t + c * plane + margin + x1 + 1, 0.0f);
-        }
-        if (!terminates || c1 < c0) continue;
-        for (int b = c0 / kBlock; b <= c1 / kBlock; ++b) {
-            if (opaque[std::size_t(b)]) continue;
-            bool all = true;
-            const int xe = std::min(f.width, (b + 1) * kBlock);
-            for (int y = 0; y < rows && all; ++y)
-                for (int x = b * kBlock; x < xe; ++x)
-                    if (out.a[std::size_t(row0 + y) * f.width + std::size_t(x)] < threshold) {
-                        all = false;
-                        break;
-                    }
-            if (all) {
-                opaque[std::size_t(b)] = 1;
-                ++opaqueCount;
-            }
-        }
+        const int c0 = std::max(w.x0, 0), c1 = std::min(w.x1, f.width - 1);
+        for (int y = w.y0; y <= w.y1; ++y)
+            compositeAndClear(band.at(y, 0), w.x0, w.x1, c0, c1, std::size_t(row0 + y) * f.width,
+                              order, out);
+        if (band.terminates && c1 >= c0) markOpaqueBlocks(f, out, c0, c1, band);
     }
-    return weights;
+    return {band.weights, band.hidden};
 }
 
 /// Catmull-Rom weights of the four samples around a point t in [0, 1) past the second.
@@ -422,10 +499,11 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
     const Factorisation f = factorise(scene, camera, s);
     const glm::ivec3 dims = scene.volume->dims;
     const int sheets = dims[f.m];
-    // Sheets along i cross the list's rows: gathered in sheet order; others read in place.
-    SheetSplats gathered;
-    if (f.m == 0) gathered = sheetSplats(scene, f.m, f.u, f.v, er, eg, eb);
-    const GatheredRows gatheredRows{gathered, dims[f.v]};
+    // Sheets along i cross the list's rows: read in the scene's sheet order; others in place.
+    static const SheetsAlongI::Order none;
+    const GatheredRows gatheredRows{scene.splats,
+                                    f.m == 0 ? scene.state<SheetsAlongI>().get() : none,
+                                    dims[f.v], er, eg, eb};
     CellIndex& cells = scene.state<CellIndex>();
     const ListRows listRows{scene.splats,
                             cells.cellStarts(),
@@ -448,10 +526,10 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
     w.b.assign(size, 0.0f);
     w.a.assign(size, 0.0f);
     const int bands = (f.height + kBand - 1) / kBand;
-    std::vector<std::size_t> weights(std::size_t(bands), 0);
+    std::vector<std::pair<std::size_t, std::size_t>> counts(static_cast<std::size_t>(bands));
     tbb::parallel_for(0, bands, [&](int k) {
         const int row0 = k * kBand, rows = std::min(kBand, f.height - row0);
-        weights[std::size_t(k)] = f.m == 0 ? renderBand(f, gatheredRows, sheets, stamps, row0, rows,
+        counts[std::size_t(k)] = f.m == 0 ? renderBand(f, gatheredRows, sheets, stamps, row0, rows,
                                                         s.order, s.quality.earlyTermination, w)
                                            : renderBand(f, listRows, sheets, stamps, row0, rows,
                                                         s.order, s.quality.earlyTermination, w);
@@ -461,7 +539,10 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
     stats.sheetAxis = f.m;
     stats.sheetSign = sheetAxis(camera.view, scene.volume->spacing).sign;
     stats.sheets = std::size_t(sheets);
-    for (std::size_t n : weights) stats.footprintPixels += n;
+    for (const auto& [weights, hidden] : counts) {
+        stats.footprintPixels += weights;
+        stats.culledSplats += hidden;
+    }
     return image;
 }
 
