@@ -122,6 +122,7 @@ struct SheetStamp {
     int a, b;
     int xMin, xMax;
     std::vector<int> x0, count, offset;
+    std::vector<int> samples;  ///< samples[y]: the samples of rows [0, y)
     std::vector<float> w;
 };
 
@@ -134,6 +135,7 @@ SheetStamp sheetStamp(const Factorisation& f, int q, const footprint::FootprintT
     st.xMin = f.stampW;
     st.xMax = -1;
     std::vector<float> row(std::size_t(f.stampW) + 1);
+    st.samples.push_back(0);
     for (int y = 0; y < f.stampH; ++y) {
         int lo = f.stampW, hi = -1;
         for (int x = 0; x < f.stampW; ++x) {
@@ -152,6 +154,7 @@ SheetStamp sheetStamp(const Factorisation& f, int q, const footprint::FootprintT
         st.x0.push_back(hi < lo ? 0 : lo);
         st.count.push_back(count);
         st.offset.push_back(int(st.w.size()));
+        st.samples.push_back(st.samples.back() + count);
         for (int x = 0; x < count; ++x) st.w.insert(st.w.end(), 4, row[std::size_t(lo + x)]);
         if (hi >= lo) {
             st.xMin = std::min(st.xMin, lo);
@@ -164,14 +167,15 @@ SheetStamp sheetStamp(const Factorisation& f, int q, const footprint::FootprintT
 /// The factorised sheets' state per scene (Scene::Impl::state), made on first use: the list
 /// in sheet order along i (a counting sort on the slice index; the list is in (k, j, i)
 /// order, so sorting by i keeps rows by (k, j) within a slice): position p holds splat
-/// id[p] at (u, v) = (j, k); slice q at positions [start[q], start[q + 1]). Made once, so a
-/// frame with sheets along i reads the list in sheet order without gathering it.
+/// id[p] at (u, v) = (j, k), of palette entry entry[p] (a paletted list); slice q at
+/// positions [start[q], start[q + 1]). Made once, so a frame with sheets along i reads the
+/// list in sheet order without gathering it.
 class SheetsAlongI {
   public:
     explicit SheetsAlongI(const Scene::Impl& scene) : scene_(scene) {}
     struct Order {
         std::vector<std::uint32_t> id, start;
-        std::vector<std::uint16_t> u, v;
+        std::vector<std::uint16_t> u, v, entry;
     };
     const Order& get() {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -190,11 +194,13 @@ class SheetsAlongI {
         o->id.resize(s.size());
         o->u.resize(s.size());
         o->v.resize(s.size());
+        if (s.paletted()) o->entry.resize(s.size());
         for (std::size_t n = 0; n < s.size(); ++n) {
             const std::uint32_t p = next[s.i[n]]++;
             o->id[p] = std::uint32_t(n);
             o->u[p] = s.j[n];
             o->v[p] = s.k[n];
+            if (s.paletted()) o->entry[p] = s.emissionIndex[n];
         }
         return o;
     }
@@ -252,7 +258,7 @@ struct GatheredRows {
     }
     glm::vec4 value(std::size_t p) const {
         const std::size_t id = list.id[p];
-        const glm::vec4 e = s.emission(id);
+        const glm::vec4 e = list.entry.empty() ? s.emission(id) : s.palette[list.entry[p]];
         return er ? glm::vec4(e.x, er[id], eg[id], eb[id]) : e;
     }
 };
@@ -262,29 +268,45 @@ struct Composited {
     std::vector<float> r, g, b, a;
 };
 
+/// Adds value * stamp rows [y0, y1) to the interleaved samples of the buffer, stamp row y
+/// (SheetStamp::x0, count, offset) at `at` + (y - y0) `rowFloats` + its first column: `at` is
+/// the stamp's column 0 in its row y0.
+inline void addStampRowsScalar(float* at, std::size_t rowFloats, const SheetStamp& st, int y0,
+                               int y1, const glm::vec4& value) {
+    for (int y = y0; y < y1; ++y) {
+        float* p = at + std::size_t(y - y0) * rowFloats + 4 * st.x0[std::size_t(y)];
+        const float* w = &st.w[std::size_t(st.offset[std::size_t(y)])];
+        for (int x = 0; x < 4 * st.count[std::size_t(y)]; ++x) p[x] += value[x & 3] * w[x];
+    }
+}
+
 #if defined(FOOTPRINT_HAVE_LANES)
 FOOTPRINT_LANES_BEGIN
-/// Adds value * stamp row to the interleaved samples at `p`, two samples (eight floats) at a
-/// time; `floats` is a multiple of 8.
-inline void addStampRowLanes(float* p, const float* w, int floats, const glm::vec4& value) {
+/// addStampRowsScalar two samples (eight floats) at a time (every row's count is even).
+inline void addStampRowsLanes(float* at, std::size_t rowFloats, const SheetStamp& st, int y0,
+                              int y1, const glm::vec4& value) {
     const __m256 v = _mm256_setr_ps(value.x, value.y, value.z, value.w, value.x, value.y,
                                     value.z, value.w);
-    for (int x = 0; x < floats; x += 8)
-        _mm256_storeu_ps(p + x, _mm256_fmadd_ps(v, _mm256_loadu_ps(w + x), _mm256_loadu_ps(p + x)));
+    for (int y = y0; y < y1; ++y) {
+        float* p = at + std::size_t(y - y0) * rowFloats + 4 * st.x0[std::size_t(y)];
+        const float* w = &st.w[std::size_t(st.offset[std::size_t(y)])];
+        const int floats = 4 * st.count[std::size_t(y)];
+        for (int x = 0; x < floats; x += 8)
+            _mm256_storeu_ps(p + x, _mm256_fmadd_ps(v, _mm256_loadu_ps(w + x), _mm256_loadu_ps(p + x)));
+    }
 }
 FOOTPRINT_LANES_END
 #endif
 
-/// Adds value * stamp row (SheetStamp::w from a row's offset, `floats` of them) to the
-/// interleaved (tau, E_r, E_g, E_b) samples at `p`.
-inline void addStampRow(float* p, const float* w, int floats, const glm::vec4& value) {
+inline void addStampRows(float* at, std::size_t rowFloats, const SheetStamp& st, int y0, int y1,
+                         const glm::vec4& value) {
 #if defined(FOOTPRINT_HAVE_LANES)
     if (footprint::cpuHasLanes()) {
-        addStampRowLanes(p, w, floats, value);
+        addStampRowsLanes(at, rowFloats, st, y0, y1, value);
         return;
     }
 #endif
-    for (int x = 0; x < floats; ++x) p[x] += value[x & 3] * w[x];
+    addStampRowsScalar(at, rowFloats, st, y0, y1, value);
 }
 
 /// A row of a band's sheet buffer, interleaved (tau, E_r, E_g, E_b) per sample, `row` at
@@ -365,13 +387,8 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
                     continue;
                 }
             }
-            const glm::vec4 value = list.value(p);
-            for (int y = ys; y < ye; ++y) {
-                const std::size_t count = std::size_t(st.count[std::size_t(y)]);
-                addStampRow(band.at(row + y, col + st.x0[std::size_t(y)]),
-                            &st.w[std::size_t(st.offset[std::size_t(y)])], int(4 * count), value);
-                band.weights += count;
-            }
+            addStampRows(band.at(row + ys, col), 4 * std::size_t(band.stride), st, ys, ye, list.value(p));
+            band.weights += std::size_t(st.samples[std::size_t(ye)] - st.samples[std::size_t(ys)]);
             w.x0 = std::min(w.x0, lo);
             w.x1 = std::max(w.x1, hi);
             w.y0 = std::min(w.y0, row + ys);
