@@ -309,24 +309,42 @@ inline void addStampRows(float* at, std::size_t rowFloats, const SheetStamp& st,
     addStampRowsScalar(at, rowFloats, st, y0, y1, value);
 }
 
+/// Composites the interleaved samples `s` of columns [c0, c0 + n) into `out` (the window
+/// row starting at `out0`), through planes of up to 256 samples.
+void compositeRun(const float* s, int c0, int n, std::size_t out0, CompositeOrder order,
+                  Composited& out) {
+    float planes[4][256];
+    for (int done = 0; done < n; done += 256) {
+        const int m = std::min(256, n - done);
+        const float* from = s + 4 * std::ptrdiff_t(done);
+        for (int x = 0; x < m; ++x)
+            for (int c = 0; c < 4; ++c) planes[c][x] = from[4 * x + c];
+        const std::size_t o = out0 + std::size_t(c0 + done);
+        compositeOpticalDepthRow(&out.r[o], &out.g[o], &out.b[o], &out.a[o], order, m, planes[0],
+                                 planes[1], planes[2], planes[3]);
+    }
+}
+
 /// A row of a band's sheet buffer, interleaved (tau, E_r, E_g, E_b) per sample, `row` at
 /// window column 0: composites columns [c0, c1] into `out` (the window row starting at
-/// `out0`), then clears columns [x0, x1].
+/// `out0`), then clears columns [x0, x1]. Skips the kBlock-column blocks marked in `opaque`
+/// (null: none; early termination) and those whose samples are all zero (no change).
 void compositeAndClear(float* row, int x0, int x1, int c0, int c1, std::size_t out0,
-                       CompositeOrder order, Composited& out) {
-    if (c1 >= c0) {
-        const int n = c1 - c0 + 1;
-        float planes[4][256];
-        for (int done = 0; done < n; done += 256) {
-            const int m = std::min(256, n - done);
-            const float* s = row + 4 * std::ptrdiff_t(c0 + done);
-            for (int x = 0; x < m; ++x)
-                for (int c = 0; c < 4; ++c) planes[c][x] = s[4 * x + c];
-            const std::size_t o = out0 + std::size_t(c0 + done);
-            compositeOpticalDepthRow(&out.r[o], &out.g[o], &out.b[o], &out.a[o], order, m,
-                                     planes[0], planes[1], planes[2], planes[3]);
+                       const std::uint8_t* opaque, CompositeOrder order, Composited& out) {
+    int run = c0;  // the pending run of active columns [run, lo)
+    for (int b = c0 / kBlock; c1 >= c0 && b <= c1 / kBlock; ++b) {
+        const int lo = std::max(c0, b * kBlock), hi = std::min(c1 + 1, (b + 1) * kBlock);
+        bool active = !(opaque && opaque[b]);
+        if (active) {
+            const float* p = row + 4 * std::ptrdiff_t(lo);
+            active = std::any_of(p, p + 4 * (hi - lo), [](float x) { return x != 0.0f; });
         }
+        if (active) continue;
+        if (lo > run) compositeRun(row + 4 * std::ptrdiff_t(run), run, lo - run, out0, order, out);
+        run = hi;
     }
+    if (c1 + 1 > run)
+        compositeRun(row + 4 * std::ptrdiff_t(run), run, c1 + 1 - run, out0, order, out);
     std::fill(row + 4 * std::ptrdiff_t(x0), row + 4 * std::ptrdiff_t(x1 + 1), 0.0f);
 }
 
@@ -452,7 +470,7 @@ std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Row
         const int c0 = std::max(w.x0, 0), c1 = std::min(w.x1, f.width - 1);
         for (int y = w.y0; y <= w.y1; ++y)
             compositeAndClear(band.at(y, 0), w.x0, w.x1, c0, c1, std::size_t(row0 + y) * f.width,
-                              order, out);
+                              nullptr, order, out);
         if (band.terminates && c1 >= c0) markOpaqueBlocks(f, out, c0, c1, band);
     }
     return {band.weights, band.hidden};
