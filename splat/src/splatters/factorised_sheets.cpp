@@ -31,6 +31,7 @@ constexpr int kBlock = 8;  ///< early termination: a band's opacity is tested pe
 /// height) covers the screen.
 struct Factorisation {
     int m, u, v;
+    int rowLength;   ///< voxels along u
     bool ascending;  ///< sheets visited in increasing q
     glm::dvec2 c, colU, colV, shear;
     double invDet;
@@ -57,6 +58,7 @@ Factorisation factorise(const Scene::Impl& scene, const Camera& camera, const Re
     f.m = sa.axis;
     f.u = f.m == 0 ? 1 : 0;
     f.v = f.m == 2 ? 1 : 2;
+    f.rowLength = volume.dims[f.u];
     f.ascending = (sa.sign > 0) == (s.order == CompositeOrder::FrontToBack);
     // The screen map of SplatProjector: x = cx + (w - eye) . right / pixel, y = cy - ... up.
     const glm::dvec3 rx = camera.right / camera.pixelSize, ry = camera.up / camera.pixelSize;
@@ -354,6 +356,7 @@ void compositeAndClear(float* row, int x0, int x1, int c0, int c1, std::size_t o
 struct BandBuffer {
     int row0, rows, margin, stride;
     std::vector<float> sheet;
+    std::vector<float> vals;  ///< a row of splat values (RowRun), zero between uses
     bool terminates;
     float threshold;
     std::vector<std::uint8_t> opaque;
@@ -372,8 +375,77 @@ struct Written {
         y1 = -1;
 };
 
+/// One sample per voxel (n = 1): a run of a sheet row's visible splats, voxels [uLo, uHi]
+/// with their values at vals[4 (u + pad)] (zero between them), added to stamp rows [ys, ye)
+/// at once as a convolution of the row with each stamp row (convolveRun).
+struct RowRun {
+    std::vector<float>& vals;
+    int pad;
+    int uLo = 0, uHi = -1;
+    void put(int u, const glm::vec4& value) {
+        if (uHi < uLo) uLo = u;
+        uHi = u;
+        float* p = &vals[4 * std::size_t(u + pad)];
+        p[0] = value.x;
+        p[1] = value.y;
+        p[2] = value.z;
+        p[3] = value.w;
+    }
+};
+
+/// out[x] += sum_t w[t] vals[x - base - t] over a stamp row's taps t, for the run's outputs,
+/// in increasing u per output (the order splat by splat stamping adds them in: the same
+/// image bit for bit); `out` is the buffer row at column `base`.
+inline void convolveRowScalar(float* out, const float* vals, const float* w, int taps, int x0,
+                              int x1) {
+    for (int x = x0; x <= x1; ++x)
+        for (int t = taps - 1; t >= 0; --t)
+            for (int c = 0; c < 4; ++c) out[4 * x + c] += w[4 * t] * vals[4 * (x - t) + c];
+}
+
+#if defined(FOOTPRINT_HAVE_LANES)
+FOOTPRINT_LANES_BEGIN
+/// convolveRowScalar two outputs (eight floats) at a time; outputs past x1 gain zeros.
+inline void convolveRowLanes(float* out, const float* vals, const float* w, int taps, int x0,
+                             int x1) {
+    for (int x = x0; x <= x1; x += 2) {
+        __m256 acc = _mm256_loadu_ps(out + 4 * x);
+        for (int t = taps - 1; t >= 0; --t)
+            acc = _mm256_fmadd_ps(_mm256_set1_ps(w[4 * t]), _mm256_loadu_ps(vals + 4 * (x - t)), acc);
+        _mm256_storeu_ps(out + 4 * x, acc);
+    }
+}
+FOOTPRINT_LANES_END
+#endif
+
+/// Adds a run's splats' stamp rows [ys, ye) (stamp row 0 at band row `row`; column 0 of voxel
+/// u at col0 + u), then clears its values.
+void convolveRun(RowRun& run, const SheetStamp& st, int row, int ys, int ye, int col0,
+                 BandBuffer& band) {
+    const float* vals = &run.vals[4 * std::size_t(run.pad)];
+    for (int y = ys; y < ye; ++y) {
+        const int taps = st.count[std::size_t(y)], base = col0 + st.x0[std::size_t(y)];
+        if (taps == 0) continue;
+        float* out = band.at(row + y, base);
+        const float* w = &st.w[std::size_t(st.offset[std::size_t(y)])];
+        const int x0 = run.uLo, x1 = run.uHi + taps - 1;
+#if defined(FOOTPRINT_HAVE_LANES)
+        if (footprint::cpuHasLanes()) {
+            convolveRowLanes(out, vals, w, taps, x0, x1);
+            continue;
+        }
+#endif
+        convolveRowScalar(out, vals, w, taps, x0, x1);
+    }
+    std::fill(run.vals.begin() + 4 * std::ptrdiff_t(run.uLo + run.pad),
+              run.vals.begin() + 4 * std::ptrdiff_t(run.uHi + run.pad + 1), 0.0f);
+    run.uHi = run.uLo - 1;
+}
+
 /// Adds the stamps of sheet q's splats that meet the band into its buffer (front to back
 /// with early termination, a splat whose non-zero columns are all opaque blocks is skipped).
+/// One sample per voxel adds a row's runs of splats as convolutions (convolveRun), more
+/// samples add splat by splat (addStampRows).
 template <class Rows>
 Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetStamp& st,
                  BandBuffer& band) {
@@ -383,14 +455,15 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
     const int top = st.b + f.dB - f.b0;
     const int vLo = std::max(0, -floorDiv(top + f.stampH - 1 - band.row0, n));
     const int vHi = std::min(floorDiv(band.row0 + band.rows - 1 - top, n), list.rows - 1);
+    const int col0 = st.a + f.dA - f.a0;  // stamp column 0 of u = 0
+    RowRun run{band.vals, f.stampW + 2};
     Written w;
     for (int v = vLo; v <= vHi; ++v) {
         const auto [pFirst, pEnd] = list.range(q, v);
         const int row = n * v + top - band.row0;  // stamp row 0, band rows
         const int ys = std::max(0, -row), ye = std::min(f.stampH, band.rows - row);
-        const int col0 = st.a + f.dA - f.a0;  // stamp column 0 of u = 0
         for (std::size_t p = pFirst; p < pEnd; ++p) {
-            const int col = n * list.u(p) + col0;
+            const int u = list.u(p), col = n * u + col0;
             const int lo = col + st.xMin, hi = col + st.xMax;
             if (hi < 0 || lo >= f.width) continue;
             if (band.terminates) {
@@ -405,13 +478,20 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
                     continue;
                 }
             }
-            addStampRows(band.at(row + ys, col), 4 * std::size_t(band.stride), st, ys, ye, list.value(p));
+            if (n == 1) {
+                if (run.uHi >= run.uLo && u > run.uHi + f.stampW) convolveRun(run, st, row, ys, ye, col0, band);
+                run.put(u, list.value(p));
+            } else {
+                addStampRows(band.at(row + ys, col), 4 * std::size_t(band.stride), st, ys, ye,
+                             list.value(p));
+            }
             band.weights += std::size_t(st.samples[std::size_t(ye)] - st.samples[std::size_t(ys)]);
             w.x0 = std::min(w.x0, lo);
             w.x1 = std::max(w.x1, hi);
             w.y0 = std::min(w.y0, row + ys);
             w.y1 = std::max(w.y1, row + ye - 1);
         }
+        if (run.uHi >= run.uLo) convolveRun(run, st, row, ys, ye, col0, band);
     }
     return w;
 }
@@ -456,6 +536,7 @@ std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Row
     band.margin = f.stampW;
     band.stride = f.width + 2 * f.stampW + 8;
     band.sheet.assign(4 * std::size_t(band.stride) * std::size_t(rows), 0.0f);
+    if (f.n == 1) band.vals.assign(4 * (std::size_t(f.rowLength) + 2 * std::size_t(f.stampW) + 8), 0.0f);
     band.terminates = order == CompositeOrder::FrontToBack && earlyTermination > 0;
     band.threshold = float(1.0 - earlyTermination);
     const int blocks = (f.width + kBlock - 1) / kBlock;
