@@ -442,8 +442,11 @@ void convolveRun(RowRun& run, const SheetStamp& st, int row, int ys, int ye, int
     run.uHi = run.uLo - 1;
 }
 
-/// Adds the stamps of sheet q's splats that meet the band into its buffer (front to back
-/// with early termination, a splat whose non-zero columns are all opaque blocks is skipped).
+/// Adds the stamps of sheet q's splats that meet the band into its buffer. Front to back with
+/// early termination, a splat is skipped when the blocks under its stamp's box (stampW
+/// columns, wider than the footprint's support) are all opaque: testing the support alone
+/// culls a few per cent more at no measurable saving and composites less into nearly opaque
+/// edges (ch2 at 512², early termination 1/32: RMSE 2.6e-3 against 2.4e-3 at azimuth 120°).
 /// One sample per voxel adds a row's runs of splats as convolutions (convolveRun), more
 /// samples add splat by splat (addStampRows).
 template <class Rows>
@@ -467,12 +470,13 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
             const int lo = col + st.xMin, hi = col + st.xMax;
             if (hi < 0 || lo >= f.width) continue;
             if (band.terminates) {
-                const int open = band.firstOpen(std::max(lo, 0));
-                if (open > std::min(hi, f.width - 1)) {
-                    // Hidden: on to the first splat whose columns reach the open block.
+                // Hidden when the stamp's box (not only its support) is over opaque blocks.
+                const int open = band.firstOpen(std::max(col, 0));
+                if (open > std::min(col + f.stampW - 1, f.width - 1)) {
+                    // On to the first splat whose box reaches the open block.
                     ++band.hidden;
                     const std::size_t next =
-                        list.seek(p + 1, pEnd, floorDiv(open - st.xMax - col0 + n - 1, n));
+                        list.seek(p + 1, pEnd, floorDiv(open - (f.stampW - 1) - col0 + n - 1, n));
                     band.hidden += next - p - 1;
                     p = next - 1;
                     continue;
