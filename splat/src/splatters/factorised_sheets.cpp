@@ -119,10 +119,10 @@ Factorisation factorise(const Scene::Impl& scene, const Camera& camera, const Re
 /// stamp as rows of the footprint's support only: row y (of stampH, from dB) covers columns
 /// [x0[y], x0[y] + count[y]) (from dA; count even, its padding weighs 0) with weights from
 /// w[offset[y]], each repeated four times to meet a sample's (tau, E_r, E_g, E_b). Columns
-/// [xMin, xMax] hold every non-zero weight.
+/// [xMin, xMax] and rows [yMin, yMax] hold every non-zero weight.
 struct SheetStamp {
     int a, b;
-    int xMin, xMax;
+    int xMin, xMax, yMin, yMax;
     std::vector<int> x0, count, offset;
     std::vector<int> samples;  ///< samples[y]: the samples of rows [0, y)
     std::vector<float> w;
@@ -136,6 +136,8 @@ SheetStamp sheetStamp(const Factorisation& f, int q, const footprint::FootprintT
     const double phaseU = sU - st.a, phaseV = sV - st.b;
     st.xMin = f.stampW;
     st.xMax = -1;
+    st.yMin = f.stampH;
+    st.yMax = -1;
     std::vector<float> row(std::size_t(f.stampW) + 1);
     st.samples.push_back(0);
     for (int y = 0; y < f.stampH; ++y) {
@@ -161,23 +163,25 @@ SheetStamp sheetStamp(const Factorisation& f, int q, const footprint::FootprintT
         if (hi >= lo) {
             st.xMin = std::min(st.xMin, lo);
             st.xMax = std::max(st.xMax, hi);
+            st.yMin = std::min(st.yMin, y);
+            st.yMax = y;
         }
     }
     return st;
 }
 
 /// The factorised sheets' state per scene (Scene::Impl::state), made on first use: the list
-/// in sheet order along i (a counting sort on the slice index; the list is in (k, j, i)
-/// order, so sorting by i keeps rows by (k, j) within a slice): position p holds splat
-/// id[p] at (u, v) = (j, k), of palette entry entry[p] (a paletted list); slice q at
-/// positions [start[q], start[q + 1]). Made once, so a frame with sheets along i reads the
-/// list in sheet order without gathering it.
+/// in sheet order along i (a counting sort on the row (i, k); the list is in (k, j, i) order,
+/// so a row stays in order of j): position p holds splat id[p] at (u, v) = (j = u[p], k), of
+/// palette entry entry[p] (a paletted list); row v of slice q at positions
+/// [row[q dims.z + v], row[q dims.z + v + 1]). Made once, so a frame with sheets along i
+/// reads the list in sheet order without gathering it.
 class SheetsAlongI {
   public:
     explicit SheetsAlongI(const Scene::Impl& scene) : scene_(scene) {}
     struct Order {
-        std::vector<std::uint32_t> id, start;
-        std::vector<std::uint16_t> u, v, entry;
+        std::vector<std::uint32_t> id, row;
+        std::vector<std::uint16_t> u, entry;
     };
     const Order& get() {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -189,19 +193,18 @@ class SheetsAlongI {
     std::unique_ptr<Order> make() const {
         const SplatList& s = scene_.splats;
         auto o = std::make_unique<Order>();
-        o->start.assign(std::size_t(scene_.volume->dims.x) + 1, 0);
-        for (std::uint16_t q : s.i) ++o->start[std::size_t(q) + 1];
-        for (std::size_t q = 1; q < o->start.size(); ++q) o->start[q] += o->start[q - 1];
-        std::vector<std::uint32_t> next(o->start.begin(), o->start.end() - 1);
+        const std::size_t rows = std::size_t(scene_.volume->dims.z);
+        o->row.assign(std::size_t(scene_.volume->dims.x) * rows + 1, 0);
+        for (std::size_t n = 0; n < s.size(); ++n) ++o->row[s.i[n] * rows + s.k[n] + 1];
+        for (std::size_t r = 1; r < o->row.size(); ++r) o->row[r] += o->row[r - 1];
+        std::vector<std::uint32_t> next(o->row.begin(), o->row.end() - 1);
         o->id.resize(s.size());
         o->u.resize(s.size());
-        o->v.resize(s.size());
         if (s.paletted()) o->entry.resize(s.size());
         for (std::size_t n = 0; n < s.size(); ++n) {
-            const std::uint32_t p = next[s.i[n]]++;
+            const std::uint32_t p = next[s.i[n] * rows + s.k[n]]++;
             o->id[p] = std::uint32_t(n);
             o->u[p] = s.j[n];
-            o->v[p] = s.k[n];
             if (s.paletted()) o->entry[p] = s.emissionIndex[n];
         }
         return o;
@@ -215,7 +218,7 @@ class SheetsAlongI {
 /// The splats of row v of sheet q, list positions [first, second), by u, from one of two
 /// sources. Sheets along j or k (ListRows): a row (k, j) of the list is consecutive
 /// (CellIndex::cellStarts), read in place. Sheets along i (GatheredRows): the list in sheet
-/// order (SheetsAlongI), rows found by bisection.
+/// order (SheetsAlongI).
 struct ListRows {
     const SplatList& s;
     const std::vector<std::uint32_t>& cells;
@@ -246,11 +249,8 @@ struct GatheredRows {
     int rows;
     const float *er, *eg, *eb;
     std::pair<std::size_t, std::size_t> range(int q, int v) const {
-        const auto first = list.v.begin() + std::ptrdiff_t(list.start[std::size_t(q)]),
-                   last = list.v.begin() + std::ptrdiff_t(list.start[std::size_t(q) + 1]);
-        const auto lo = std::lower_bound(first, last, std::uint16_t(v));
-        const auto hi = std::upper_bound(lo, last, std::uint16_t(v));
-        return {std::size_t(lo - list.v.begin()), std::size_t(hi - list.v.begin())};
+        const std::size_t r = std::size_t(q) * std::size_t(rows) + std::size_t(v);
+        return {list.row[r], list.row[r + 1]};
     }
     int u(std::size_t p) const { return list.u[p]; }
     std::size_t seek(std::size_t p, std::size_t end, int u) const {
@@ -454,17 +454,17 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
                  BandBuffer& band) {
     const int n = f.n;
     auto floorDiv = [](int x, int y) { return x >= 0 ? x / y : -((-x + y - 1) / y); };
-    // Voxel rows whose stamp rows n v + st.b + dB - b0 + [0, stampH) meet the band.
+    // Voxel rows whose stamp rows n v + st.b + dB - b0 + [yMin, yMax] meet the band.
     const int top = st.b + f.dB - f.b0;
-    const int vLo = std::max(0, -floorDiv(top + f.stampH - 1 - band.row0, n));
-    const int vHi = std::min(floorDiv(band.row0 + band.rows - 1 - top, n), list.rows - 1);
+    const int vLo = std::max(0, -floorDiv(top + st.yMax - band.row0, n));
+    const int vHi = std::min(floorDiv(band.row0 + band.rows - 1 - top - st.yMin, n), list.rows - 1);
     const int col0 = st.a + f.dA - f.a0;  // stamp column 0 of u = 0
     RowRun run{band.vals, f.stampW + 2};
     Written w;
     for (int v = vLo; v <= vHi; ++v) {
         const auto [pFirst, pEnd] = list.range(q, v);
         const int row = n * v + top - band.row0;  // stamp row 0, band rows
-        const int ys = std::max(0, -row), ye = std::min(f.stampH, band.rows - row);
+        const int ys = std::max(st.yMin, -row), ye = std::min(st.yMax + 1, band.rows - row);
         for (std::size_t p = pFirst; p < pEnd; ++p) {
             const int u = list.u(p), col = n * u + col0;
             const int lo = col + st.xMin, hi = col + st.xMax;
