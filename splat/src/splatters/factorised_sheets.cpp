@@ -465,6 +465,8 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
         const auto [pFirst, pEnd] = list.range(q, v);
         const int row = n * v + top - band.row0;  // stamp row 0, band rows
         const int ys = std::max(st.yMin, -row), ye = std::min(st.yMax + 1, band.rows - row);
+        std::size_t drawn = 0;
+        int first = std::numeric_limits<int>::max(), last = -1;  // columns of the drawn
         for (std::size_t p = pFirst; p < pEnd; ++p) {
             const int u = list.u(p), col = n * u + col0;
             const int lo = col + st.xMin, hi = col + st.xMax;
@@ -474,10 +476,9 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
                 const int open = band.firstOpen(std::max(col, 0));
                 if (open > std::min(col + f.stampW - 1, f.width - 1)) {
                     // On to the first splat whose box reaches the open block.
-                    ++band.hidden;
                     const std::size_t next =
                         list.seek(p + 1, pEnd, floorDiv(open - (f.stampW - 1) - col0 + n - 1, n));
-                    band.hidden += next - p - 1;
+                    band.hidden += next - p;
                     p = next - 1;
                     continue;
                 }
@@ -489,12 +490,16 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
                 addStampRows(band.at(row + ys, col), 4 * std::size_t(band.stride), st, ys, ye,
                              list.value(p));
             }
-            band.weights += std::size_t(st.samples[std::size_t(ye)] - st.samples[std::size_t(ys)]);
-            w.x0 = std::min(w.x0, lo);
-            w.x1 = std::max(w.x1, hi);
-            w.y0 = std::min(w.y0, row + ys);
-            w.y1 = std::max(w.y1, row + ye - 1);
+            ++drawn;
+            first = std::min(first, lo);
+            last = hi;
         }
+        if (drawn == 0) continue;
+        band.weights += drawn * std::size_t(st.samples[std::size_t(ye)] - st.samples[std::size_t(ys)]);
+        w.x0 = std::min(w.x0, first);
+        w.x1 = std::max(w.x1, last);
+        w.y0 = std::min(w.y0, row + ys);
+        w.y1 = std::max(w.y1, row + ye - 1);
         if (run.uHi >= run.uLo) convolveRun(run, st, row, ys, ye, col0, band);
     }
     return w;
