@@ -578,6 +578,13 @@ inline void catmullRom(float t, float (&w)[4]) {
 /// through its samples, opacity clamped to [0, 1] and colour to [0, opacity] (the spline's
 /// overshoot at opaque edges).
 Image warp(const Factorisation& f, const Composited& w, int width, int height) {
+    // The window as one (r, g, b, a) per sample: a tap is one load.
+    std::vector<glm::vec4> rgba(w.r.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rgba.size(), 16384),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t k = r.begin(); k != r.end(); ++k)
+                              rgba[k] = glm::vec4(w.r[k], w.g[k], w.b[k], w.a[k]);
+                      });
     Image image(width, height);
     tbb::parallel_for(0, height, [&](int y) {
         for (int x = 0; x < width; ++x) {
@@ -595,8 +602,7 @@ Image warp(const Factorisation& f, const Composited& w, int width, int height) {
             for (int j = 0; j < 4; ++j) {
                 const std::size_t r = o + std::size_t(j) * std::size_t(f.width);
                 glm::vec4 row(0.0f);
-                for (int i = 0; i < 4; ++i)
-                    row += wa[i] * glm::vec4(w.r[r + i], w.g[r + i], w.b[r + i], w.a[r + i]);
+                for (int i = 0; i < 4; ++i) row += wa[i] * rgba[r + i];
                 sum += wb[j] * row;
             }
             const float a = std::clamp(sum.a, 0.0f, 1.0f);
