@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -327,6 +328,14 @@ void compositeRun(const float* s, int c0, int n, std::size_t out0, CompositeOrde
     }
 }
 
+/// True when one of the n floats at p has a bit set (is not +0): a loop without an early
+/// exit, which the compiler vectorises.
+inline bool anyBitSet(const float* p, int n) {
+    std::uint32_t bits = 0;
+    for (int k = 0; k < n; ++k) bits |= std::bit_cast<std::uint32_t>(p[k]);
+    return bits != 0;
+}
+
 /// A row of a band's sheet buffer, interleaved (tau, E_r, E_g, E_b) per sample, `row` at
 /// window column 0: composites columns [c0, c1] into `out` (the window row starting at
 /// `out0`), then clears columns [x0, x1]. Skips the kBlock-column blocks marked in `opaque`
@@ -337,10 +346,7 @@ void compositeAndClear(float* row, int x0, int x1, int c0, int c1, std::size_t o
     for (int b = c0 / kBlock; c1 >= c0 && b <= c1 / kBlock; ++b) {
         const int lo = std::max(c0, b * kBlock), hi = std::min(c1 + 1, (b + 1) * kBlock);
         bool active = !(opaque && opaque[b]);
-        if (active) {
-            const float* p = row + 4 * std::ptrdiff_t(lo);
-            active = std::any_of(p, p + 4 * (hi - lo), [](float x) { return x != 0.0f; });
-        }
+        if (active) active = anyBitSet(row + 4 * std::ptrdiff_t(lo), 4 * (hi - lo));
         if (active) continue;
         if (lo > run) compositeRun(row + 4 * std::ptrdiff_t(run), run, lo - run, out0, order, out);
         run = hi;
