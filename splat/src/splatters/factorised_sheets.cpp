@@ -220,49 +220,50 @@ class SheetsAlongI {
 /// sources. Sheets along j or k (ListRows): a row (k, j) of the list is consecutive
 /// (CellIndex::cellStarts), read in place. Sheets along i (GatheredRows): the list in sheet
 /// order (SheetsAlongI).
-struct ListRows {
+/// A splat's (rho, e_r, e_g, e_b) at list position p through raw arrays (the per-splat loop
+/// keeps them in registers): `id` maps positions to splats (null: the same), `entry` holds
+/// the positions' palette entries (null: a list without palette, or shaded emission).
+struct SplatValues {
     const SplatList& s;
+    const std::uint32_t* id;
+    const std::uint16_t* entry;
+    const glm::vec4* palette;
+    const float *er, *eg, *eb;
+    glm::vec4 value(std::size_t p) const {
+        if (entry) return palette[entry[p]];
+        const std::size_t n = id ? id[p] : p;
+        const glm::vec4 e = s.emission(n);
+        return er ? glm::vec4(e.x, er[n], eg[n], eb[n]) : e;
+    }
+};
+
+/// The positions' u, sorted within a row: u(p) and seek.
+struct RowU {
+    const std::uint16_t* at;
+    int u(std::size_t p) const { return at[p]; }
+    /// The first of positions [p, end) whose u is at least `u`.
+    std::size_t seek(std::size_t p, std::size_t end, int u) const {
+        return std::size_t(std::lower_bound(at + p, at + end, u) - at);
+    }
+};
+
+struct ListRows : RowU, SplatValues {
     const std::vector<std::uint32_t>& cells;
     std::size_t ny, cx;
     int m, rows;  ///< sheet axis (1 or 2), rows per sheet
-    const float *er, *eg, *eb;
     std::pair<std::size_t, std::size_t> range(int q, int v) const {
         const std::size_t k = std::size_t(m == 2 ? q : v), j = std::size_t(m == 2 ? v : q);
         const std::size_t c = (k * ny + j) * cx;
         return {cells[c], cells[c + cx]};
     }
-    int u(std::size_t p) const { return s.i[p]; }
-    /// The first of positions [p, end) whose u is at least `u`.
-    std::size_t seek(std::size_t p, std::size_t end, int u) const {
-        return std::size_t(std::lower_bound(s.i.begin() + std::ptrdiff_t(p),
-                                            s.i.begin() + std::ptrdiff_t(end), u) -
-                           s.i.begin());
-    }
-    glm::vec4 value(std::size_t p) const {
-        const glm::vec4 e = s.emission(p);
-        return er ? glm::vec4(e.x, er[p], eg[p], eb[p]) : e;
-    }
 };
 
-struct GatheredRows {
-    const SplatList& s;
-    const SheetsAlongI::Order& list;
+struct GatheredRows : RowU, SplatValues {
+    const std::vector<std::uint32_t>& row;
     int rows;
-    const float *er, *eg, *eb;
     std::pair<std::size_t, std::size_t> range(int q, int v) const {
         const std::size_t r = std::size_t(q) * std::size_t(rows) + std::size_t(v);
-        return {list.row[r], list.row[r + 1]};
-    }
-    int u(std::size_t p) const { return list.u[p]; }
-    std::size_t seek(std::size_t p, std::size_t end, int u) const {
-        return std::size_t(std::lower_bound(list.u.begin() + std::ptrdiff_t(p),
-                                            list.u.begin() + std::ptrdiff_t(end), u) -
-                           list.u.begin());
-    }
-    glm::vec4 value(std::size_t p) const {
-        const std::size_t id = list.id[p];
-        const glm::vec4 e = list.entry.empty() ? s.emission(id) : s.palette[list.entry[p]];
-        return er ? glm::vec4(e.x, er[id], eg[id], eb[id]) : e;
+        return {row[r], row[r + 1]};
     }
 };
 
@@ -638,19 +639,25 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
     const int sheets = dims[f.m];
     // Sheets along i cross the list's rows: read in the scene's sheet order; others in place.
     static const SheetsAlongI::Order none;
-    const GatheredRows gatheredRows{scene.splats,
-                                    f.m == 0 ? scene.state<SheetsAlongI>().get() : none,
-                                    dims[f.v], er, eg, eb};
+    const SheetsAlongI::Order& alongI = f.m == 0 ? scene.state<SheetsAlongI>().get() : none;
+    const SplatList& list = scene.splats;
+    const bool palette = list.paletted() && !er;
+    const GatheredRows gatheredRows{
+        {alongI.u.data()},
+        {list, alongI.id.data(), palette ? alongI.entry.data() : nullptr, list.palette.data(), er,
+         eg, eb},
+        alongI.row,
+        dims[f.v]};
     CellIndex& cells = scene.state<CellIndex>();
-    const ListRows listRows{scene.splats,
-                            cells.cellStarts(),
-                            std::size_t(dims.y),
-                            std::size_t(cells.cellsX()),
-                            f.m,
-                            dims[f.v],
-                            er,
-                            eg,
-                            eb};
+    const ListRows listRows{
+        {list.i.data()},
+        {list, nullptr, palette ? list.emissionIndex.data() : nullptr, list.palette.data(), er, eg,
+         eb},
+        cells.cellStarts(),
+        std::size_t(dims.y),
+        std::size_t(cells.cellsX()),
+        f.m,
+        dims[f.v]};
     std::vector<SheetStamp> stamps(static_cast<std::size_t>(sheets));
     tbb::parallel_for(0, sheets,
                       [&](int q) { stamps[std::size_t(q)] = sheetStamp(f, q, scene.table); });
