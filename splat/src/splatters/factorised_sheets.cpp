@@ -289,14 +289,15 @@ FOOTPRINT_LANES_BEGIN
 /// addStampRowsScalar two samples (eight floats) at a time (every row's count is even).
 inline void addStampRowsLanes(float* at, std::size_t rowFloats, const SheetStamp& st, int y0,
                               int y1, const glm::vec4& value) {
-    const __m256 v = _mm256_setr_ps(value.x, value.y, value.z, value.w, value.x, value.y,
-                                    value.z, value.w);
+    const __m256 v =
+        _mm256_setr_ps(value.x, value.y, value.z, value.w, value.x, value.y, value.z, value.w);
     for (int y = y0; y < y1; ++y) {
         float* p = at + std::size_t(y - y0) * rowFloats + 4 * st.x0[std::size_t(y)];
         const float* w = &st.w[std::size_t(st.offset[std::size_t(y)])];
         const int floats = 4 * st.count[std::size_t(y)];
         for (int x = 0; x < floats; x += 8)
-            _mm256_storeu_ps(p + x, _mm256_fmadd_ps(v, _mm256_loadu_ps(w + x), _mm256_loadu_ps(p + x)));
+            _mm256_storeu_ps(p + x,
+                             _mm256_fmadd_ps(v, _mm256_loadu_ps(w + x), _mm256_loadu_ps(p + x)));
     }
 }
 FOOTPRINT_LANES_END
@@ -370,10 +371,14 @@ struct BandBuffer {
     std::vector<int> nextOpen;  ///< per block, the first block at or after it that is not opaque
     int opaqueCount = 0;
     std::size_t weights = 0, hidden = 0;
-    float* at(int y, int x) { return &sheet[4 * (std::size_t(y) * stride + std::size_t(x + margin))]; }
+    float* at(int y, int x) {
+        return &sheet[4 * (std::size_t(y) * stride + std::size_t(x + margin))];
+    }
     /// The first column at or after c0 in a block that is not opaque (past c1: all of
     /// [c0, c1] is hidden).
-    int firstOpen(int c0) const { return std::max(c0, nextOpen[std::size_t(c0 / kBlock)] * kBlock); }
+    int firstOpen(int c0) const {
+        return std::max(c0, nextOpen[std::size_t(c0 / kBlock)] * kBlock);
+    }
 };
 
 /// The written rectangle of a band's sheet buffer: columns [x0, x1], band rows [y0, y1].
@@ -418,7 +423,8 @@ inline void convolveRowLanes(float* out, const float* vals, const float* w, int 
     for (int x = x0; x <= x1; x += 2) {
         __m256 acc = _mm256_loadu_ps(out + 4 * x);
         for (int t = taps - 1; t >= 0; --t)
-            acc = _mm256_fmadd_ps(_mm256_set1_ps(w[4 * t]), _mm256_loadu_ps(vals + 4 * (x - t)), acc);
+            acc =
+                _mm256_fmadd_ps(_mm256_set1_ps(w[4 * t]), _mm256_loadu_ps(vals + 4 * (x - t)), acc);
         _mm256_storeu_ps(out + 4 * x, acc);
     }
 }
@@ -491,7 +497,8 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
                 }
             }
             if (n == 1) {
-                if (run.uHi >= run.uLo && u > run.uHi + f.stampW) convolveRun(run, st, row, ys, ye, col0, band);
+                if (run.uHi >= run.uLo && u > run.uHi + f.stampW)
+                    convolveRun(run, st, row, ys, ye, col0, band);
                 run.put(u, list.value(p));
             } else {
                 addStampRows(band.at(row + ys, col), 4 * std::size_t(band.stride), st, ys, ye,
@@ -502,7 +509,8 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
             last = hi;
         }
         if (drawn == 0) continue;
-        band.weights += drawn * std::size_t(st.samples[std::size_t(ye)] - st.samples[std::size_t(ys)]);
+        band.weights +=
+            drawn * std::size_t(st.samples[std::size_t(ye)] - st.samples[std::size_t(ys)]);
         w.x0 = std::min(w.x0, first);
         w.x1 = std::max(w.x1, last);
         w.y0 = std::min(w.y0, row + ys);
@@ -534,7 +542,8 @@ void markOpaqueBlocks(const Factorisation& f, const Composited& out, int c0, int
     }
     if (!marked) return;
     for (int b = int(band.opaque.size()) - 1; b >= 0; --b)
-        band.nextOpen[std::size_t(b)] = band.opaque[std::size_t(b)] ? band.nextOpen[std::size_t(b) + 1] : b;
+        band.nextOpen[std::size_t(b)] =
+            band.opaque[std::size_t(b)] ? band.nextOpen[std::size_t(b) + 1] : b;
 }
 
 /// One band of the window, rows [row0, row0 + rows): every sheet in visiting order, its
@@ -542,9 +551,9 @@ void markOpaqueBlocks(const Factorisation& f, const Composited& out, int c0, int
 /// back, the band ends when all its column blocks are opaque. Returns the samples added and
 /// the splats skipped as hidden.
 template <class Rows>
-std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Rows& list,
-                                               int sheets, const std::vector<SheetStamp>& stamps,
-                                               int row0, int rows, CompositeOrder order,
+std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Rows& list, int sheets,
+                                               const std::vector<SheetStamp>& stamps, int row0,
+                                               int rows, CompositeOrder order,
                                                double earlyTermination, Composited& out) {
     BandBuffer band;
     band.row0 = row0;
@@ -552,7 +561,8 @@ std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Row
     band.margin = f.stampW;
     band.stride = f.width + 2 * f.stampW + 8;
     band.sheet.assign(4 * std::size_t(band.stride) * std::size_t(rows), 0.0f);
-    if (f.n == 1) band.vals.assign(4 * (std::size_t(f.rowLength) + 2 * std::size_t(f.stampW) + 8), 0.0f);
+    if (f.n == 1)
+        band.vals.assign(4 * (std::size_t(f.rowLength) + 2 * std::size_t(f.stampW) + 8), 0.0f);
     band.terminates = order == CompositeOrder::FrontToBack && earlyTermination > 0;
     band.threshold = float(1.0 - earlyTermination);
     const int blocks = (f.width + kBlock - 1) / kBlock;
@@ -649,15 +659,14 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
         alongI.row,
         dims[f.v]};
     CellIndex& cells = scene.state<CellIndex>();
-    const ListRows listRows{
-        {list.i.data()},
-        {list, nullptr, palette ? list.emissionIndex.data() : nullptr, list.palette.data(), er, eg,
-         eb},
-        cells.cellStarts(),
-        std::size_t(dims.y),
-        std::size_t(cells.cellsX()),
-        f.m,
-        dims[f.v]};
+    const ListRows listRows{{list.i.data()},
+                            {list, nullptr, palette ? list.emissionIndex.data() : nullptr,
+                             list.palette.data(), er, eg, eb},
+                            cells.cellStarts(),
+                            std::size_t(dims.y),
+                            std::size_t(cells.cellsX()),
+                            f.m,
+                            dims[f.v]};
     std::vector<SheetStamp> stamps(static_cast<std::size_t>(sheets));
     tbb::parallel_for(0, sheets,
                       [&](int q) { stamps[std::size_t(q)] = sheetStamp(f, q, scene.table); });
@@ -674,9 +683,9 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
     tbb::parallel_for(0, bands, [&](int k) {
         const int row0 = k * kBand, rows = std::min(kBand, f.height - row0);
         counts[std::size_t(k)] = f.m == 0 ? renderBand(f, gatheredRows, sheets, stamps, row0, rows,
-                                                        s.order, s.quality.earlyTermination, w)
-                                           : renderBand(f, listRows, sheets, stamps, row0, rows,
-                                                        s.order, s.quality.earlyTermination, w);
+                                                       s.order, s.quality.earlyTermination, w)
+                                          : renderBand(f, listRows, sheets, stamps, row0, rows,
+                                                       s.order, s.quality.earlyTermination, w);
     });
     Image image = warp(f, w, camera.width(), camera.height());
     stats.tilesMs = msSince(tiles);
