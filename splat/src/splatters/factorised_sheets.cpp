@@ -216,10 +216,6 @@ class SheetsAlongI {
     std::unique_ptr<Order> order_;
 };
 
-/// The splats of row v of sheet q, list positions [first, second), by u, from one of two
-/// sources. Sheets along j or k (ListRows): a row (k, j) of the list is consecutive
-/// (CellIndex::cellStarts), read in place. Sheets along i (GatheredRows): the list in sheet
-/// order (SheetsAlongI).
 /// A splat's (rho, e_r, e_g, e_b) at list position p through raw arrays (the per-splat loop
 /// keeps them in registers): `id` maps positions to splats (null: the same), `entry` holds
 /// the positions' palette entries (null: a list without palette, or shaded emission).
@@ -247,6 +243,10 @@ struct RowU {
     }
 };
 
+/// The splats of row v of sheet q, list positions [first, second), by u, from one of two
+/// sources. Sheets along j or k (ListRows): a row (k, j) of the list is consecutive
+/// (CellIndex::cellStarts), read in place. Sheets along i (GatheredRows): the list in sheet
+/// order (SheetsAlongI).
 struct ListRows : RowU, SplatValues {
     const std::vector<std::uint32_t>& cells;
     std::size_t ny, cx;
