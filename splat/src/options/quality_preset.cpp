@@ -22,9 +22,9 @@ PresetValues valuesOf(QualityPreset preset) {
     switch (preset) {
         case QualityPreset::Fast:
             // Axis-aligned: factorised sheets at one sample per voxel and early termination
-            // at 1/32 (ch2 at 512²: RMSE 2.3e-3, within VTK's 2.7e-3 at 1-voxel steps, at
-            // 0.54x the default's CPU time); image-aligned: slabs of 2 voxels; the reference:
-            // a tenfold looser step refinement.
+            // at 1/32 (ch2 at 512²: RMSE 2.2e-3 to 2.4e-3, within VTK's 2.7e-3 at 1-voxel
+            // steps, at 0.18x the default's CPU time); image-aligned: slabs of 2 voxels; the
+            // reference: a tenfold looser step refinement.
             return {1.0 / 32.0, 2.0, 0.0, 1e-3, 1};
         case QualityPreset::Exact:
             // The converged end (docs/speed-vs-accuracy.md "Convergence orders"): no early
