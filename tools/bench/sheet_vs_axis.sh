@@ -1,10 +1,11 @@
 #!/bin/bash
 # The image-aligned splatter (--renderer sheet) of two builds against the axis-aligned splatter
-# on ch2 with the mri-head preset, 2 threads, a 3-frame rotation (elevation 15, one warm-up
+# on ch2 with the mri-head preset, THREADS threads, a 3-frame rotation (elevation 15, one warm-up
 # frame): per setting, CPU time (user + sys) and wall time per frame, averaged over rounds that
 # interleave A's sheet, B's sheet and A's axis-aligned frame, B's and the axis ratio to A's sheet.
 # Usage: bash tools/bench/sheet_vs_axis.sh A_BENCH_FRAMES B_BENCH_FRAMES
-# Environment: SIZES (default "512 256"), SLABS (default "1 0.5"), ROUNDS (default 3).
+# Environment: SIZES (default "512 256"), SLABS (default "1 0.5"), ROUNDS (default 3), THREADS
+# (default 2).
 set -euo pipefail
 A=${1:?usage: sheet_vs_axis.sh A_BENCH_FRAMES B_BENCH_FRAMES}
 B=${2:?usage: sheet_vs_axis.sh A_BENCH_FRAMES B_BENCH_FRAMES}
@@ -15,6 +16,7 @@ OUT=$(mktemp -d /tmp/sheet_vs_axis.XXXXXX)
 SIZES=${SIZES:-"512 256"}
 SLABS=${SLABS:-"1 0.5"}
 ROUNDS=${ROUNDS:-3}
+THREADS=${THREADS:-2}
 for r in $(seq 1 "$ROUNDS"); do
     for S in $SIZES; do
         for T in $SLABS; do
@@ -23,7 +25,7 @@ for r in $(seq 1 "$ROUNDS"); do
                 slab=(--slab "$T")
                 [ "$2" = axis ] && slab=()  # the axis-aligned splatter has no slabs
                 nice "$3" render "$CH2" mri-head --renderer "$2" "${slab[@]}" --size "$S" \
-                    --threads 2 --frames 3 --warmup 1 > "$OUT/${1}_${2}_${S}_${T}_r$r.json"
+                    --threads "$THREADS" --frames 3 --warmup 1 > "$OUT/${1}_${2}_${S}_${T}_r$r.json"
             done
         done
     done
