@@ -62,8 +62,9 @@ class FootprintLanes {
           coef_(poly ? poly->coefficients()[0].data() : nullptr),
           seg_(_mm256_set1_ps(poly ? poly->segmentScale() : 0.0f)),
           lastSeg_(_mm256_set1_ps(float(FootprintPoly::kSegments - 1))) {}
-    /// fp(r2) for r2 >= 0; lanes at or beyond R^2 must be masked by the caller.
-    __m256 operator()(__m256 r2) const {
+    /// fp(r2) for r2 >= 0; lanes at or beyond R^2 must be masked by the caller. Inlined
+    /// always: a call would clobber every vector register the caller's loop holds.
+    [[gnu::always_inline]] __m256 operator()(__m256 r2) const {
         if (poly_) {
             const __m256 s = _mm256_mul_ps(r2, seg_);
             const __m256 sf = _mm256_min_ps(_mm256_floor_ps(s), lastSeg_);

@@ -16,10 +16,11 @@ constexpr std::size_t kChunks = 64;
 /// many splats ahead of its use.
 constexpr std::size_t kAhead = 16;
 
+/// Calls f(t) for every tile t the (non-empty, so inside the image) rectangle r touches.
 template <class F>
 void forTilesOf(const PixelRect& r, const TileGrid& g, F&& f) {
-    const int tx0 = r.x0 / g.tileSize, tx1 = r.x1 / g.tileSize;
-    const int ty0 = r.y0 / g.tileSize, ty1 = r.y1 / g.tileSize;
+    const int tx0 = g.tileOf(r.x0), tx1 = g.tileOf(r.x1);
+    const int ty0 = g.tileOf(r.y0), ty1 = g.tileOf(r.y1);
     for (int ty = ty0; ty <= ty1; ++ty)
         for (int tx = tx0; tx <= tx1; ++tx) f(ty * g.tilesX + tx);
 }

@@ -203,6 +203,7 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
     bool pending = false;
     while (next < end || pending) {
         if (!pending) step = std::max(step, cutter.key(src.record(next)));  // skip empty sheets
+        const std::uint32_t slot = step % ring;  // where sheet `step` is in the ring
         for (; next < end && cutter.key(src.record(next)) == step; ++next)
             src.forEachSplat(src.record(next), [&](const auto& rec) {
                 const PixelRect r = clipToTile(src.rect(rec), grid, ox, oy);
@@ -212,14 +213,15 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
                     return;
                 }
                 const std::uint32_t n = cutter.span(rec);
-                for (std::uint32_t j = 0; j < n; ++j) target[j] = sheets[(step + j) % ring];
+                for (std::uint32_t j = 0, k = slot; j < n; ++j, k = k + 1 == ring ? 0 : k + 1)
+                    target[j] = sheets[k];  // sheets[(step + j) % ring]
                 float v[NCh];
                 recordValues<Policy>(in, rec, v);
                 cnt.footprintPixels += cutter.cut(target, rec, v, src.ellipse(rec), r);
                 pendingEnd = std::max(pendingEnd, step + n - 1);
                 pending = true;
             });
-        SheetBuffer<NCh>& sheet = *sheets[step % ring];
+        SheetBuffer<NCh>& sheet = *sheets[slot];
         if (sheet.dirty()) {
             acc.setSheet(step);
             sheet.flush(acc, policy, in.plan.pathLength, tileScale);

@@ -45,7 +45,7 @@ struct SlabRange {
     int pre, suf, jBegin, jEnd;
 };
 template <class Front, class Back>
-SlabRange slabRange(int n, bool ascending, Front front, Back back) {
+[[gnu::always_inline]] inline SlabRange slabRange(int n, bool ascending, Front front, Back back) {
     int pre = 0, suf = n + 1;
     if (ascending) {
         while (pre <= n && front(pre)) ++pre;
@@ -57,18 +57,23 @@ SlabRange slabRange(int n, bool ascending, Front front, Back back) {
     return {pre, suf, std::max(pre - 1, 0), std::min(suf, n)};
 }
 
-/// Row y of the sheets jBegin .. jEnd - 1 and the distance between their channel planes
-/// (the stores may alias the sheets' members: without these the compiler reloads them for
-/// every store).
+/// Where the vector loops write: channel c of row y of sheet j starts at
+/// origin[j] + y stride + c plane. The sheets a splat is cut into all have the tile's size
+/// (one ring or group of sheets made alike), so stride and plane are the same for every
+/// sheet and are read once per splat, not per row and sheet.
+struct SheetRows {
+    float* origin[kMaxSpan];
+    std::ptrdiff_t stride, plane;
+};
 template <int NCh>
-void sheetRows(SheetBuffer<NCh>* const* sheets, int jBegin, int jEnd, int y, float** rows,
-               std::ptrdiff_t* planes) {
-    for (int j = jBegin; j < jEnd; ++j) {
-        rows[j] = sheets[j]->row(0, y);
-        if constexpr (NCh > 1)
-            planes[j] = sheets[j]->row(1, y) - rows[j];
-        else
-            planes[j] = 0;
+void sheetRows(SheetBuffer<NCh>* const* sheets, int n, SheetRows& out) {
+    out.stride = sheets[0]->row(0, 1) - sheets[0]->row(0, 0);
+    out.plane = NCh > 1 ? sheets[0]->row(1, 0) - sheets[0]->row(0, 0) : 0;
+    for (int j = 0; j < n; ++j) {
+        out.origin[j] = sheets[j]->row(0, 0);
+        if (sheets[j]->row(0, 1) - out.origin[j] != out.stride ||
+            (NCh > 1 && sheets[j]->row(1, 0) - out.origin[j] != out.plane))
+            throw std::logic_error("image-aligned splatter: a splat's sheets differ in size");
     }
 }
 
@@ -82,8 +87,8 @@ FOOTPRINT_LANES_BEGIN
 /// j gets values * scale * |at(j + 1) - at(j)|, at(b) the kernel's cumulative part (fraction
 /// or N P) at boundary b (the boundaries run back to front when compositing is).
 template <int NCh, class At>
-[[gnu::always_inline]] inline void addSections(float* const* rows, const std::ptrdiff_t* planes,
-                                               int x, int jBegin, int jEnd, __m256 scale,
+[[gnu::always_inline]] inline void addSections(const SheetRows& rows, std::ptrdiff_t at0,
+                                               int jBegin, int jEnd, __m256 scale,
                                                const __m256 (&vv)[NCh], At at) {
     const __m256 signBit = _mm256_set1_ps(-0.0f);
     __m256 below = at(jBegin);
@@ -91,9 +96,10 @@ template <int NCh, class At>
         const __m256 above = at(j + 1);
         const __m256 w = _mm256_mul_ps(scale, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
         below = above;
-        float* p = rows[j] + x;
-        for (int c = 0; c < NCh; ++c, p += planes[j]) {
-            _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
+        float* const p = rows.origin[j] + at0;
+        for (int c = 0; c < NCh; ++c) {
+            float* const q = p + c * rows.plane;
+            _mm256_storeu_ps(q, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(q)));
         }
     }
 }
@@ -124,8 +130,8 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
     // the reverse): a row visits only slabs [pre - 1, suf), the others' sections are zero.
     const bool ascending = tb[n] > tb[0];
     const __m256 vPre = ascending ? vZero : vOne, vSuf = ascending ? vOne : vZero;
-    float* rows[kMaxSpan];
-    std::ptrdiff_t planes[kMaxSpan];  // distance between channel planes, per sheet
+    SheetRows rows;
+    sheetRows(sheets, n, rows);
     for (int y = y0; y <= y1; ++y) {
         const float dy = float(y + oy) + 0.5f - sy;
         const float gyy = e.gamma * dy * dy;     // the row's smallest r^2 (every lane's r^2 >= it)
@@ -141,7 +147,7 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
         const SlabRange range = slabRange(n, ascending, zero, one);
         const int pre = range.pre, suf = range.suf, jBegin = range.jBegin, jEnd = range.jEnd;
         if (jBegin >= jEnd) continue;
-        sheetRows(sheets, jBegin, jEnd, y, rows, planes);
+        const std::ptrdiff_t rowAt = std::ptrdiff_t(y) * rows.stride;
         const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(e.beta * dy);
         const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
@@ -163,7 +169,7 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
                 return fraction(radial,
                                 _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
             };
-            addSections(rows, planes, x, jBegin, jEnd, weight, vv, fractionAt);
+            addSections(rows, rowAt + x, jBegin, jEnd, weight, vv, fractionAt);
         }
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
@@ -199,10 +205,15 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
     __m256 vv[NCh];
     for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
     // Flat: per boundary z, z^2, erf(z / (sigma sqrt 2)) and the cubic term, 8 at a time.
+    // fneg: the sign bit of N P beyond the chord on boundary b's side (-fp / 2 before the
+    // kernel's centre, +fp / 2 behind it).
     alignas(32) float fz[Flat ? kMaxFlat + 8 : 1], fzz[Flat ? kMaxFlat + 8 : 1],
-        fe[Flat ? kMaxFlat + 8 : 1], fq[Flat ? kMaxFlat + 8 : 1];
+        fe[Flat ? kMaxFlat + 8 : 1], fq[Flat ? kMaxFlat + 8 : 1], fneg[Flat ? kMaxFlat + 8 : 1];
     if constexpr (Flat) {
-        for (int b = 0; b <= n; ++b) fz[b] = e.depthScale * tb[b];
+        for (int b = 0; b <= n; ++b) {
+            fz[b] = e.depthScale * tb[b];
+            fneg[b] = fz[b] > 0.0f ? 0.0f : -0.0f;
+        }
         for (int b = n + 1; b % 8; ++b) fz[b] = 0.0f;
         const __m256 vs = _mm256_set1_ps(slab.erfScale());
         for (int b = 0; b <= n; b += 8) {
@@ -216,8 +227,8 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
     // smallest r^2 (N P = -fp / 2 front to back) and behind it (+fp / 2) are a prefix and
     // a suffix.
     const bool ascending = tb[n] > tb[0];
-    float* rows[kMaxSpan];
-    std::ptrdiff_t planes[kMaxSpan];
+    SheetRows rows;
+    sheetRows(sheets, n, rows);
     for (int y = y0; y <= y1; ++y) {
         const float dy = float(y + oy) + 0.5f - sy;
         const float gyy = e.gamma * dy * dy;
@@ -231,7 +242,7 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
         const SlabRange range = slabRange(n, ascending, before, behind);
         const int pre = range.pre, suf = range.suf, jBegin = range.jBegin, jEnd = range.jEnd;
         if (jBegin >= jEnd) continue;
-        sheetRows(sheets, jBegin, jEnd, y, rows, planes);
+        const std::ptrdiff_t rowAt = std::ptrdiff_t(y) * rows.stride;
         const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(e.beta * dy);
         const __m256 vtyy = _mm256_set1_ps(e.ty * dy);
         const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
@@ -258,13 +269,14 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
                     const __m256 p = footprint::GaussianSlabLanes::inside(
                         radial, _mm256_broadcast_ss(fz + b), _mm256_broadcast_ss(fe + b),
                         _mm256_broadcast_ss(fq + b));
-                    return _mm256_blendv_ps(fz[b] > 0.0f ? plus : minus, p, in);
+                    const __m256 beyond = _mm256_xor_ps(plus, _mm256_broadcast_ss(fneg + b));
+                    return _mm256_blendv_ps(beyond, p, in);
                 } else {
                     return section(radial,
                                    _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
                 }
             };
-            addSections(rows, planes, x, jBegin, jEnd, vScale, vv, pAt);
+            addSections(rows, rowAt + x, jBegin, jEnd, vScale, vv, pAt);
         }
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
