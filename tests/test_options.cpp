@@ -128,7 +128,15 @@ TEST_CASE("a malformed value names its flag in one line", "[options]") {
     CHECK_THROWS_WITH(values.set("tile-size", "1.5"), "--tile-size: '1.5' is not an integer");
     CHECK_THROWS_WITH(values.set("no-such", "1"), "unknown option --no-such");
     values.set("tile-size", "4");
-    CHECK_THROWS_WITH(parseRenderOptions(values), "--tile-size must be between 8 and 64");
+    CHECK_THROWS_WITH(parseRenderOptions(values), "--tile-size must be between 8 and 32");
+    // Early termination tracks a tile in at most 64 blocks of 4x4 pixels: 32 is the largest
+    // tile the compositor takes, so the option refuses 33 and 64 before a render starts.
+    for (const char* tile : {"33", "64"}) {
+        values.set("tile-size", tile);
+        CHECK_THROWS_WITH(parseRenderOptions(values), "--tile-size must be between 8 and 32");
+    }
+    values.set("tile-size", "32");
+    CHECK_NOTHROW(parseRenderOptions(values));
 }
 
 TEST_CASE("flag, scene key and library accept and refuse the same values alike",

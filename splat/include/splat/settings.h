@@ -157,7 +157,7 @@ struct Quality {
     /// Reference ray caster: first-pass step in voxels, and the per-pixel change at which
     /// step halving stops.
     double referenceStep = 0.25, referenceTolerance = 1e-4;
-    /// Screen tile edge, pixels (8..64): each tile owns its sheets and compositing.
+    /// Screen tile edge, pixels (8..32: early termination tracks a tile in 64 blocks of 4x4 pixels): each tile owns its sheets and compositing.
     int tileSize = 32;
     /// Level of detail of the splatters: off, a pixel threshold, auto or brick.
     LevelOfDetail lod;

@@ -207,7 +207,7 @@ void validateFrame(const RenderSettings& s) {
         throw Error("slab thickness below 0.001 voxels would need millions of sheets");
     if (!(q.earlyTermination >= 0 && q.earlyTermination < 1))
         throw Error("early termination threshold must be in [0, 1)");
-    if (q.tileSize < 8 || q.tileSize > 64) throw Error("tile size must be between 8 and 64 pixels");
+    if (q.tileSize < 8 || q.tileSize > 32) throw Error("tile size must be between 8 and 32 pixels");
     if (!(q.lod.pixels >= 0 && q.lod.pixels <= 64))
         throw Error("level of detail threshold must be between 0 (off) and 64 pixels per voxel");
     if (!(q.pixelFilter >= 0 && q.pixelFilter <= 4))

@@ -244,7 +244,7 @@ std::vector<OptionSpec> makeTable() {
         {"ref-tolerance", T::Real, "0.0001", "reference renderer: step refinement tolerance", kQ,
          kFrame, R, P::None, ignoredRefTolerance},
         {"threads", T::Integer, "0", "worker threads (0 = all cores)", kQ, kFrame, R},
-        {"tile-size", T::Integer, "32", "splatters: screen tile edge in pixels (8..64)", kQ, kFrame,
+        {"tile-size", T::Integer, "32", "splatters: screen tile edge in pixels (8..32)", kQ, kFrame,
          R, P::None, ignoredTileSize},
         {"lod", T::Text, "0",
          "splatters: level of detail, pixels per voxel below which 2x2x2 voxels are "

@@ -133,7 +133,7 @@ void parseQuality(const OptionValues& v, RenderSettings& s) {
     const long long threads = v.integer("threads"), tile = v.integer("tile-size");
     if (threads < 0 || threads > 1024)
         throw OptionError("--threads must be between 0 (all cores) and 1024");
-    if (tile < 8 || tile > 64) throw OptionError("--tile-size must be between 8 and 64");
+    if (tile < 8 || tile > 32) throw OptionError("--tile-size must be between 8 and 32");
     s.threads = int(threads);
     q.tileSize = int(tile);
     parseLevelOfDetail(v.text("lod"), q);
