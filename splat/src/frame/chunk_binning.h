@@ -128,7 +128,7 @@ struct ChunkBins {
     std::vector<footprint::EllipticalFootprint> each;  ///< perspective: per chunk position
     std::vector<float> sx, sy;                         ///< per chunk position
     std::vector<std::uint16_t> value;                  ///< per chunk position (fields.value)
-    std::vector<PixelRect> rect;                       ///< boxes of the entries (sweep too)
+    std::vector<PixelRect> rect;                       ///< scratch: boxes of the entries
     std::vector<std::uint32_t> visible;                ///< scratch: tiles where visible
     std::vector<std::uint32_t> entry;                  ///< scratch: splats per entry
     std::vector<std::uint32_t> counts;                 ///< scratch: per part and tile

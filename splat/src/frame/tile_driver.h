@@ -151,9 +151,6 @@ struct BinnedSplats {
     const footprint::EllipticalFootprint& ellipse(const SheetRecord& r) const {
         return in.proj.ellipse(r.id);
     }
-    /// A record is one splat: the sweep's per-splat test is the only one.
-    bool entryHidden(const SheetRecord&, const TileAccumulator&, int, int) const { return false; }
-    std::uint32_t entrySplats(const SheetRecord&) const { return 1; }
     /// ProjectedSplats::rect of the (binned, so not behind the eye) splat, from its record.
     PixelRect rect(const SheetRecord& r) const {
         return footprintRect(r.sx, r.sy, ellipse(r), in.bins.grid.width, in.bins.grid.height);
@@ -171,15 +168,6 @@ struct ChunkRecords {
     std::uint32_t begin() const { return bins.begin[t]; }
     std::uint32_t end() const { return bins.begin[t + 1]; }
     const RunRecord& record(std::uint32_t q) const { return bins.records[q]; }
-    /// True when the tile is opaque over the box of the run's footprint boxes (binning's box
-    /// of the entry), so that the sweep's per-splat test would skip each of its splats: the
-    /// run is skipped without expanding it (same image, fewer per-splat steps).
-    bool entryHidden(const RunRecord& r, const TileAccumulator& acc, int ox, int oy) const {
-        if (r.count < 2) return false;
-        const PixelRect b = clipToTile(bins.rect[r.local], grid, ox, oy);
-        return !b.empty() && acc.rectOpaque(b.x0 - ox, b.y0 - oy, b.x1 - ox, b.y1 - oy);
-    }
-    std::uint32_t entrySplats(const RunRecord& r) const { return r.count; }
     /// Calls f(SplatRecord) for each splat of the run, in visiting order.
     template <class F>
     void forEachSplat(const RunRecord& r, F&& f) const {
@@ -215,11 +203,7 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
     bool pending = false;
     while (next < end || pending) {
         if (!pending) step = std::max(step, cutter.key(src.record(next)));  // skip empty sheets
-        for (; next < end && cutter.key(src.record(next)) == step; ++next) {
-            if (src.entryHidden(src.record(next), acc, ox, oy)) {
-                cnt.culled += src.entrySplats(src.record(next));
-                continue;
-            }
+        for (; next < end && cutter.key(src.record(next)) == step; ++next)
             src.forEachSplat(src.record(next), [&](const auto& rec) {
                 const PixelRect r = clipToTile(src.rect(rec), grid, ox, oy);
                 if (r.empty()) return;  // a splat of a run that misses this tile
@@ -235,7 +219,6 @@ void sweepTile(const TileInputs& in, const Policy& policy, const Cutter& cutter,
                 pendingEnd = std::max(pendingEnd, step + n - 1);
                 pending = true;
             });
-        }
         SheetBuffer<NCh>& sheet = *sheets[step % ring];
         if (sheet.dirty()) {
             acc.setSheet(step);
@@ -415,8 +398,8 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
             SheetBuffer<NCh>* ring[1] = {sheet.get()};
             const std::vector<float> tileScale = tilePathScale(pathScale, g, t);
             sweepTile(in, policy, cutter, ChunkRecords{bins, projector, g, order, fields, t}, g, t,
-                      acc, ring, 1, tileScale.empty() ? nullptr : tileScale.data(),
-                      counters[std::size_t(t)]);
+                      acc, ring, 1,
+                      tileScale.empty() ? nullptr : tileScale.data(), counters[std::size_t(t)]);
         });
         binMs += ms(t0, t1);
         tilesMs += ms(t1, Clock::now());
