@@ -136,7 +136,8 @@ struct WholeFootprints {
     const footprint::FootprintTable& table;
     const footprint::FootprintPoly* poly;
 #if defined(FOOTPRINT_HAVE_LANES)
-    const PhaseStamps* stamps = nullptr;  ///< per-frame footprint stamps, when asked for
+    const PhaseStamps* stamps = nullptr;    ///< per-frame footprint stamps, when asked for
+    const Degree5Lanes* degree5 = nullptr;  ///< the frame's polynomial lanes, where they fit
 #endif
 
     template <class Record>  // SplatRecord or RunRecord
@@ -150,8 +151,11 @@ struct WholeFootprints {
     int cut(SheetBuffer<NCh>* const* sheets, const SplatRecord& s, const float (&v)[NCh],
             const footprint::EllipticalFootprint& e, const PixelRect& r) const {
 #if defined(FOOTPRINT_HAVE_LANES)
-        if constexpr (NCh != kLabelChannels)
+        if constexpr (NCh != kLabelChannels) {
             if (stamps) return stamps->add(*sheets[0], v, s.sx, s.sy, r);
+            if (degree5)
+                return splatFootprintLanes(*sheets[0], v, s.sx, s.sy, e, r, table, *degree5);
+        }
 #endif
         return splatFootprint(*sheets[0], v, s.sx, s.sy, e, r, table, poly);
     }
@@ -373,6 +377,12 @@ class AxisAligned final : public Splatter {
         // Quality::factorisedSheets < 0 (an experiment beside factorised sheets): per-frame
         // footprint stamps at -factorisedSheets phases per pixel, orthographic views only.
         std::optional<PhaseStamps> stamps;
+        // The polynomial's coefficients loaded once per frame instead of once per splat.
+        std::optional<Degree5Lanes> degree5;
+        if (cutter.poly && Degree5Lanes::fits(*cutter.poly) && footprint::cpuHasLanes()) {
+            degree5.emplace(*cutter.poly);
+            cutter.degree5 = &*degree5;
+        }
         const int phases = -in.settings.quality.factorisedSheets;
         if (phases > 0 && !in.camera.perspective() && footprint::cpuHasLanes()) {
             const SplatProjector projector(
