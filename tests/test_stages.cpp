@@ -298,35 +298,41 @@ LaneErrors laneErrors(const footprint::FootprintTable& table, const footprint::F
     return worst;
 }
 FOOTPRINT_LANES_END
+
+/// True when this CPU runs the lanes (else a warning: the scalar lookups are used everywhere).
+bool lanesOnThisCpu() {
+    if (footprint::cpuHasLanes()) return true;
+    WARN("this CPU has no AVX2 + FMA: the scalar lookups are used everywhere");
+    return false;
+}
+
+/// The default Gaussian kernel's footprint table and polynomial.
+struct DefaultFootprint {
+    footprint::Kernel kernel = footprint::Kernel::fromName("gaussian", 0, 0);
+    footprint::FootprintTable table{kernel};
+    footprint::FootprintPoly poly{table};
+};
 }  // namespace
 
 TEST_CASE("footprint lanes equal the tables' scalar lookups", "[stages]") {
-    if (!footprint::cpuHasLanes()) {
-        WARN("this CPU has no AVX2 + FMA: the scalar lookups are used everywhere");
-        return;
-    }
-    const footprint::Kernel kernel = footprint::Kernel::fromName("gaussian", 0, 0);
-    const footprint::FootprintTable table(kernel);
-    const footprint::FootprintPoly poly(table);
-    const footprint::SlabTable slabs(kernel);
-    const LaneErrors worst = laneErrors(table, poly, slabs);
+    if (!lanesOnThisCpu()) return;
+    const DefaultFootprint f;
+    const footprint::FootprintTable& table = f.table;
+    const footprint::SlabTable slabs(f.kernel);
+    const LaneErrors worst = laneErrors(table, f.poly, slabs);
     const double peak = table.peak();
     CHECK(worst.table <= 1e-7 * peak);   // the same interpolation, FMA rounding only
     CHECK(worst.poly <= 1.5e-6 * peak);  // FootprintPoly's tolerance, 1e-6 of the peak
     CHECK(worst.fraction <= 1e-6);       // F in [0, 1], the same bilinear interpolation
 }
-#endif
 
-#if defined(FOOTPRINT_HAVE_LANES)
 TEST_CASE("footprint lanes: two rows per group fill the sheet of one row per group, bit for bit",
           "[stages][axis]") {
-    if (!footprint::cpuHasLanes()) {
-        WARN("this CPU has no AVX2 + FMA: the scalar lookups are used everywhere");
-        return;
-    }
-    const footprint::Kernel kernel = footprint::Kernel::fromName("gaussian", 0, 0);
-    const footprint::FootprintTable table(kernel);
-    const footprint::FootprintPoly poly(table);
+    if (!lanesOnThisCpu()) return;
+    const DefaultFootprint f;
+    const footprint::Kernel& kernel = f.kernel;
+    const footprint::FootprintTable& table = f.table;
+    const footprint::FootprintPoly& poly = f.poly;
     REQUIRE(Degree5Lanes::fits(poly));
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> u(-1.0, 1.0), pixel(0.4, 2.5);
