@@ -5,6 +5,7 @@
 #include <tbb/task_scheduler_observer.h>
 
 #include <atomic>
+#include <cstring>
 #include <catch2/catch.hpp>
 #include <random>
 
@@ -17,6 +18,7 @@
 #include "splat/render.h"
 #include "splat/scene.h"
 #include "splat/synthetic.h"
+#include "splatters/footprint_lanes.h"
 #include "splatters/splatter.h"
 
 using namespace splat;
@@ -296,22 +298,76 @@ LaneErrors laneErrors(const footprint::FootprintTable& table, const footprint::F
     return worst;
 }
 FOOTPRINT_LANES_END
+
+/// True when this CPU runs the lanes (else a warning: the scalar lookups are used everywhere).
+bool lanesOnThisCpu() {
+    if (footprint::cpuHasLanes()) return true;
+    WARN("this CPU has no AVX2 + FMA: the scalar lookups are used everywhere");
+    return false;
+}
+
+/// The default Gaussian kernel's footprint table and polynomial.
+struct DefaultFootprint {
+    footprint::Kernel kernel = footprint::Kernel::fromName("gaussian", 0, 0);
+    footprint::FootprintTable table{kernel};
+    footprint::FootprintPoly poly{table};
+};
 }  // namespace
 
 TEST_CASE("footprint lanes equal the tables' scalar lookups", "[stages]") {
-    if (!footprint::cpuHasLanes()) {
-        WARN("this CPU has no AVX2 + FMA: the scalar lookups are used everywhere");
-        return;
-    }
-    const footprint::Kernel kernel = footprint::Kernel::fromName("gaussian", 0, 0);
-    const footprint::FootprintTable table(kernel);
-    const footprint::FootprintPoly poly(table);
-    const footprint::SlabTable slabs(kernel);
-    const LaneErrors worst = laneErrors(table, poly, slabs);
+    if (!lanesOnThisCpu()) return;
+    const DefaultFootprint f;
+    const footprint::FootprintTable& table = f.table;
+    const footprint::SlabTable slabs(f.kernel);
+    const LaneErrors worst = laneErrors(table, f.poly, slabs);
     const double peak = table.peak();
     CHECK(worst.table <= 1e-7 * peak);   // the same interpolation, FMA rounding only
     CHECK(worst.poly <= 1.5e-6 * peak);  // FootprintPoly's tolerance, 1e-6 of the peak
     CHECK(worst.fraction <= 1e-6);       // F in [0, 1], the same bilinear interpolation
+}
+
+TEST_CASE("footprint lanes: two rows per group fill the sheet of one row per group, bit for bit",
+          "[stages][axis]") {
+    if (!lanesOnThisCpu()) return;
+    const DefaultFootprint f;
+    const footprint::Kernel& kernel = f.kernel;
+    const footprint::FootprintTable& table = f.table;
+    const footprint::FootprintPoly& poly = f.poly;
+    REQUIRE(Degree5Lanes::fits(poly));
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0), pixel(0.4, 2.5);
+    std::uniform_real_distribution<float> pos(-3.0f, 35.0f), val(0.0f, 2.0f);
+    // A tile at (32, 64) of a 96 x 128 image; oblique views and pixels of 0.4 to 2.5 voxels
+    // give boxes 2 to 12 pixels wide.
+    const int ox = 32, oy = 64, width = 96, height = 128;
+    int narrow = 0, wide = 0;
+    for (int view = 0; view < 20; ++view) {
+        const glm::dvec3 dir = glm::normalize(glm::dvec3(u(rng), u(rng), 1.5 + u(rng)));
+        const glm::dvec3 right = glm::normalize(glm::cross(dir, glm::dvec3(0.3, 1.0, 0.1)));
+        const glm::dvec3 up = glm::cross(right, dir);
+        const double size = pixel(rng);
+        const footprint::EllipticalFootprint e = footprint::ellipticalFootprint(
+            glm::dvec3(1.0, 1.0, 1.5), right * size, -up * size, dir, kernel.radius());
+        SheetBuffer<4> paired(ox, oy, 32, 32), single(ox, oy, 32, 32);
+        for (int n = 0; n < 60; ++n) {
+            const float sx = float(ox) + pos(rng), sy = float(oy) + pos(rng);
+            const PixelRect r = clipToTile(footprintRect(sx, sy, e, width, height),
+                                           TileGrid(width, height, 32), ox, oy);
+            if (r.empty()) continue;
+            (r.x1 - r.x0 < 4 ? narrow : wide) += 1;
+            const float v[4] = {val(rng), val(rng), val(rng), val(rng)};
+            const Degree5Lanes fp(poly);
+            const int a = splatFootprintLanes(paired, v, sx, sy, e, r, table, fp, true);
+            const int b = splatFootprintLanes(single, v, sx, sy, e, r, table, fp, false);
+            REQUIRE(a == b);
+        }
+        for (int c = 0; c < 4; ++c)
+            for (int y = 0; y < 32; ++y)
+                REQUIRE(std::memcmp(paired.row(c, y), single.row(c, y), 32 * sizeof(float)) == 0);
+    }
+    INFO(narrow << " narrow and " << wide << " wide boxes");
+    CHECK(narrow > 100);
+    CHECK(wide > 100);
 }
 #endif
 

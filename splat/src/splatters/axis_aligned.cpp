@@ -16,6 +16,7 @@
 
 #include "footprint/lanes.h"
 #include "splatters/cell_index.h"
+#include "splatters/footprint_lanes.h"
 #include "splatters/splatter.h"
 
 namespace splat {
@@ -31,97 +32,6 @@ namespace {
 
 #if defined(FOOTPRINT_HAVE_LANES)
 FOOTPRINT_LANES_BEGIN
-/// fp(r^2) for eight r^2 >= 0 from a footprint polynomial of degree <= 5 (lanes at or beyond
-/// R^2 masked by the caller): footprint::FootprintLanes' evaluation without its terms of
-/// degree 6 and 7, which are exact zeros there, so every value is the same to the bit and
-/// a lookup costs two permutes and two fused multiply-adds less (the default Gaussian's
-/// polynomial has degree 5).
-class Degree5Lanes {
-  public:
-    explicit Degree5Lanes(const footprint::FootprintPoly& poly)
-        : seg_(_mm256_set1_ps(poly.segmentScale())),
-          lastSeg_(_mm256_set1_ps(float(footprint::FootprintPoly::kSegments - 1))) {
-        for (int k = 0; k < 6; ++k)
-            coef_[k] = _mm256_loadu_ps(
-                poly.coefficients()[footprint::FootprintPoly::kMaxCoefficients - 1 - k].data());
-    }
-    static bool fits(const footprint::FootprintPoly& poly) {
-        return footprint::FootprintPoly::kMaxCoefficients == 8 && poly.degree() <= 5;
-    }
-    __m256 operator()(__m256 r2) const {
-        const __m256 s = _mm256_mul_ps(r2, seg_);
-        const __m256 sf = _mm256_min_ps(_mm256_floor_ps(s), lastSeg_);
-        const __m256i seg = _mm256_cvttps_epi32(sf);
-        const __m256 u =
-            _mm256_fmsub_ps(_mm256_set1_ps(2.0f), _mm256_sub_ps(s, sf), _mm256_set1_ps(1.0f));
-        auto a = [&](int k) { return _mm256_permutevar8x32_ps(coef_[k], seg); };  // of u^k
-        const __m256 u2 = _mm256_mul_ps(u, u), u4 = _mm256_mul_ps(u2, u2);
-        const __m256 q0 = _mm256_fmadd_ps(a(1), u, a(0)), q1 = _mm256_fmadd_ps(a(3), u, a(2));
-        const __m256 q2 = _mm256_fmadd_ps(a(5), u, a(4));
-        return _mm256_fmadd_ps(q2, u4, _mm256_fmadd_ps(q1, u2, q0));
-    }
-
-  private:
-    __m256 seg_, lastSeg_;
-    __m256 coef_[6];  ///< coefficient of u^k of every segment
-};
-
-/// Adds values * fp(r^2) * e.scale, the whole footprint, to the pixels of `rect`: eight
-/// pixels at a time where AVX2 is available (fp from `footprintOf`: FootprintLanes or
-/// Degree5Lanes).
-template <int NCh, class Footprint>
-int splatFootprintLanes(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx, float sy,
-                        const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                        const footprint::FootprintTable& table, const Footprint& footprintOf) {
-    const int ox = sheet.originX(), oy = sheet.originY();
-    const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
-    sheet.markDirty(x0, x1, y0, y1);
-    const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
-    const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
-    const __m256 vMax = _mm256_set1_ps(table.r2Max()), zero = _mm256_setzero_ps();
-    __m256 vv[NCh];
-    for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
-    // Row pointers from plain locals: the stores could alias the sheet's members, which the
-    // compiler would otherwise reload after every store.
-    const std::ptrdiff_t plane = NCh > 1 ? sheet.row(1, 0) - sheet.row(0, 0) : 0;
-    for (int y = y0; y <= y1; ++y) {
-        float* const base = sheet.row(0, y);
-        const float dy = float(y + oy) + 0.5f - sy;
-        // r^2 = a (dx + beta dy)^2 + gamma dy^2 (EllipticalFootprint::r2).
-        const float gyy = e.gamma * dy * dy, shift = e.beta * dy;
-        const __m256 vgyy = _mm256_set1_ps(gyy), vshift = _mm256_set1_ps(shift);
-        const __m256 lastX = _mm256_set1_ps(float(x1) + 0.5f);
-        // Lanes start at the box's first pixel, not at an 8-aligned one: a box up to 8
-        // pixels wide is one group per row wherever it lies (the lanes past x1 add zero to
-        // the row's padding or to the next row; SheetBuffer pads the last row's end).
-        for (int x = x0; x <= x1; x += 8) {
-            const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
-            const __m256 q =
-                _mm256_add_ps(_mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx)), vshift);
-            const __m256 r2 = _mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy);
-            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
-                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
-            const __m256 fp = footprintOf(_mm256_max_ps(r2, zero));
-            const __m256 w = _mm256_and_ps(inside, _mm256_mul_ps(fp, vScale));
-            float* p = base + x;
-            for (int c = 0; c < NCh; ++c, p += plane)
-                _mm256_storeu_ps(p, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(p)));
-        }
-    }
-    return (x1 - x0 + 1) * (y1 - y0 + 1);
-}
-
-/// splatFootprintLanes with the footprint polynomial (Degree5Lanes where it fits) or table.
-template <int NCh>
-int splatFootprintVector(SheetBuffer<NCh>& sheet, const float (&values)[NCh], float sx, float sy,
-                         const footprint::EllipticalFootprint& e, const PixelRect& rect,
-                         const footprint::FootprintTable& table,
-                         const footprint::FootprintPoly* poly) {
-    if (poly && Degree5Lanes::fits(*poly))
-        return splatFootprintLanes(sheet, values, sx, sy, e, rect, table, Degree5Lanes(*poly));
-    return splatFootprintLanes(sheet, values, sx, sy, e, rect, table,
-                               footprint::FootprintLanes(table, poly));
-}
 /// Per-frame footprint stamps (orthographic views, one ellipse for every splat): the
 /// footprint rasterised once per frame at `phases` x `phases` sub-pixel phases, so that a
 /// splat adds a stamp, the one of its phase rounded to the nearest 1 / phases pixel (its
@@ -226,7 +136,8 @@ struct WholeFootprints {
     const footprint::FootprintTable& table;
     const footprint::FootprintPoly* poly;
 #if defined(FOOTPRINT_HAVE_LANES)
-    const PhaseStamps* stamps = nullptr;  ///< per-frame footprint stamps, when asked for
+    const PhaseStamps* stamps = nullptr;    ///< per-frame footprint stamps, when asked for
+    const Degree5Lanes* degree5 = nullptr;  ///< the frame's polynomial lanes, where they fit
 #endif
 
     template <class Record>  // SplatRecord or RunRecord
@@ -240,8 +151,11 @@ struct WholeFootprints {
     int cut(SheetBuffer<NCh>* const* sheets, const SplatRecord& s, const float (&v)[NCh],
             const footprint::EllipticalFootprint& e, const PixelRect& r) const {
 #if defined(FOOTPRINT_HAVE_LANES)
-        if constexpr (NCh != kLabelChannels)
+        if constexpr (NCh != kLabelChannels) {
             if (stamps) return stamps->add(*sheets[0], v, s.sx, s.sy, r);
+            if (degree5)
+                return splatFootprintLanes(*sheets[0], v, s.sx, s.sy, e, r, table, *degree5);
+        }
 #endif
         return splatFootprint(*sheets[0], v, s.sx, s.sy, e, r, table, poly);
     }
@@ -463,6 +377,12 @@ class AxisAligned final : public Splatter {
         // Quality::factorisedSheets < 0 (an experiment beside factorised sheets): per-frame
         // footprint stamps at -factorisedSheets phases per pixel, orthographic views only.
         std::optional<PhaseStamps> stamps;
+        // The polynomial's coefficients loaded once per frame instead of once per splat.
+        std::optional<Degree5Lanes> degree5;
+        if (cutter.poly && Degree5Lanes::fits(*cutter.poly) && footprint::cpuHasLanes()) {
+            degree5.emplace(*cutter.poly);
+            cutter.degree5 = &*degree5;
+        }
         const int phases = -in.settings.quality.factorisedSheets;
         if (phases > 0 && !in.camera.perspective() && footprint::cpuHasLanes()) {
             const SplatProjector projector(
