@@ -21,4 +21,8 @@ RT=()
 if [ "$(id -u)" -eq 0 ] && command -v chrt > /dev/null && chrt -f 50 true 2> /dev/null; then
     RT=(chrt -f 50)
 fi
-BENCH_ARGS="$*" exec "${RT[@]}" python3 tools/bench/vs_vtk.py "$@"
+# Debian's interpreter, which has Debian's python3-vtk9 (the first python3 on PATH may be
+# another one).
+PY=python3
+[ -x /usr/bin/python3 ] && PY=/usr/bin/python3
+BENCH_ARGS="$*" exec "${RT[@]}" "$PY" tools/bench/vs_vtk.py "$@"

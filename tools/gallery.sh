@@ -23,7 +23,7 @@ $S render $CH2 --mode xray --azimuth 90 --size 320x320 -o $G/head_xray.png
 $S render synthetic:phantom:128 --tf tools/gallery/phantom-tf.json --renderer sheet --elevation 25 --azimuth 30 --size 320x320 -o $G/phantom_sheet.png
 $S render synthetic:phantom:128 --tf tools/gallery/phantom-tf.json --renderer sheet --classify post --elevation 25 --azimuth 30 --size 320x320 -o $G/phantom_sheet_post.png
 # One kernel's footprint (X-ray of a single voxel), isotropic and with spacing 1 x 1 x 3.
-python3 -c "import struct,sys; sys.stdout.buffer.write(struct.pack('<f', 1.0))" > $tmp/one_1x1x1_float32.raw
+/usr/bin/python3 -c "import struct,sys; sys.stdout.buffer.write(struct.pack('<f', 1.0))" > $tmp/one_1x1x1_float32.raw
 $S render $tmp/one_1x1x1_float32.raw --mode xray --pixel-size 0.04 --size 160x160 -o $G/footprint.png
 $S render $tmp/one_1x1x1_float32.raw --spacing 1,1,3 --mode xray --azimuth 30 --elevation 40 --pixel-size 0.06 --size 160x160 -o $G/footprint_elliptical.png
 # Error against the reference ray caster at 45 degrees (phantom:64, 256x256).
@@ -38,7 +38,7 @@ $S rotate synthetic:phantom:96 --tf tools/gallery/phantom-tf.json --renderer she
 # Popping: where the axis-aligned splatter's sheets turn (ch2, mri-head, 40..50 degrees): the
 # error-jump plot and the event's frames before/after with their differences.
 $S popping $CH2 --tf mri-head --size 128x128 --from 40 --to 50 --step 0.5 --report $tmp/popping -q
-python3 tools/popping_figures.py $tmp/popping $G/popping_ch2
+/usr/bin/python3 tools/popping_figures.py $tmp/popping $G/popping_ch2
 
 # ---- Techniques: shading, edges, isosurfaces, labels, clipping, views ----------
 T=/usr/share/mricron/templates
