@@ -12,7 +12,8 @@ B=${2:?usage: sheet_vs_axis.sh A_BENCH_FRAMES B_BENCH_FRAMES}
 CH2=/usr/share/mricron/templates/ch2.nii.gz
 for bin in "$A" "$B"; do [ -x "$bin" ] || { echo "sheet_vs_axis: $bin is missing" >&2; exit 1; }; done
 [ -f "$CH2" ] || { echo "sheet_vs_axis: $CH2 is missing (Debian package mricron-data)" >&2; exit 77; }
-OUT=$(mktemp -d /tmp/sheet_vs_axis.XXXXXX)
+OUT=$(mktemp -d /tmp/sheet_vs_axis.XXXXXX)  # the per-run JSON of bench_frames
+trap 'rm -rf "$OUT"' EXIT
 SIZES=${SIZES:-"512 256"}
 SLABS=${SLABS:-"1 0.5"}
 ROUNDS=${ROUNDS:-3}
