@@ -421,32 +421,75 @@ inline void convolveRowScalar(float* out, const float* vals, const float* w, int
 #if defined(FOOTPRINT_HAVE_LANES)
 FOOTPRINT_LANES_BEGIN
 /// convolveRowScalar at n = 1, two outputs (eight floats) at a time; outputs past x1 gain
-/// zeros.
+/// zeros. `Taps` > 0: that many taps, their weights held in registers across the row (a
+/// stamp row has a handful); 0: `taps` of them, each weight read per output pair.
+template <int Taps>
 inline void convolveRowLanes(float* out, const float* vals, const float* w, int taps, int x0,
                              int x1) {
-    for (int x = x0; x <= x1; x += 2) {
-        __m256 acc = _mm256_loadu_ps(out + 4 * x);
-        for (int t = taps - 1; t >= 0; --t)
-            acc =
-                _mm256_fmadd_ps(_mm256_set1_ps(w[4 * t]), _mm256_loadu_ps(vals + 4 * (x - t)), acc);
-        _mm256_storeu_ps(out + 4 * x, acc);
+    if constexpr (Taps > 0) {
+        __m256 wt[Taps];
+        for (int t = 0; t < Taps; ++t) wt[t] = _mm256_set1_ps(w[4 * t]);
+        for (int x = x0; x <= x1; x += 2) {
+            __m256 acc = _mm256_loadu_ps(out + 4 * x);
+            for (int t = Taps - 1; t >= 0; --t)
+                acc = _mm256_fmadd_ps(wt[t], _mm256_loadu_ps(vals + 4 * (x - t)), acc);
+            _mm256_storeu_ps(out + 4 * x, acc);
+        }
+    } else {
+        for (int x = x0; x <= x1; x += 2) {
+            __m256 acc = _mm256_loadu_ps(out + 4 * x);
+            for (int t = taps - 1; t >= 0; --t)
+                acc = _mm256_fmadd_ps(_mm256_set1_ps(w[4 * t]),
+                                      _mm256_loadu_ps(vals + 4 * (x - t)), acc);
+            _mm256_storeu_ps(out + 4 * x, acc);
+        }
     }
 }
 
 /// convolveRowScalar at n = 2 (x0 even), outputs 2m and 2m + 1 at a time: both take voxel
 /// m - k through taps 2k and 2k + 1, which are the stamp's interleaved weights w[8k, 8k + 8).
+/// `Pairs` > 0: taps = 2 Pairs, the weights held in registers; 0: any even `taps`.
+template <int Pairs>
 inline void convolvePairsLanes(float* out, const float* vals, const float* w, int taps, int x0,
                                int x1) {
-    for (int x = x0; x <= x1; x += 2) {
-        __m256 acc = _mm256_loadu_ps(out + 4 * x);
-        const int m = x / 2;
-        for (int k = taps / 2 - 1; k >= 0; --k) {
-            const __m256 v =
-                _mm256_broadcast_ps(reinterpret_cast<const __m128*>(vals + 4 * (m - k)));
-            acc = _mm256_fmadd_ps(_mm256_loadu_ps(w + 8 * k), v, acc);
+    auto voxel = [&](int u) {
+        return _mm256_broadcast_ps(reinterpret_cast<const __m128*>(vals + 4 * u));
+    };
+    if constexpr (Pairs > 0) {
+        __m256 wk[Pairs];
+        for (int k = 0; k < Pairs; ++k) wk[k] = _mm256_loadu_ps(w + 8 * k);
+        for (int x = x0; x <= x1; x += 2) {
+            __m256 acc = _mm256_loadu_ps(out + 4 * x);
+            const int m = x / 2;
+            for (int k = Pairs - 1; k >= 0; --k) acc = _mm256_fmadd_ps(wk[k], voxel(m - k), acc);
+            _mm256_storeu_ps(out + 4 * x, acc);
         }
-        _mm256_storeu_ps(out + 4 * x, acc);
+    } else {
+        for (int x = x0; x <= x1; x += 2) {
+            __m256 acc = _mm256_loadu_ps(out + 4 * x);
+            const int m = x / 2;
+            for (int k = taps / 2 - 1; k >= 0; --k)
+                acc = _mm256_fmadd_ps(_mm256_loadu_ps(w + 8 * k), voxel(m - k), acc);
+            _mm256_storeu_ps(out + 4 * x, acc);
+        }
     }
+}
+
+/// The convolution of one stamp row (n = 1 or 2) by a kernel specialised to its tap count.
+using ConvolveLanes = void (*)(float*, const float*, const float*, int, int, int);
+
+ConvolveLanes convolveLanes(int n, int taps) {
+    static constexpr ConvolveLanes row[] = {
+        convolveRowLanes<0>,  convolveRowLanes<1>,  convolveRowLanes<2>,  convolveRowLanes<3>,
+        convolveRowLanes<4>,  convolveRowLanes<5>,  convolveRowLanes<6>,  convolveRowLanes<7>,
+        convolveRowLanes<8>,  convolveRowLanes<9>,  convolveRowLanes<10>, convolveRowLanes<11>,
+        convolveRowLanes<12>};
+    static constexpr ConvolveLanes pairs[] = {
+        convolvePairsLanes<0>, convolvePairsLanes<1>, convolvePairsLanes<2>,
+        convolvePairsLanes<3>, convolvePairsLanes<4>, convolvePairsLanes<5>,
+        convolvePairsLanes<6>, convolvePairsLanes<7>, convolvePairsLanes<8>};
+    if (n == 1) return taps < 13 ? row[taps] : row[0];
+    return taps / 2 < 9 ? pairs[taps / 2] : pairs[0];
 }
 FOOTPRINT_LANES_END
 #endif
@@ -464,10 +507,7 @@ void convolveRun(RowRun& run, const SheetStamp& st, int n, int row, int ys, int 
         const int x0 = n * run.uLo, x1 = n * run.uHi + taps - 1;
 #if defined(FOOTPRINT_HAVE_LANES)
         if (footprint::cpuHasLanes()) {
-            if (n == 1)
-                convolveRowLanes(out, vals, w, taps, x0, x1);
-            else
-                convolvePairsLanes(out, vals, w, taps, x0, x1);
+            convolveLanes(n, taps)(out, vals, w, taps, x0, x1);
             continue;
         }
 #endif
