@@ -17,6 +17,8 @@ FOOTPRINT_LANES_BEGIN
 /// sampleFromOpticalDepth). |tau| < 1/2: k from its Taylor series to tau^8 (relative error
 /// < 3e-9, and no cancellation), alpha = k tau; otherwise exp(-tau) by range reduction to
 /// |r| <= ln2 / 2 and a degree-7 Taylor polynomial (relative error < 3e-9), k = alpha / tau.
+/// Eight lanes all below 1/2 (most samples of thin sheets) return before the exponential and
+/// its division, with the lanes the blend would have kept.
 inline void opacityLanes(__m256 tau, __m256& alpha, __m256& k) {
     const __m256 one = _mm256_set1_ps(1.0f);
     // Series: k = sum_n (-tau)^n / (n + 1)!, Horner from the highest term.
@@ -25,6 +27,13 @@ inline void opacityLanes(__m256 tau, __m256& alpha, __m256& k) {
     for (float c : {1.0f / 40320.0f, 1.0f / 5040.0f, 1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f,
                     1.0f / 6.0f, 0.5f, 1.0f})
         ks = _mm256_fmadd_ps(ks, t, _mm256_set1_ps(c));
+    const __m256 big = _mm256_cmp_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), tau),
+                                     _mm256_set1_ps(0.5f), _CMP_GE_OQ);
+    if (_mm256_testz_ps(big, big)) {  // every lane on the series: no exponential to blend in
+        alpha = _mm256_mul_ps(ks, tau);
+        k = ks;
+        return;
+    }
     // exp(x), x = -tau clamped to where float exp is finite and normal.
     const __m256 x = _mm256_min_ps(_mm256_max_ps(t, _mm256_set1_ps(-87.0f)), _mm256_set1_ps(87.0f));
     const __m256 n = _mm256_round_ps(_mm256_mul_ps(x, _mm256_set1_ps(1.44269504088896341f)),
@@ -37,8 +46,6 @@ inline void opacityLanes(__m256 tau, __m256& alpha, __m256& k) {
     const __m256i e =
         _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
     const __m256 ex = _mm256_mul_ps(p, _mm256_castsi256_ps(e));
-    const __m256 big = _mm256_cmp_ps(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), tau),
-                                     _mm256_set1_ps(0.5f), _CMP_GE_OQ);
     const __m256 alphaBig = _mm256_sub_ps(one, ex);
     alpha = _mm256_blendv_ps(_mm256_mul_ps(ks, tau), alphaBig, big);
     // Division only where it is taken (|tau| >= 1/2 there).
