@@ -52,34 +52,65 @@ inline void opacityLanes(__m256 tau, __m256& alpha, __m256& k) {
     k = _mm256_blendv_ps(ks, _mm256_div_ps(alphaBig, _mm256_blendv_ps(one, tau, big)), big);
 }
 
+/// Composites eight samples (optical depth tau, emission er, eg, eb) into the pixels at R, G,
+/// B, A of the lanes in `mask`.
+inline void compositeLanes(float* R, float* G, float* B, float* A, bool frontToBack, __m256i mask,
+                           __m256 tau, __m256 er, __m256 eg, __m256 eb) {
+    const __m256 one = _mm256_set1_ps(1.0f);
+    __m256 alpha, k;
+    opacityLanes(tau, alpha, k);
+    const __m256 cr = _mm256_mul_ps(k, er), cg = _mm256_mul_ps(k, eg), cb = _mm256_mul_ps(k, eb);
+    const __m256 a = _mm256_maskload_ps(A, mask);
+    const __m256 r = _mm256_maskload_ps(R, mask), g = _mm256_maskload_ps(G, mask),
+                 b = _mm256_maskload_ps(B, mask);
+    if (frontToBack) {
+        const __m256 t = _mm256_sub_ps(one, a);
+        _mm256_maskstore_ps(R, mask, _mm256_fmadd_ps(t, cr, r));
+        _mm256_maskstore_ps(G, mask, _mm256_fmadd_ps(t, cg, g));
+        _mm256_maskstore_ps(B, mask, _mm256_fmadd_ps(t, cb, b));
+        _mm256_maskstore_ps(A, mask, _mm256_fmadd_ps(t, alpha, a));
+    } else {
+        const __m256 t = _mm256_sub_ps(one, alpha);
+        _mm256_maskstore_ps(R, mask, _mm256_fmadd_ps(t, r, cr));
+        _mm256_maskstore_ps(G, mask, _mm256_fmadd_ps(t, g, cg));
+        _mm256_maskstore_ps(B, mask, _mm256_fmadd_ps(t, b, cb));
+        _mm256_maskstore_ps(A, mask, _mm256_fmadd_ps(t, a, alpha));
+    }
+}
+
 void compositeOpticalDepthsLanes(float* R, float* G, float* B, float* A, bool frontToBack, int n,
                                  const float* tau, const float* er, const float* eg,
                                  const float* eb) {
-    const __m256 one = _mm256_set1_ps(1.0f);
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     for (int i = 0; i < n; i += 8) {
         const __m256i mask = _mm256_cmpgt_epi32(_mm256_set1_epi32(n - i), lane);
-        __m256 alpha, k;
-        opacityLanes(_mm256_maskload_ps(tau + i, mask), alpha, k);
-        const __m256 cr = _mm256_mul_ps(k, _mm256_maskload_ps(er + i, mask));
-        const __m256 cg = _mm256_mul_ps(k, _mm256_maskload_ps(eg + i, mask));
-        const __m256 cb = _mm256_mul_ps(k, _mm256_maskload_ps(eb + i, mask));
-        const __m256 a = _mm256_maskload_ps(A + i, mask);
-        const __m256 r = _mm256_maskload_ps(R + i, mask), g = _mm256_maskload_ps(G + i, mask),
-                     b = _mm256_maskload_ps(B + i, mask);
-        if (frontToBack) {
-            const __m256 t = _mm256_sub_ps(one, a);
-            _mm256_maskstore_ps(R + i, mask, _mm256_fmadd_ps(t, cr, r));
-            _mm256_maskstore_ps(G + i, mask, _mm256_fmadd_ps(t, cg, g));
-            _mm256_maskstore_ps(B + i, mask, _mm256_fmadd_ps(t, cb, b));
-            _mm256_maskstore_ps(A + i, mask, _mm256_fmadd_ps(t, alpha, a));
-        } else {
-            const __m256 t = _mm256_sub_ps(one, alpha);
-            _mm256_maskstore_ps(R + i, mask, _mm256_fmadd_ps(t, r, cr));
-            _mm256_maskstore_ps(G + i, mask, _mm256_fmadd_ps(t, g, cg));
-            _mm256_maskstore_ps(B + i, mask, _mm256_fmadd_ps(t, b, cb));
-            _mm256_maskstore_ps(A + i, mask, _mm256_fmadd_ps(t, a, alpha));
+        compositeLanes(R + i, G + i, B + i, A + i, frontToBack, mask,
+                       _mm256_maskload_ps(tau + i, mask), _mm256_maskload_ps(er + i, mask),
+                       _mm256_maskload_ps(eg + i, mask), _mm256_maskload_ps(eb + i, mask));
+    }
+}
+
+/// compositeOpticalDepthsLanes for samples interleaved (tau, er, eg, eb): eight samples are
+/// four loads of (sample i, sample i + 4) pairs, transposed in registers.
+void compositeInterleavedLanes(float* R, float* G, float* B, float* A, bool frontToBack, int n,
+                               const float* samples) {
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    alignas(32) float tail[32];
+    for (int i = 0; i < n; i += 8) {
+        const __m256i mask = _mm256_cmpgt_epi32(_mm256_set1_epi32(n - i), lane);
+        const float* s = samples + 4 * std::ptrdiff_t(i);
+        if (n - i < 8) {
+            std::fill(std::begin(tail), std::end(tail), 0.0f);
+            std::copy(s, s + 4 * (n - i), tail);
+            s = tail;
         }
+        auto pair = [&](int j) { return _mm256_loadu2_m128(s + 4 * (j + 4), s + 4 * j); };
+        const __m256 p0 = pair(0), p1 = pair(1), p2 = pair(2), p3 = pair(3);
+        const __m256 lo01 = _mm256_unpacklo_ps(p0, p1), hi01 = _mm256_unpackhi_ps(p0, p1);
+        const __m256 lo23 = _mm256_unpacklo_ps(p2, p3), hi23 = _mm256_unpackhi_ps(p2, p3);
+        compositeLanes(R + i, G + i, B + i, A + i, frontToBack, mask,
+                       _mm256_shuffle_ps(lo01, lo23, 0x44), _mm256_shuffle_ps(lo01, lo23, 0xee),
+                       _mm256_shuffle_ps(hi01, hi23, 0x44), _mm256_shuffle_ps(hi01, hi23, 0xee));
     }
 }
 FOOTPRINT_LANES_END
@@ -123,6 +154,24 @@ void compositeOpticalDepthRow(float* r, float* g, float* b, float* a, CompositeO
             b[i] = s.b + t * b[i];
             a[i] = s.alpha + t * a[i];
         }
+    }
+}
+
+void compositeInterleavedRow(float* r, float* g, float* b, float* a, CompositeOrder order, int n,
+                             const float* samples) {
+#if defined(FOOTPRINT_HAVE_LANES)
+    if (footprint::cpuHasLanes()) {
+        compositeInterleavedLanes(r, g, b, a, order == CompositeOrder::FrontToBack, n, samples);
+        return;
+    }
+#endif
+    float planes[4][64];
+    for (int done = 0; done < n; done += 64) {
+        const int m = std::min(64, n - done);
+        for (int x = 0; x < m; ++x)
+            for (int c = 0; c < 4; ++c) planes[c][x] = samples[4 * (done + x) + c];
+        compositeOpticalDepthRow(r + done, g + done, b + done, a + done, order, m, planes[0],
+                                 planes[1], planes[2], planes[3]);
     }
 }
 

@@ -315,19 +315,11 @@ inline void addStampRows(float* at, std::size_t rowFloats, const SheetStamp& st,
 }
 
 /// Composites the interleaved samples `s` of columns [c0, c0 + n) into `out` (the window
-/// row starting at `out0`), through planes of up to 256 samples.
+/// row starting at `out0`).
 void compositeRun(const float* s, int c0, int n, std::size_t out0, CompositeOrder order,
                   Composited& out) {
-    float planes[4][256];
-    for (int done = 0; done < n; done += 256) {
-        const int m = std::min(256, n - done);
-        const float* from = s + 4 * std::ptrdiff_t(done);
-        for (int x = 0; x < m; ++x)
-            for (int c = 0; c < 4; ++c) planes[c][x] = from[4 * x + c];
-        const std::size_t o = out0 + std::size_t(c0 + done);
-        compositeOpticalDepthRow(&out.r[o], &out.g[o], &out.b[o], &out.a[o], order, m, planes[0],
-                                 planes[1], planes[2], planes[3]);
-    }
+    const std::size_t o = out0 + std::size_t(c0);
+    compositeInterleavedRow(&out.r[o], &out.g[o], &out.b[o], &out.a[o], order, n, s);
 }
 
 /// True when one of the n floats at p has a bit set (is not +0): a loop without an early
