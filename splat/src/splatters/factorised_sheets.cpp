@@ -361,6 +361,7 @@ struct BandBuffer {
     float threshold;
     std::vector<std::uint8_t> opaque;
     std::vector<int> nextOpen;  ///< per block, the first block at or after it that is not opaque
+    std::vector<int> nextClosed;  ///< per block, the first opaque block at or after it
     int opaqueCount = 0;
     std::size_t weights = 0, hidden = 0;
     float* at(int y, int x) {
@@ -371,6 +372,8 @@ struct BandBuffer {
     int firstOpen(int c0) const {
         return std::max(c0, nextOpen[std::size_t(c0 / kBlock)] * kBlock);
     }
+    /// The last column of the open stretch that holds column c (c in an open block).
+    int openUntil(int c) const { return nextClosed[std::size_t(c / kBlock)] * kBlock - 1; }
 };
 
 /// The written rectangle of a band's sheet buffer: columns [x0, x1], band rows [y0, y1].
@@ -386,6 +389,7 @@ struct RowRun {
     std::vector<float>& vals;
     int pad;
     int uLo = 0, uHi = -1;
+    int first = 0, last = 0;  ///< the first and last voxel drawn in the row (addRowRuns)
     void put(int u, const glm::vec4& value) {
         if (uHi < uLo) uLo = u;
         uHi = u;
@@ -510,6 +514,66 @@ void convolveRun(RowRun& run, const SheetStamp& st, int n, int row, int ys, int 
     run.uHi = run.uLo - 1;
 }
 
+/// Where a sheet row's stamps go in a band: stamp row 0 at band row `row`, stamp rows
+/// [ys, ye) inside the band, column 0 of voxel u's stamp at col0 + n u.
+struct RowPlace {
+    int row, ys, ye, col0;
+};
+
+inline int floorDiv(int x, int y) { return x >= 0 ? x / y : -((-x + y - 1) / y); }
+
+/// One or two samples per voxel: adds the visible splats of list positions [p, pEnd) (one
+/// sheet row) as runs (convolveRun) and returns how many; run.first, run.last: the first and
+/// last drawn voxel. Front to back with early termination, a splat is hidden when the stamp's
+/// box (not only its support) is over opaque blocks: testing the support alone culls a few
+/// per cent more at no measurable saving and composites less into nearly opaque edges (ch2 at
+/// 512², early termination 1/32: RMSE 2.6e-3 against 2.4e-3 at azimuth 120°). The splats are
+/// taken by stretches of open blocks: every splat whose box ends in or past a stretch's first
+/// column and starts in it is visible, without a test of its own; hidden ones are skipped by
+/// bisection (a row is sorted by u).
+template <class Rows>
+std::size_t addRowRuns(const Factorisation& f, const Rows& list, std::size_t p, std::size_t pEnd,
+                       const SheetStamp& st, RowPlace at, RowRun& run, BandBuffer& band) {
+    const int n = f.n, box = f.stampW - 1;
+    // Columns of the splats inside the window: hi = col + xMax >= 0, lo = col + xMin < width.
+    const int colLo = -st.xMax, colHi = f.width - 1 - st.xMin;
+    std::size_t drawn = 0;
+    while (p < pEnd) {
+        int col = n * list.u(p) + at.col0;
+        int end = colHi;  // the last column of the visible stretch
+        if (col < colLo) {
+            p = list.seek(p + 1, pEnd, floorDiv(colLo - at.col0 + n - 1, n));
+            continue;
+        }
+        if (col > colHi) break;
+        if (band.terminates) {
+            const int open = band.firstOpen(std::max(col, 0));
+            if (open > std::min(col + box, f.width - 1)) {
+                // On to the first splat whose box reaches the open block.
+                const std::size_t next =
+                    list.seek(p + 1, pEnd, floorDiv(open - box - at.col0 + n - 1, n));
+                band.hidden += next - p;
+                p = next;
+                continue;
+            }
+            end = std::min(end, band.openUntil(open));
+        }
+        if (drawn == 0) run.first = list.u(p);
+        for (; p < pEnd; ++p) {
+            const int u = list.u(p);
+            col = n * u + at.col0;
+            if (col > end) break;
+            if (run.uHi >= run.uLo && u > run.uHi + f.stampW)
+                convolveRun(run, st, n, at.row, at.ys, at.ye, at.col0, band);
+            run.put(u, list.value(p));
+            run.last = u;
+            ++drawn;
+        }
+    }
+    if (run.uHi >= run.uLo) convolveRun(run, st, n, at.row, at.ys, at.ye, at.col0, band);
+    return drawn;
+}
+
 /// Adds the stamps of sheet q's splats that meet the band into its buffer. Front to back with
 /// early termination, a splat is skipped when the blocks under its stamp's box (stampW
 /// columns, wider than the footprint's support) are all opaque: testing the support alone
@@ -521,7 +585,6 @@ template <class Rows>
 Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetStamp& st,
                  BandBuffer& band) {
     const int n = f.n;
-    auto floorDiv = [](int x, int y) { return x >= 0 ? x / y : -((-x + y - 1) / y); };
     // Voxel rows whose stamp rows n v + st.b + dB - b0 + [yMin, yMax] meet the band.
     const int top = st.b + f.dB - f.b0;
     const int vLo = std::max(0, -floorDiv(top + st.yMax - band.row0, n));
@@ -535,33 +598,33 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
         const int ys = std::max(st.yMin, -row), ye = std::min(st.yMax + 1, band.rows - row);
         std::size_t drawn = 0;
         int first = std::numeric_limits<int>::max(), last = -1;  // columns of the drawn
-        for (std::size_t p = pFirst; p < pEnd; ++p) {
-            const int u = list.u(p), col = n * u + col0;
-            const int lo = col + st.xMin, hi = col + st.xMax;
-            if (hi < 0 || lo >= f.width) continue;
-            if (band.terminates) {
-                // Hidden when the stamp's box (not only its support) is over opaque blocks.
-                const int open = band.firstOpen(std::max(col, 0));
-                if (open > std::min(col + f.stampW - 1, f.width - 1)) {
-                    // On to the first splat whose box reaches the open block.
-                    const std::size_t next =
-                        list.seek(p + 1, pEnd, floorDiv(open - (f.stampW - 1) - col0 + n - 1, n));
-                    band.hidden += next - p;
-                    p = next - 1;
-                    continue;
-                }
+        if (n <= 2) {
+            drawn = addRowRuns(f, list, pFirst, pEnd, st, RowPlace{row, ys, ye, col0}, run, band);
+            if (drawn) {
+                first = n * run.first + col0 + st.xMin;
+                last = n * run.last + col0 + st.xMax;
             }
-            if (n <= 2) {
-                if (run.uHi >= run.uLo && u > run.uHi + f.stampW)
-                    convolveRun(run, st, n, row, ys, ye, col0, band);
-                run.put(u, list.value(p));
-            } else {
+        } else {
+            for (std::size_t p = pFirst; p < pEnd; ++p) {
+                const int u = list.u(p), col = n * u + col0;
+                const int lo = col + st.xMin, hi = col + st.xMax;
+                if (hi < 0 || lo >= f.width) continue;
+                if (band.terminates) {
+                    const int open = band.firstOpen(std::max(col, 0));
+                    if (open > std::min(col + f.stampW - 1, f.width - 1)) {
+                        const std::size_t next = list.seek(
+                            p + 1, pEnd, floorDiv(open - (f.stampW - 1) - col0 + n - 1, n));
+                        band.hidden += next - p;
+                        p = next - 1;
+                        continue;
+                    }
+                }
                 addStampRows(band.at(row + ys, col), 4 * std::size_t(band.stride), st, ys, ye,
                              list.value(p));
+                ++drawn;
+                first = std::min(first, lo);
+                last = hi;
             }
-            ++drawn;
-            first = std::min(first, lo);
-            last = hi;
         }
         if (drawn == 0) continue;
         band.weights +=
@@ -570,7 +633,6 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
         w.x1 = std::max(w.x1, last);
         w.y0 = std::min(w.y0, row + ys);
         w.y1 = std::max(w.y1, row + ye - 1);
-        if (run.uHi >= run.uLo) convolveRun(run, st, n, row, ys, ye, col0, band);
     }
     return w;
 }
@@ -596,9 +658,11 @@ void markOpaqueBlocks(const Factorisation& f, const Composited& out, int c0, int
         }
     }
     if (!marked) return;
-    for (int b = int(band.opaque.size()) - 1; b >= 0; --b)
-        band.nextOpen[std::size_t(b)] =
-            band.opaque[std::size_t(b)] ? band.nextOpen[std::size_t(b) + 1] : b;
+    for (int b = int(band.opaque.size()) - 1; b >= 0; --b) {
+        const std::size_t k = std::size_t(b);
+        band.nextOpen[k] = band.opaque[k] ? band.nextOpen[k + 1] : b;
+        band.nextClosed[k] = band.opaque[k] ? b : band.nextClosed[k + 1];
+    }
 }
 
 /// One band of the window, rows [row0, row0 + rows): every sheet in visiting order, its
@@ -624,6 +688,7 @@ std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Row
     band.opaque.assign(std::size_t(blocks), 0);
     band.nextOpen.resize(std::size_t(blocks) + 1);
     for (int b = 0; b <= blocks; ++b) band.nextOpen[std::size_t(b)] = b;
+    band.nextClosed.assign(std::size_t(blocks) + 1, blocks);
     for (int k = 0; k < sheets && !(band.terminates && band.opaqueCount == blocks); ++k) {
         const int q = f.ascending ? k : sheets - 1 - k;
         const Written w = addSheet(f, list, q, stamps[std::size_t(q)], band);
