@@ -53,28 +53,38 @@ inline void opacityLanes(__m256 tau, __m256& alpha, __m256& k) {
 }
 
 /// Composites eight samples (optical depth tau, emission er, eg, eb) into the pixels at R, G,
-/// B, A of the lanes in `mask`.
+/// B, A of the lanes in `mask` (Full: all eight, by plain loads and stores: masked stores cost
+/// several times a plain one on some processors, AMD's among them).
+template <bool Full>
 inline void compositeLanes(float* R, float* G, float* B, float* A, bool frontToBack, __m256i mask,
                            __m256 tau, __m256 er, __m256 eg, __m256 eb) {
     const __m256 one = _mm256_set1_ps(1.0f);
     __m256 alpha, k;
     opacityLanes(tau, alpha, k);
     const __m256 cr = _mm256_mul_ps(k, er), cg = _mm256_mul_ps(k, eg), cb = _mm256_mul_ps(k, eb);
-    const __m256 a = _mm256_maskload_ps(A, mask);
-    const __m256 r = _mm256_maskload_ps(R, mask), g = _mm256_maskload_ps(G, mask),
-                 b = _mm256_maskload_ps(B, mask);
+    auto load = [&](const float* p) {
+        if constexpr (Full) return _mm256_loadu_ps(p);
+        return _mm256_maskload_ps(p, mask);
+    };
+    auto store = [&](float* p, __m256 x) {
+        if constexpr (Full)
+            _mm256_storeu_ps(p, x);
+        else
+            _mm256_maskstore_ps(p, mask, x);
+    };
+    const __m256 a = load(A), r = load(R), g = load(G), b = load(B);
     if (frontToBack) {
         const __m256 t = _mm256_sub_ps(one, a);
-        _mm256_maskstore_ps(R, mask, _mm256_fmadd_ps(t, cr, r));
-        _mm256_maskstore_ps(G, mask, _mm256_fmadd_ps(t, cg, g));
-        _mm256_maskstore_ps(B, mask, _mm256_fmadd_ps(t, cb, b));
-        _mm256_maskstore_ps(A, mask, _mm256_fmadd_ps(t, alpha, a));
+        store(R, _mm256_fmadd_ps(t, cr, r));
+        store(G, _mm256_fmadd_ps(t, cg, g));
+        store(B, _mm256_fmadd_ps(t, cb, b));
+        store(A, _mm256_fmadd_ps(t, alpha, a));
     } else {
         const __m256 t = _mm256_sub_ps(one, alpha);
-        _mm256_maskstore_ps(R, mask, _mm256_fmadd_ps(t, r, cr));
-        _mm256_maskstore_ps(G, mask, _mm256_fmadd_ps(t, g, cg));
-        _mm256_maskstore_ps(B, mask, _mm256_fmadd_ps(t, b, cb));
-        _mm256_maskstore_ps(A, mask, _mm256_fmadd_ps(t, a, alpha));
+        store(R, _mm256_fmadd_ps(t, r, cr));
+        store(G, _mm256_fmadd_ps(t, g, cg));
+        store(B, _mm256_fmadd_ps(t, b, cb));
+        store(A, _mm256_fmadd_ps(t, a, alpha));
     }
 }
 
@@ -84,9 +94,16 @@ void compositeOpticalDepthsLanes(float* R, float* G, float* B, float* A, bool fr
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     for (int i = 0; i < n; i += 8) {
         const __m256i mask = _mm256_cmpgt_epi32(_mm256_set1_epi32(n - i), lane);
-        compositeLanes(R + i, G + i, B + i, A + i, frontToBack, mask,
-                       _mm256_maskload_ps(tau + i, mask), _mm256_maskload_ps(er + i, mask),
-                       _mm256_maskload_ps(eg + i, mask), _mm256_maskload_ps(eb + i, mask));
+        if (n - i >= 8)
+            compositeLanes<true>(R + i, G + i, B + i, A + i, frontToBack, mask,
+                                 _mm256_loadu_ps(tau + i), _mm256_loadu_ps(er + i),
+                                 _mm256_loadu_ps(eg + i), _mm256_loadu_ps(eb + i));
+        else
+            compositeLanes<false>(R + i, G + i, B + i, A + i, frontToBack, mask,
+                                  _mm256_maskload_ps(tau + i, mask),
+                                  _mm256_maskload_ps(er + i, mask),
+                                  _mm256_maskload_ps(eg + i, mask),
+                                  _mm256_maskload_ps(eb + i, mask));
     }
 }
 
@@ -108,9 +125,14 @@ void compositeInterleavedLanes(float* R, float* G, float* B, float* A, bool fron
         const __m256 p0 = pair(0), p1 = pair(1), p2 = pair(2), p3 = pair(3);
         const __m256 lo01 = _mm256_unpacklo_ps(p0, p1), hi01 = _mm256_unpackhi_ps(p0, p1);
         const __m256 lo23 = _mm256_unpacklo_ps(p2, p3), hi23 = _mm256_unpackhi_ps(p2, p3);
-        compositeLanes(R + i, G + i, B + i, A + i, frontToBack, mask,
-                       _mm256_shuffle_ps(lo01, lo23, 0x44), _mm256_shuffle_ps(lo01, lo23, 0xee),
-                       _mm256_shuffle_ps(hi01, hi23, 0x44), _mm256_shuffle_ps(hi01, hi23, 0xee));
+        const __m256 tau = _mm256_shuffle_ps(lo01, lo23, 0x44),
+                     er = _mm256_shuffle_ps(lo01, lo23, 0xee),
+                     eg = _mm256_shuffle_ps(hi01, hi23, 0x44),
+                     eb = _mm256_shuffle_ps(hi01, hi23, 0xee);
+        if (n - i >= 8)
+            compositeLanes<true>(R + i, G + i, B + i, A + i, frontToBack, mask, tau, er, eg, eb);
+        else
+            compositeLanes<false>(R + i, G + i, B + i, A + i, frontToBack, mask, tau, er, eg, eb);
     }
 }
 FOOTPRINT_LANES_END
