@@ -107,32 +107,40 @@ void compositeOpticalDepthsLanes(float* R, float* G, float* B, float* A, bool fr
     }
 }
 
-/// compositeOpticalDepthsLanes for samples interleaved (tau, er, eg, eb): eight samples are
-/// four loads of (sample i, sample i + 4) pairs, transposed in registers.
+/// compositeOpticalDepthsLanes for samples interleaved (tau, er, eg, eb), which it sets to
+/// zero: eight samples are four loads of (sample i, sample i + 4) pairs, transposed in
+/// registers; eight samples all +0 (no change to the pixels) are passed over.
 void compositeInterleavedLanes(float* R, float* G, float* B, float* A, bool frontToBack, int n,
-                               const float* samples) {
+                               float* samples) {
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     alignas(32) float tail[32];
     for (int i = 0; i < n; i += 8) {
         const __m256i mask = _mm256_cmpgt_epi32(_mm256_set1_epi32(n - i), lane);
-        const float* s = samples + 4 * std::ptrdiff_t(i);
+        float* at = samples + 4 * std::ptrdiff_t(i);
+        const float* s = at;
         if (n - i < 8) {
             std::fill(std::begin(tail), std::end(tail), 0.0f);
-            std::copy(s, s + 4 * (n - i), tail);
+            std::copy(at, at + 4 * (n - i), tail);
             s = tail;
         }
         auto pair = [&](int j) { return _mm256_loadu2_m128(s + 4 * (j + 4), s + 4 * j); };
         const __m256 p0 = pair(0), p1 = pair(1), p2 = pair(2), p3 = pair(3);
+        const __m256i bits = _mm256_castps_si256(
+            _mm256_or_ps(_mm256_or_ps(p0, p1), _mm256_or_ps(p2, p3)));
+        if (_mm256_testz_si256(bits, bits)) continue;
         const __m256 lo01 = _mm256_unpacklo_ps(p0, p1), hi01 = _mm256_unpackhi_ps(p0, p1);
         const __m256 lo23 = _mm256_unpacklo_ps(p2, p3), hi23 = _mm256_unpackhi_ps(p2, p3);
         const __m256 tau = _mm256_shuffle_ps(lo01, lo23, 0x44),
                      er = _mm256_shuffle_ps(lo01, lo23, 0xee),
                      eg = _mm256_shuffle_ps(hi01, hi23, 0x44),
                      eb = _mm256_shuffle_ps(hi01, hi23, 0xee);
-        if (n - i >= 8)
+        if (n - i >= 8) {
             compositeLanes<true>(R + i, G + i, B + i, A + i, frontToBack, mask, tau, er, eg, eb);
-        else
+            for (int k = 0; k < 32; k += 8) _mm256_storeu_ps(at + k, _mm256_setzero_ps());
+        } else {
             compositeLanes<false>(R + i, G + i, B + i, A + i, frontToBack, mask, tau, er, eg, eb);
+            std::fill(at, at + 4 * (n - i), 0.0f);
+        }
     }
 }
 FOOTPRINT_LANES_END
@@ -179,8 +187,8 @@ void compositeOpticalDepthRow(float* r, float* g, float* b, float* a, CompositeO
     }
 }
 
-void compositeInterleavedRow(float* r, float* g, float* b, float* a, CompositeOrder order, int n,
-                             const float* samples) {
+void compositeInterleavedRowAndClear(float* r, float* g, float* b, float* a, CompositeOrder order,
+                                     int n, float* samples) {
 #if defined(FOOTPRINT_HAVE_LANES)
     if (footprint::cpuHasLanes()) {
         compositeInterleavedLanes(r, g, b, a, order == CompositeOrder::FrontToBack, n, samples);
@@ -195,6 +203,7 @@ void compositeInterleavedRow(float* r, float* g, float* b, float* a, CompositeOr
         compositeOpticalDepthRow(r + done, g + done, b + done, a + done, order, m, planes[0],
                                  planes[1], planes[2], planes[3]);
     }
+    std::fill(samples, samples + 4 * std::ptrdiff_t(n), 0.0f);
 }
 
 TileAccumulator::TileAccumulator(int width, int height, CompositeOrder order,

@@ -36,9 +36,10 @@ void compositeOpticalDepthRow(float* r, float* g, float* b, float* a, CompositeO
                               const float* tau, const float* er, const float* eg,
                               const float* eb);
 
-/// compositeOpticalDepthRow for samples interleaved in one array, (tau, er, eg, eb) per pixel.
-void compositeInterleavedRow(float* r, float* g, float* b, float* a, CompositeOrder order, int n,
-                             const float* samples);
+/// compositeOpticalDepthRow for samples interleaved in one array, (tau, er, eg, eb) per pixel,
+/// which it then sets to zero (a sheet buffer ready for the next sheet).
+void compositeInterleavedRowAndClear(float* r, float* g, float* b, float* a, CompositeOrder order,
+                                     int n, float* samples);
 
 /// Compositing state of one tile: premultiplied colour and opacity (b in docs/design.md) for
 /// dvr; for mip the running maximum and for xray the running sum, both in r.

@@ -5,7 +5,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -314,40 +313,24 @@ inline void addStampRows(float* at, std::size_t rowFloats, const SheetStamp& st,
     addStampRowsScalar(at, rowFloats, st, y0, y1, value);
 }
 
-/// Composites the interleaved samples `s` of columns [c0, c0 + n) into `out` (the window
-/// row starting at `out0`).
-void compositeRun(const float* s, int c0, int n, std::size_t out0, CompositeOrder order,
-                  Composited& out) {
-    const std::size_t o = out0 + std::size_t(c0);
-    compositeInterleavedRow(&out.r[o], &out.g[o], &out.b[o], &out.a[o], order, n, s);
-}
-
-/// True when one of the n floats at p has a bit set (is not +0): a loop without an early
-/// exit, which the compiler vectorises.
-inline bool anyBitSet(const float* p, int n) {
-    std::uint32_t bits = 0;
-    for (int k = 0; k < n; ++k) bits |= std::bit_cast<std::uint32_t>(p[k]);
-    return bits != 0;
-}
-
 /// A row of a band's sheet buffer, interleaved (tau, E_r, E_g, E_b) per sample, `row` at
 /// window column 0: composites columns [c0, c1] into `out` (the window row starting at
-/// `out0`), then clears columns [x0, x1]. Skips the kBlock-column blocks marked in `opaque`
-/// (null: none; early termination) and those whose samples are all zero (no change).
+/// `out0`; eight samples that are all zero make no change and are passed over), then clears
+/// columns [x0, x1], in the same pass for the composited ones.
 void compositeAndClear(float* row, int x0, int x1, int c0, int c1, std::size_t out0,
-                       const std::uint8_t* opaque, CompositeOrder order, Composited& out) {
-    int run = c0;  // the pending run of active columns [run, lo)
-    for (int b = c0 / kBlock; c1 >= c0 && b <= c1 / kBlock; ++b) {
-        const int lo = std::max(c0, b * kBlock), hi = std::min(c1 + 1, (b + 1) * kBlock);
-        bool active = !(opaque && opaque[b]);
-        if (active) active = anyBitSet(row + 4 * std::ptrdiff_t(lo), 4 * (hi - lo));
-        if (active) continue;
-        if (lo > run) compositeRun(row + 4 * std::ptrdiff_t(run), run, lo - run, out0, order, out);
-        run = hi;
+                       CompositeOrder order, Composited& out) {
+    auto clear = [&](int from, int to) {  // columns [from, to)
+        if (to > from) std::fill(row + 4 * std::ptrdiff_t(from), row + 4 * std::ptrdiff_t(to), 0.0f);
+    };
+    if (c1 < c0) {
+        clear(x0, x1 + 1);
+        return;
     }
-    if (c1 + 1 > run)
-        compositeRun(row + 4 * std::ptrdiff_t(run), run, c1 + 1 - run, out0, order, out);
-    std::fill(row + 4 * std::ptrdiff_t(x0), row + 4 * std::ptrdiff_t(x1 + 1), 0.0f);
+    const std::size_t o = out0 + std::size_t(c0);
+    compositeInterleavedRowAndClear(&out.r[o], &out.g[o], &out.b[o], &out.a[o], order,
+                                    c1 - c0 + 1, row + 4 * std::ptrdiff_t(c0));
+    clear(x0, c0);
+    clear(c1 + 1, x1 + 1);
 }
 
 /// A band's state across sheets: the sheet buffer (interleaved tau, E_r, E_g, E_b per sample,
@@ -697,7 +680,7 @@ std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Row
         const int c0 = std::max(w.x0, 0), c1 = std::min(w.x1, f.width - 1);
         for (int y = w.y0; y <= w.y1; ++y)
             compositeAndClear(band.at(y, 0), w.x0, w.x1, c0, c1, std::size_t(row0 + y) * f.width,
-                              nullptr, order, out);
+                              order, out);
         if (band.terminates && c1 >= c0) markOpaqueBlocks(f, out, c0, c1, band);
     }
     return {band.weights, band.hidden};
