@@ -5,6 +5,7 @@
 #include <tbb/task_scheduler_observer.h>
 
 #include <atomic>
+#include <bit>
 #include <cstring>
 #include <catch2/catch.hpp>
 #include <random>
@@ -260,6 +261,49 @@ TEST_CASE("compositing: a row of optical depths composites as sampleFromOpticalD
             CHECK(img.at(0, 1).a == 0.0f);
             if (1 + n < 16) CHECK(img.at(1 + n, 1).a == 0.0f);
             CHECK(img.at(1, 0).a == 0.0f);
+        }
+}
+
+TEST_CASE("compositing: interleaved samples composite as the planes do, bit for bit, and clear",
+          "[stages]") {
+    // compositeInterleavedRowAndClear (the factorised sheets' rows: (tau, er, eg, eb) per
+    // pixel) against compositeOpticalDepthRow on the same samples in planes: row lengths 1..21
+    // (whole groups of eight and tails), groups of zero samples among others (passed over),
+    // optical depths on both sides of the series/exp switch at 1/2.
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (CompositeOrder order : {CompositeOrder::FrontToBack, CompositeOrder::BackToFront})
+        for (int n = 1; n <= 21; ++n) {
+            std::vector<float> planes[4], rows[2][4];
+            for (auto& r : rows)
+                for (auto& c : r) c.assign(std::size_t(n), 0.0f);
+            for (int step = 0; step < 4; ++step) {
+                std::vector<float> samples(4 * std::size_t(n), 0.0f);
+                for (auto& c : planes) c.assign(std::size_t(n), 0.0f);
+                for (int i = 0; i < n; ++i) {
+                    if ((i / 8 + step) % 3 == 0) continue;  // a group (or part) of zeros
+                    const float tau = u(rng) * (step % 2 ? 3.0f : 0.4f);
+                    const float e[4] = {tau, u(rng) * tau, u(rng) * tau, u(rng) * tau};
+                    for (int c = 0; c < 4; ++c) {
+                        samples[4 * std::size_t(i) + std::size_t(c)] = e[c];
+                        planes[c][std::size_t(i)] = e[c];
+                    }
+                }
+                compositeOpticalDepthRow(rows[0][0].data(), rows[0][1].data(), rows[0][2].data(),
+                                         rows[0][3].data(), order, n, planes[0].data(),
+                                         planes[1].data(), planes[2].data(), planes[3].data());
+                compositeInterleavedRowAndClear(rows[1][0].data(), rows[1][1].data(),
+                                                rows[1][2].data(), rows[1][3].data(), order, n,
+                                                samples.data());
+                for (float x : samples) REQUIRE(std::bit_cast<std::uint32_t>(x) == 0u);
+            }
+            for (int c = 0; c < 4; ++c)
+                for (int i = 0; i < n; ++i) {
+                    INFO("n " << n << " channel " << c << " pixel " << i);
+                    REQUIRE(std::bit_cast<std::uint32_t>(rows[1][c][std::size_t(i)]) ==
+                            std::bit_cast<std::uint32_t>(rows[0][c][std::size_t(i)]));
+                }
+            CHECK(rows[0][3][0] > 0.0f);
         }
 }
 
