@@ -557,6 +557,19 @@ std::size_t addRowRuns(const Factorisation& f, const Rows& list, std::size_t p, 
     return drawn;
 }
 
+/// Asks the cache for rows [vLo, vHi] of sheet q (their u and palette entries, up to 4 KiB of
+/// each), which the band reads next: a band reads each sheet's rows as one short stretch of
+/// the list, which the processor's stream prefetch finds only after its first misses.
+template <class Rows>
+void prefetchRows(const Rows& list, int q, int vLo, int vHi) {
+    const std::size_t p0 = list.range(q, vLo).first, p1 = list.range(q, vHi).second;
+    const std::size_t end = std::min(p1, p0 + 2048);
+    for (std::size_t p = p0; p < end; p += 32) {
+        __builtin_prefetch(list.at + p);
+        if (list.entry) __builtin_prefetch(list.entry + p);
+    }
+}
+
 /// Adds the stamps of sheet q's splats that meet the band into its buffer. Front to back with
 /// early termination, a splat is skipped when the blocks under its stamp's box (stampW
 /// columns, wider than the footprint's support) are all opaque: testing the support alone
@@ -565,7 +578,7 @@ std::size_t addRowRuns(const Factorisation& f, const Rows& list, std::size_t p, 
 /// One or two samples per voxel add a row's runs of splats as convolutions (convolveRun), more
 /// samples add splat by splat (addStampRows).
 template <class Rows>
-Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetStamp& st,
+Written addSheet(const Factorisation& f, const Rows& list, int q, int next, const SheetStamp& st,
                  BandBuffer& band) {
     const int n = f.n;
     // Voxel rows whose stamp rows n v + st.b + dB - b0 + [yMin, yMax] meet the band.
@@ -573,6 +586,7 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetSta
     const int vLo = std::max(0, -floorDiv(top + st.yMax - band.row0, n));
     const int vHi = std::min(floorDiv(band.row0 + band.rows - 1 - top - st.yMin, n), list.rows - 1);
     const int col0 = st.a + f.dA - f.a0;  // stamp column 0 of u = 0
+    if (next >= 0 && vLo <= vHi) prefetchRows(list, next, vLo, vHi);
     RowRun run{band.vals, f.stampW + 2};
     Written w;
     for (int v = vLo; v <= vHi; ++v) {
@@ -674,7 +688,8 @@ std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Row
     band.nextClosed.assign(std::size_t(blocks) + 1, blocks);
     for (int k = 0; k < sheets && !(band.terminates && band.opaqueCount == blocks); ++k) {
         const int q = f.ascending ? k : sheets - 1 - k;
-        const Written w = addSheet(f, list, q, stamps[std::size_t(q)], band);
+        const int next = k + 1 < sheets ? (f.ascending ? q + 1 : q - 1) : -1;
+        const Written w = addSheet(f, list, q, next, stamps[std::size_t(q)], band);
         if (w.x1 < w.x0) continue;
         // Composite the written rectangle (its part inside the window), then clear it.
         const int c0 = std::max(w.x0, 0), c1 = std::min(w.x1, f.width - 1);
