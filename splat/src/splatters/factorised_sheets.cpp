@@ -709,9 +709,73 @@ inline void catmullRom(float t, float (&w)[4]) {
     w[3] = (t - 1.0f) * t * t * 0.5f;
 }
 
+/// A pixel's Catmull-Rom taps on the window: the 4 x 4 samples from `o` (its top-left) with
+/// weights wa (along a row) and wb (across rows).
+struct WarpTaps {
+    std::size_t o;
+    float wa[4], wb[4];
+};
+
+/// The taps of the pixel centre (x + 1/2, y + 1/2); false when they leave the window.
+bool warpTaps(const Factorisation& f, int x, int y, WarpTaps& t) {
+    const glm::dvec2 p = f.sheet({x + 0.5, y + 0.5});
+    const double ga = (p.x - f.U0) * f.n - f.a0, gb = (p.y - f.V0) * f.n - f.b0;
+    const double fa = std::floor(ga), fb = std::floor(gb);
+    if (!(fa >= 1 && fb >= 1 && fa + 2 < f.width && fb + 2 < f.height)) return false;
+    catmullRom(float(ga - fa), t.wa);
+    catmullRom(float(gb - fb), t.wb);
+    t.o = (std::size_t(fb) - 1) * std::size_t(f.width) + std::size_t(fa) - 1;
+    return true;
+}
+
+/// Opacity clamped to [0, 1] and colour to [0, opacity] (the spline's overshoot at opaque
+/// edges).
+inline glm::vec4 clampWarped(const glm::vec4& sum) {
+    const float a = std::clamp(sum.a, 0.0f, 1.0f);
+    return {std::clamp(sum.r, 0.0f, a), std::clamp(sum.g, 0.0f, a), std::clamp(sum.b, 0.0f, a), a};
+}
+
+/// The spline's sum at one pixel: rows of four taps, then the four rows, each a product then
+/// a sum (the order warpPairLanes keeps).
+glm::vec4 warpSum(const glm::vec4* rgba, std::size_t width, const WarpTaps& t) {
+    glm::vec4 sum(0.0f);
+    for (int j = 0; j < 4; ++j) {
+        const std::size_t r = t.o + std::size_t(j) * width;
+        glm::vec4 row(0.0f);
+        for (int i = 0; i < 4; ++i) row += t.wa[i] * rgba[r + std::size_t(i)];
+        sum += t.wb[j] * row;
+    }
+    return sum;
+}
+
+#if defined(FOOTPRINT_HAVE_LANES)
+/// warpSum of two pixels at once, one per half of eight lanes: each half takes warpSum's
+/// products and sums in its order, compiled for AVX without FMA (a fused multiply-add would
+/// round once where warpSum rounds twice), so the pixels are warpSum's bit for bit.
+__attribute__((target("avx"))) void warpPairLanes(const glm::vec4* rgba, std::size_t width,
+                                                  const WarpTaps& t0, const WarpTaps& t1,
+                                                  glm::vec4& s0, glm::vec4& s1) {
+    const float* base = reinterpret_cast<const float*>(rgba);
+    __m256 sum = _mm256_setzero_ps();
+    for (int j = 0; j < 4; ++j) {
+        const float* r0 = base + 4 * (t0.o + std::size_t(j) * width);
+        const float* r1 = base + 4 * (t1.o + std::size_t(j) * width);
+        __m256 row = _mm256_setzero_ps();
+        for (int i = 0; i < 4; ++i) {
+            const __m256 wa = _mm256_set_m128(_mm_set1_ps(t1.wa[i]), _mm_set1_ps(t0.wa[i]));
+            row = _mm256_add_ps(row, _mm256_mul_ps(wa, _mm256_loadu2_m128(r1 + 4 * i, r0 + 4 * i)));
+        }
+        const __m256 wb = _mm256_set_m128(_mm_set1_ps(t1.wb[j]), _mm_set1_ps(t0.wb[j]));
+        sum = _mm256_add_ps(sum, _mm256_mul_ps(wb, row));
+    }
+    _mm_storeu_ps(&s0.x, _mm256_castps256_ps128(sum));
+    _mm_storeu_ps(&s1.x, _mm256_extractf128_ps(sum, 1));
+}
+#endif
+
 /// The screen image: the composited window at each pixel centre, by the Catmull-Rom spline
-/// through its samples, opacity clamped to [0, 1] and colour to [0, opacity] (the spline's
-/// overshoot at opaque edges).
+/// through its samples (warpSum, two pixels at a time where the lanes are), clamped
+/// (clampWarped).
 Image warp(const Factorisation& f, const Composited& w, int width, int height) {
     // The window as one (r, g, b, a) per sample: a tap is one load.
     std::vector<glm::vec4> rgba(w.r.size());
@@ -721,28 +785,26 @@ Image warp(const Factorisation& f, const Composited& w, int width, int height) {
                               rgba[k] = glm::vec4(w.r[k], w.g[k], w.b[k], w.a[k]);
                       });
     Image image(width, height);
+    const std::size_t rowSamples = std::size_t(f.width);
+#if defined(FOOTPRINT_HAVE_LANES)
+    const bool lanes = footprint::cpuHasLanes();
+#else
+    const bool lanes = false;
+#endif
     tbb::parallel_for(0, height, [&](int y) {
+        WarpTaps t0, t1;
         for (int x = 0; x < width; ++x) {
-            const glm::dvec2 p = f.sheet({x + 0.5, y + 0.5});
-            const double ga = (p.x - f.U0) * f.n - f.a0, gb = (p.y - f.V0) * f.n - f.b0;
-            const double fa = std::floor(ga), fb = std::floor(gb);
-            if (!(fa >= 1 && fb >= 1 && fa + 2 < f.width && fb + 2 < f.height)) continue;
-            const float ta = float(ga - fa), tb = float(gb - fb);
-            float wa[4], wb[4];
-            catmullRom(ta, wa);
-            catmullRom(tb, wb);
-            const std::size_t o =
-                (std::size_t(fb) - 1) * std::size_t(f.width) + std::size_t(fa) - 1;
-            glm::vec4 sum(0.0f);
-            for (int j = 0; j < 4; ++j) {
-                const std::size_t r = o + std::size_t(j) * std::size_t(f.width);
-                glm::vec4 row(0.0f);
-                for (int i = 0; i < 4; ++i) row += wa[i] * rgba[r + i];
-                sum += wb[j] * row;
+            if (!warpTaps(f, x, y, t0)) continue;
+#if defined(FOOTPRINT_HAVE_LANES)
+            if (lanes && x + 1 < width && warpTaps(f, x + 1, y, t1)) {
+                glm::vec4 s0, s1;
+                warpPairLanes(rgba.data(), rowSamples, t0, t1, s0, s1);
+                image.at(x, y) = clampWarped(s0);
+                image.at(++x, y) = clampWarped(s1);
+                continue;
             }
-            const float a = std::clamp(sum.a, 0.0f, 1.0f);
-            image.at(x, y) = glm::vec4(std::clamp(sum.r, 0.0f, a), std::clamp(sum.g, 0.0f, a),
-                                       std::clamp(sum.b, 0.0f, a), a);
+#endif
+            image.at(x, y) = clampWarped(warpSum(rgba.data(), rowSamples, t0));
         }
     });
     return image;
