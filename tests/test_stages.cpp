@@ -6,8 +6,8 @@
 
 #include <atomic>
 #include <bit>
-#include <cstring>
 #include <catch2/catch.hpp>
+#include <cstring>
 #include <random>
 
 #include "footprint/lanes.h"

@@ -99,11 +99,10 @@ void compositeOpticalDepthsLanes(float* R, float* G, float* B, float* A, bool fr
                                  _mm256_loadu_ps(tau + i), _mm256_loadu_ps(er + i),
                                  _mm256_loadu_ps(eg + i), _mm256_loadu_ps(eb + i));
         else
-            compositeLanes<false>(R + i, G + i, B + i, A + i, frontToBack, mask,
-                                  _mm256_maskload_ps(tau + i, mask),
-                                  _mm256_maskload_ps(er + i, mask),
-                                  _mm256_maskload_ps(eg + i, mask),
-                                  _mm256_maskload_ps(eb + i, mask));
+            compositeLanes<false>(
+                R + i, G + i, B + i, A + i, frontToBack, mask, _mm256_maskload_ps(tau + i, mask),
+                _mm256_maskload_ps(er + i, mask), _mm256_maskload_ps(eg + i, mask),
+                _mm256_maskload_ps(eb + i, mask));
     }
 }
 
@@ -125,8 +124,8 @@ void compositeInterleavedLanes(float* R, float* G, float* B, float* A, bool fron
         }
         auto pair = [&](int j) { return _mm256_loadu2_m128(s + 4 * (j + 4), s + 4 * j); };
         const __m256 p0 = pair(0), p1 = pair(1), p2 = pair(2), p3 = pair(3);
-        const __m256i bits = _mm256_castps_si256(
-            _mm256_or_ps(_mm256_or_ps(p0, p1), _mm256_or_ps(p2, p3)));
+        const __m256i bits =
+            _mm256_castps_si256(_mm256_or_ps(_mm256_or_ps(p0, p1), _mm256_or_ps(p2, p3)));
         if (_mm256_testz_si256(bits, bits)) continue;
         const __m256 lo01 = _mm256_unpacklo_ps(p0, p1), hi01 = _mm256_unpackhi_ps(p0, p1);
         const __m256 lo23 = _mm256_unpacklo_ps(p2, p3), hi23 = _mm256_unpackhi_ps(p2, p3);

@@ -320,15 +320,16 @@ inline void addStampRows(float* at, std::size_t rowFloats, const SheetStamp& st,
 void compositeAndClear(float* row, int x0, int x1, int c0, int c1, std::size_t out0,
                        CompositeOrder order, Composited& out) {
     auto clear = [&](int from, int to) {  // columns [from, to)
-        if (to > from) std::fill(row + 4 * std::ptrdiff_t(from), row + 4 * std::ptrdiff_t(to), 0.0f);
+        if (to > from)
+            std::fill(row + 4 * std::ptrdiff_t(from), row + 4 * std::ptrdiff_t(to), 0.0f);
     };
     if (c1 < c0) {
         clear(x0, x1 + 1);
         return;
     }
     const std::size_t o = out0 + std::size_t(c0);
-    compositeInterleavedRowAndClear(&out.r[o], &out.g[o], &out.b[o], &out.a[o], order,
-                                    c1 - c0 + 1, row + 4 * std::ptrdiff_t(c0));
+    compositeInterleavedRowAndClear(&out.r[o], &out.g[o], &out.b[o], &out.a[o], order, c1 - c0 + 1,
+                                    row + 4 * std::ptrdiff_t(c0));
     clear(x0, c0);
     clear(c1 + 1, x1 + 1);
 }
@@ -418,8 +419,8 @@ inline void convolveRowLanes(float* out, const float* vals, const float* w, int 
         for (int x = x0; x <= x1; x += 2) {
             __m256 acc = _mm256_loadu_ps(out + 4 * x);
             for (int t = taps - 1; t >= 0; --t)
-                acc = _mm256_fmadd_ps(_mm256_set1_ps(w[4 * t]),
-                                      _mm256_loadu_ps(vals + 4 * (x - t)), acc);
+                acc = _mm256_fmadd_ps(_mm256_set1_ps(w[4 * t]), _mm256_loadu_ps(vals + 4 * (x - t)),
+                                      acc);
             _mm256_storeu_ps(out + 4 * x, acc);
         }
     }
@@ -459,9 +460,9 @@ using ConvolveLanes = void (*)(float*, const float*, const float*, int, int, int
 
 ConvolveLanes convolveLanes(int n, int taps) {
     static constexpr ConvolveLanes row[] = {
-        convolveRowLanes<0>,  convolveRowLanes<1>,  convolveRowLanes<2>,  convolveRowLanes<3>,
-        convolveRowLanes<4>,  convolveRowLanes<5>,  convolveRowLanes<6>,  convolveRowLanes<7>,
-        convolveRowLanes<8>,  convolveRowLanes<9>,  convolveRowLanes<10>, convolveRowLanes<11>,
+        convolveRowLanes<0>, convolveRowLanes<1>, convolveRowLanes<2>,  convolveRowLanes<3>,
+        convolveRowLanes<4>, convolveRowLanes<5>, convolveRowLanes<6>,  convolveRowLanes<7>,
+        convolveRowLanes<8>, convolveRowLanes<9>, convolveRowLanes<10>, convolveRowLanes<11>,
         convolveRowLanes<12>};
     static constexpr ConvolveLanes pairs[] = {
         convolvePairsLanes<0>, convolvePairsLanes<1>, convolvePairsLanes<2>,
