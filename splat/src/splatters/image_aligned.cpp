@@ -179,6 +179,66 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
 /// crossing more slabs take the general one.
 constexpr int kMaxFlat = 64;
 
+/// The Flat path's terms of one splat's boundaries (their depths are the same for every
+/// pixel): z, z^2, erf(z / (sigma sqrt 2)) and the cubic term, and the sign bit of N P
+/// beyond the chord on boundary b's side (-fp / 2 before the kernel's centre, +fp / 2
+/// behind it).
+struct FlatBoundaries {
+    alignas(32) float z[kMaxFlat + 8], zz[kMaxFlat + 8], e[kMaxFlat + 8], q[kMaxFlat + 8],
+        neg[kMaxFlat + 8];
+
+    /// The n + 1 boundaries tb (n < kMaxFlat), 8 at a time.
+    void compute(const float* tb, int n, float depthScale, const footprint::GaussianSlab& slab,
+                 const footprint::GaussianSlabLanes& section) {
+        for (int b = 0; b <= n; ++b) {
+            z[b] = depthScale * tb[b];
+            neg[b] = z[b] > 0.0f ? 0.0f : -0.0f;
+        }
+        for (int b = n + 1; b % 8; ++b) z[b] = 0.0f;
+        const __m256 vs = _mm256_set1_ps(slab.erfScale());
+        for (int b = 0; b <= n; b += 8) {
+            const __m256 vz = _mm256_load_ps(z + b), vzz = _mm256_mul_ps(vz, vz);
+            _mm256_store_ps(zz + b, vzz);
+            _mm256_store_ps(e + b, section.erf(_mm256_mul_ps(vz, vs)));
+            _mm256_store_ps(q + b, _mm256_mul_ps(section.cubic(), _mm256_mul_ps(vzz, vz)));
+        }
+    }
+
+    /// N P at boundary b for the lanes' radial part: inside the chord a erf(z) - b z + q,
+    /// beyond it `plus` (fp / 2) with the boundary's sign.
+    [[gnu::always_inline]] __m256 at(const footprint::GaussianSlabLanes::Radial& radial,
+                                     __m256 plus, int b) const {
+        const __m256 in = _mm256_cmp_ps(radial.l2, _mm256_broadcast_ss(zz + b), _CMP_GT_OQ);
+        const __m256 p = footprint::GaussianSlabLanes::inside(
+            radial, _mm256_broadcast_ss(z + b), _mm256_broadcast_ss(e + b),
+            _mm256_broadcast_ss(q + b));
+        const __m256 beyond = _mm256_xor_ps(plus, _mm256_broadcast_ss(neg + b));
+        return _mm256_blendv_ps(beyond, p, in);
+    }
+};
+
+/// The radial part of N P for 8 pixels at offsets (dx, dy) from the splat centre whose rays
+/// pass at r^2 = a (dx + beta dy)^2 + gamma dy^2 (shift = beta dy, gyy = gamma dy^2) and
+/// half the footprint: pl = fp / 2, 0 (and the chord 0) outside the kernel and where `keep`
+/// is clear.
+struct RadialLanes {
+    const footprint::FootprintLanes& footprintOf;
+    const footprint::GaussianSlabLanes& section;
+    __m256 a, r2Max;
+
+    [[gnu::always_inline]] footprint::GaussianSlabLanes::Radial operator()(
+        __m256 dx, __m256 shift, __m256 gyy, __m256 keep) const {
+        const __m256 q = _mm256_add_ps(dx, shift);
+        const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(a, q), q, gyy),
+                                        _mm256_setzero_ps());
+        const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, r2Max, _CMP_LT_OQ), keep);
+        footprint::GaussianSlabLanes::Radial radial = section.radial(
+            r2, _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), _mm256_set1_ps(0.5f))));
+        radial.l2 = _mm256_and_ps(inside, radial.l2);
+        return radial;
+    }
+};
+
 /// splatSectionsLanes with the kernel's closed form (footprint/gaussian_slab.h) instead of
 /// the table's fraction: per pixel the radial part of N P (exp, and half the footprint from
 /// the same table or polynomial as the axis-aligned splatter, so that the sections sum to
@@ -196,33 +256,16 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
     const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
     for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
     const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), vZero = _mm256_setzero_ps();
-    const __m256 vHalf = _mm256_set1_ps(0.5f);
-    const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
-    const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
+    const __m256 vScale = _mm256_set1_ps(e.scale);
     const footprint::FootprintLanes footprintOf(fpTable, poly);
     const footprint::GaussianSlabLanes section(slab);
+    const RadialLanes radialOf{footprintOf, section, _mm256_set1_ps(e.a),
+                               _mm256_set1_ps(fpTable.r2Max())};
     const __m256 vds = _mm256_set1_ps(e.depthScale), vtx = _mm256_set1_ps(e.tx);
     __m256 vv[NCh];
     for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
-    // Flat: per boundary z, z^2, erf(z / (sigma sqrt 2)) and the cubic term, 8 at a time.
-    // fneg: the sign bit of N P beyond the chord on boundary b's side (-fp / 2 before the
-    // kernel's centre, +fp / 2 behind it).
-    alignas(32) float fz[Flat ? kMaxFlat + 8 : 1], fzz[Flat ? kMaxFlat + 8 : 1],
-        fe[Flat ? kMaxFlat + 8 : 1], fq[Flat ? kMaxFlat + 8 : 1], fneg[Flat ? kMaxFlat + 8 : 1];
-    if constexpr (Flat) {
-        for (int b = 0; b <= n; ++b) {
-            fz[b] = e.depthScale * tb[b];
-            fneg[b] = fz[b] > 0.0f ? 0.0f : -0.0f;
-        }
-        for (int b = n + 1; b % 8; ++b) fz[b] = 0.0f;
-        const __m256 vs = _mm256_set1_ps(slab.erfScale());
-        for (int b = 0; b <= n; b += 8) {
-            const __m256 z = _mm256_load_ps(fz + b), zz = _mm256_mul_ps(z, z);
-            _mm256_store_ps(fzz + b, zz);
-            _mm256_store_ps(fe + b, section.erf(_mm256_mul_ps(z, vs)));
-            _mm256_store_ps(fq + b, _mm256_mul_ps(section.cubic(), _mm256_mul_ps(zz, z)));
-        }
-    }
+    FlatBoundaries flat;
+    if constexpr (Flat) flat.compute(tb, n, e.depthScale, slab, section);
     // As splatSectionsLanes: per row, the boundaries before the kernel's chord at the row's
     // smallest r^2 (N P = -fp / 2 front to back) and behind it (+fp / 2) are a prefix and
     // a suffix.
@@ -249,14 +292,9 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
         for (int x = x0; x <= x1; x += 8) {
             const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
             const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
-            const __m256 q = _mm256_add_ps(dx, vshift);
-            const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), vZero);
-            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
-                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
             // Outside the kernel (and beyond the rectangle) the chord and fp are 0: so is N P.
-            footprint::GaussianSlabLanes::Radial radial =
-                section.radial(r2, _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vHalf)));
-            radial.l2 = _mm256_and_ps(inside, radial.l2);
+            const footprint::GaussianSlabLanes::Radial radial =
+                radialOf(dx, vshift, vgyy, _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
             const __m256 plus = radial.pl, minus = _mm256_sub_ps(vZero, radial.pl);
             const __m256 vPre = ascending ? minus : plus, vSuf = ascending ? plus : minus;
             const __m256 tc = _mm256_fmadd_ps(vtx, dx, vtyy);
@@ -264,13 +302,7 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
                 if (b < pre) return vPre;
                 if (b >= suf) return vSuf;
                 if constexpr (Flat) {
-                    const __m256 in =
-                        _mm256_cmp_ps(radial.l2, _mm256_broadcast_ss(fzz + b), _CMP_GT_OQ);
-                    const __m256 p = footprint::GaussianSlabLanes::inside(
-                        radial, _mm256_broadcast_ss(fz + b), _mm256_broadcast_ss(fe + b),
-                        _mm256_broadcast_ss(fq + b));
-                    const __m256 beyond = _mm256_xor_ps(plus, _mm256_broadcast_ss(fneg + b));
-                    return _mm256_blendv_ps(beyond, p, in);
+                    return flat.at(radial, plus, b);
                 } else {
                     return section(radial,
                                    _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
