@@ -313,6 +313,117 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
 }
+/// addSections for two rows of at most 4 pixels in one vector: lanes 0-3 are added at
+/// at0 of each slab's row and, if `both`, lanes 4-7 at at0 of the row below.
+template <int NCh, class At>
+[[gnu::always_inline]] inline void addPairedSections(const SheetRows& rows, std::ptrdiff_t at0,
+                                                     bool both, int jBegin, int jEnd,
+                                                     __m256 scale, const __m256 (&vv)[NCh],
+                                                     At at) {
+    const __m256 signBit = _mm256_set1_ps(-0.0f);
+    __m256 below = at(jBegin);
+    for (int j = jBegin; j < jEnd; ++j) {
+        const __m256 above = at(j + 1);
+        const __m256 w = _mm256_mul_ps(scale, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
+        below = above;
+        float* const p = rows.origin[j] + at0;
+        for (int c = 0; c < NCh; ++c) {
+            float* const lo = p + c * rows.plane;
+            float* const hi = lo + rows.stride;
+            if (both) {
+                _mm256_storeu2_m128(hi, lo, _mm256_fmadd_ps(vv[c], w, _mm256_loadu2_m128(hi, lo)));
+            } else {
+                const __m128 sum = _mm_fmadd_ps(_mm256_castps256_ps128(vv[c]),
+                                                _mm256_castps256_ps128(w), _mm_loadu_ps(lo));
+                _mm_storeu_ps(lo, sum);
+            }
+        }
+    }
+}
+
+/// One row's part of a paired group: its offset dy from the splat centre, gamma dy^2, and
+/// the prefix and suffix of constant boundaries (SlabRange; pre = suf = n + 1, every
+/// boundary before the kernel, for a row outside it or past the rectangle).
+struct PairedRow {
+    float dy, gyy;
+    SlabRange range;
+};
+
+/// The Flat path (splatSectionsClosedLanes) for rectangles at most 4 pixels wide, as a
+/// kernel's rows are at small image sizes or where a tile's edge cuts it: rows y and y + 1
+/// share one vector (lanes 0-3 and 4-7) instead of each filling 8 lanes with at most 4
+/// pixels. Each lane computes what splatSectionsClosedLanes computes for its pixel, and a
+/// row's boundaries outside its own range take that row's constants, so the sheets receive
+/// the same sums bit for bit.
+template <int NCh>
+int splatSectionsPairedLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh],
+                             float sx, float sy, const footprint::EllipticalFootprint& e,
+                             const PixelRect& rect, const footprint::FootprintTable& fpTable,
+                             const footprint::GaussianSlab& slab,
+                             const footprint::FootprintPoly* poly, const float* tb) {
+    const int ox = sheets[0]->originX(), oy = sheets[0]->originY();
+    const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
+    for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
+    const footprint::FootprintLanes footprintOf(fpTable, poly);
+    const footprint::GaussianSlabLanes section(slab);
+    const RadialLanes radialOf{footprintOf, section, _mm256_set1_ps(e.a),
+                               _mm256_set1_ps(fpTable.r2Max())};
+    const __m256 vScale = _mm256_set1_ps(e.scale), vZero = _mm256_setzero_ps();
+    const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x0)), _mm256_setr_ps(0, 1, 2, 3, 0, 1, 2, 3));
+    const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
+    const __m256 inRect = _mm256_cmp_ps(px, _mm256_set1_ps(float(x1) + 0.5f), _CMP_LT_OQ);
+    const __m256 lowHalf = _mm256_castsi256_ps(_mm256_setr_epi32(-1, -1, -1, -1, 0, 0, 0, 0));
+    const __m256 highHalf = _mm256_castsi256_ps(_mm256_setr_epi32(0, 0, 0, 0, -1, -1, -1, -1));
+    __m256 vv[NCh];
+    for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+    FlatBoundaries flat;
+    flat.compute(tb, n, e.depthScale, slab, section);
+    const bool ascending = tb[n] > tb[0];
+    SheetRows rows;
+    sheetRows(sheets, n, rows);
+    // As splatSectionsClosedLanes' rows (the depths do not depend on the pixel).
+    auto rowOf = [&](int y) {
+        PairedRow r;
+        r.dy = float(y + oy) + 0.5f - sy;
+        r.gyy = e.gamma * r.dy * r.dy;
+        r.range = {n + 1, n + 1, n, 0};  // (an empty range that leaves the other row's)
+        if (y > y1 || !(r.gyy < fpTable.r2Max())) return r;
+        const float chord = std::sqrt(std::max(slab.r2Max() - r.gyy, 0.0f));
+        const float dxA = float(x0 + ox) + 0.5f - sx, dxB = float(x1 + ox) + 0.5f - sx;
+        const float tcA = e.tx * dxA + e.ty * r.dy, tcB = e.tx * dxB + e.ty * r.dy;
+        const float tcLo = std::min(tcA, tcB), tcHi = std::max(tcA, tcB);
+        auto before = [&](int b) { return e.depthScale * (tb[b] - tcLo) <= -chord; };
+        auto behind = [&](int b) { return e.depthScale * (tb[b] - tcHi) >= chord; };
+        r.range = slabRange(n, ascending, before, behind);
+        return r;
+    };
+    for (int y = y0; y <= y1; y += 2) {
+        const PairedRow a = rowOf(y), b = rowOf(y + 1);
+        const int jBegin = std::min(a.range.jBegin, b.range.jBegin);
+        const int jEnd = std::max(a.range.jEnd, b.range.jEnd);
+        if (jBegin >= jEnd) continue;
+        const __m256 shift = _mm256_setr_m128(_mm_set1_ps(e.beta * a.dy), _mm_set1_ps(e.beta * b.dy));
+        const __m256 gyy = _mm256_setr_m128(_mm_set1_ps(a.gyy), _mm_set1_ps(b.gyy));
+        const footprint::GaussianSlabLanes::Radial radial = radialOf(dx, shift, gyy, inRect);
+        const __m256 plus = radial.pl, minus = _mm256_sub_ps(vZero, radial.pl);
+        const __m256 vPre = ascending ? minus : plus, vSuf = ascending ? plus : minus;
+        const int preLo = std::min(a.range.pre, b.range.pre), preHi = std::max(a.range.pre, b.range.pre);
+        const int sufLo = std::min(a.range.suf, b.range.suf), sufHi = std::max(a.range.suf, b.range.suf);
+        // The half whose row has boundary k before (after) the kernel: its constant.
+        auto half = [&](bool inA, bool inB) { return inA ? (inB ? _mm256_castsi256_ps(_mm256_set1_epi32(-1)) : lowHalf) : highHalf; };
+        auto pAt = [&](int k) {
+            if (k < preLo) return vPre;
+            if (k >= sufHi) return vSuf;
+            __m256 p = flat.at(radial, plus, k);
+            if (k < preHi) p = _mm256_blendv_ps(p, vPre, half(k < a.range.pre, k < b.range.pre));
+            if (k >= sufLo) p = _mm256_blendv_ps(p, vSuf, half(k >= a.range.suf, k >= b.range.suf));
+            return p;
+        };
+        addPairedSections(rows, std::ptrdiff_t(y) * rows.stride + x0, y < y1, jBegin, jEnd, vScale,
+                          vv, pAt);
+    }
+    return n * (x1 - x0 + 1) * (y1 - y0 + 1);
+}
 FOOTPRINT_LANES_END
 #endif
 
@@ -351,6 +462,9 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
             // Flat when the boundaries' depths vary over the footprint by < 1e-6 kernel units.
             const float drift =
                 e.depthScale * (std::abs(e.tx) * e.halfWidth + std::abs(e.ty) * e.halfHeight);
+            if (drift <= 1e-6f && n < kMaxFlat && rect.x1 - rect.x0 < 4)
+                return splatSectionsPairedLanes(sheets, n, values, sx, sy, e, rect,
+                                                table.footprint(), *closed, poly, tb);
             if (drift <= 1e-6f && n < kMaxFlat)
                 return splatSectionsClosedLanes<NCh, true>(sheets, n, values, sx, sy, e, rect,
                                                            table.footprint(), *closed, poly, tb);
