@@ -452,7 +452,7 @@ template <int NCh>
 int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
                   float sy, const footprint::EllipticalFootprint& e, const PixelRect& rect,
                   const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
-                  const float* tb) {
+                  const float* tb, bool pairNarrowRows = true) {
 #if defined(FOOTPRINT_HAVE_LANES)
     if constexpr (NCh != kLabelChannels)  // labels select by max: the scalar loop
         if (footprint::cpuHasLanes()) {
@@ -462,7 +462,7 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
             // Flat when the boundaries' depths vary over the footprint by < 1e-6 kernel units.
             const float drift =
                 e.depthScale * (std::abs(e.tx) * e.halfWidth + std::abs(e.ty) * e.halfHeight);
-            if (drift <= 1e-6f && n < kMaxFlat && rect.x1 - rect.x0 < 4)
+            if (drift <= 1e-6f && n < kMaxFlat && pairNarrowRows && rect.x1 - rect.x0 < 4)
                 return splatSectionsPairedLanes(sheets, n, values, sx, sy, e, rect,
                                                 table.footprint(), *closed, poly, tb);
             if (drift <= 1e-6f && n < kMaxFlat)
@@ -474,6 +474,17 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
 #endif
     return splatSectionsScalar(sheets, n, values, sx, sy, e, rect, table, poly, tb);
 }
+
+}  // namespace
+
+int cutIntoSlabs(SheetBuffer<4>* const* sheets, int n, const float (&values)[4], float sx, float sy,
+                 const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                 const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
+                 const float* tb, bool pairNarrowRows) {
+    return splatSections(sheets, n, values, sx, sy, e, rect, table, poly, tb, pairNarrowRows);
+}
+
+namespace {
 
 /// Each splat is cut into the slabs it crosses: `span` slabs from `key` in visiting order;
 /// only those in [lo, hi) (exact bricks cut one group of slabs at a time: slab_sheets.h).
