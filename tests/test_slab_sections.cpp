@@ -65,8 +65,8 @@ TEST_CASE("slab sections: two rows per vector fill the sheets of one row per vec
             std::vector<float> tb(std::size_t(n) + 1);
             const float first = -float(kernel.radius()) - phase(rng) * thickness;
             for (int b = 0; b <= n; ++b)
-                tb[std::size_t(b)] = ascending ? first + float(b) * thickness
-                                               : first + float(n - b) * thickness;
+                tb[std::size_t(b)] =
+                    ascending ? first + float(b) * thickness : first + float(n - b) * thickness;
             const float v[4] = {val(rng), val(rng), val(rng), val(rng)};
             const int a = cutIntoSlabs(p.data(), n, v, sx, sy, e, r, table, &poly, tb.data(), true);
             const int b =

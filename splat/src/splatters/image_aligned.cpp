@@ -85,24 +85,43 @@ void sheetRows(SheetBuffer<NCh>* const* sheets, int n, SheetRows& out) {
 FOOTPRINT_LANES_BEGIN
 /// Adds one 8-pixel group of a kernel's sections to the rows of slabs jBegin .. jEnd - 1: slab
 /// j gets values * scale * |at(j + 1) - at(j)|, at(b) the kernel's cumulative part (fraction
-/// or N P) at boundary b (the boundaries run back to front when compositing is).
-template <int NCh, class At>
+/// or N P) at boundary b (the boundaries run back to front when compositing is). add(q, v, w)
+/// adds v * w to a channel's row at q (addRow, or addTwoRows for two rows in one vector).
+template <int NCh, class At, class Add>
 [[gnu::always_inline]] inline void addSections(const SheetRows& rows, std::ptrdiff_t at0,
                                                int jBegin, int jEnd, __m256 scale,
-                                               const __m256 (&vv)[NCh], At at) {
+                                               const __m256 (&vv)[NCh], At at, Add add) {
     const __m256 signBit = _mm256_set1_ps(-0.0f);
     __m256 below = at(jBegin);
     for (int j = jBegin; j < jEnd; ++j) {
         const __m256 above = at(j + 1);
-        const __m256 w = _mm256_mul_ps(scale, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
+        const __m256 w =
+            _mm256_mul_ps(scale, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
         below = above;
         float* const p = rows.origin[j] + at0;
-        for (int c = 0; c < NCh; ++c) {
-            float* const q = p + c * rows.plane;
-            _mm256_storeu_ps(q, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(q)));
-        }
+        for (int c = 0; c < NCh; ++c) add(p + c * rows.plane, vv[c], w);
     }
 }
+
+/// The 8 lanes of one row at q.
+[[gnu::always_inline]] inline void addRow(float* q, __m256 v, __m256 w) {
+    _mm256_storeu_ps(q, _mm256_fmadd_ps(v, w, _mm256_loadu_ps(q)));
+}
+
+/// Lanes 0-3 at q and, if `both`, lanes 4-7 at q + stride (the row below).
+struct AddTwoRows {
+    std::ptrdiff_t stride;
+    bool both;
+    [[gnu::always_inline]] void operator()(float* q, __m256 v, __m256 w) const {
+        float* const below = q + stride;
+        if (both) {
+            _mm256_storeu2_m128(below, q, _mm256_fmadd_ps(v, w, _mm256_loadu2_m128(below, q)));
+        } else {
+            _mm_storeu_ps(q, _mm_fmadd_ps(_mm256_castps256_ps128(v), _mm256_castps256_ps128(w),
+                                          _mm_loadu_ps(q)));
+        }
+    }
+};
 
 template <int NCh>
 int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
@@ -169,7 +188,7 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
                 return fraction(radial,
                                 _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
             };
-            addSections(rows, rowAt + x, jBegin, jEnd, weight, vv, fractionAt);
+            addSections(rows, rowAt + x, jBegin, jEnd, weight, vv, fractionAt, addRow);
         }
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
@@ -209,9 +228,9 @@ struct FlatBoundaries {
     [[gnu::always_inline]] __m256 at(const footprint::GaussianSlabLanes::Radial& radial,
                                      __m256 plus, int b) const {
         const __m256 in = _mm256_cmp_ps(radial.l2, _mm256_broadcast_ss(zz + b), _CMP_GT_OQ);
-        const __m256 p = footprint::GaussianSlabLanes::inside(
-            radial, _mm256_broadcast_ss(z + b), _mm256_broadcast_ss(e + b),
-            _mm256_broadcast_ss(q + b));
+        const __m256 p = footprint::GaussianSlabLanes::inside(radial, _mm256_broadcast_ss(z + b),
+                                                              _mm256_broadcast_ss(e + b),
+                                                              _mm256_broadcast_ss(q + b));
         const __m256 beyond = _mm256_xor_ps(plus, _mm256_broadcast_ss(neg + b));
         return _mm256_blendv_ps(beyond, p, in);
     }
@@ -226,11 +245,12 @@ struct RadialLanes {
     const footprint::GaussianSlabLanes& section;
     __m256 a, r2Max;
 
-    [[gnu::always_inline]] footprint::GaussianSlabLanes::Radial operator()(
-        __m256 dx, __m256 shift, __m256 gyy, __m256 keep) const {
+    [[gnu::always_inline]] footprint::GaussianSlabLanes::Radial operator()(__m256 dx, __m256 shift,
+                                                                           __m256 gyy,
+                                                                           __m256 keep) const {
         const __m256 q = _mm256_add_ps(dx, shift);
-        const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(a, q), q, gyy),
-                                        _mm256_setzero_ps());
+        const __m256 r2 =
+            _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(a, q), q, gyy), _mm256_setzero_ps());
         const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, r2Max, _CMP_LT_OQ), keep);
         footprint::GaussianSlabLanes::Radial radial = section.radial(
             r2, _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), _mm256_set1_ps(0.5f))));
@@ -308,39 +328,11 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
                                    _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
                 }
             };
-            addSections(rows, rowAt + x, jBegin, jEnd, vScale, vv, pAt);
+            addSections(rows, rowAt + x, jBegin, jEnd, vScale, vv, pAt, addRow);
         }
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
 }
-/// addSections for two rows of at most 4 pixels in one vector: lanes 0-3 are added at
-/// at0 of each slab's row and, if `both`, lanes 4-7 at at0 of the row below.
-template <int NCh, class At>
-[[gnu::always_inline]] inline void addPairedSections(const SheetRows& rows, std::ptrdiff_t at0,
-                                                     bool both, int jBegin, int jEnd,
-                                                     __m256 scale, const __m256 (&vv)[NCh],
-                                                     At at) {
-    const __m256 signBit = _mm256_set1_ps(-0.0f);
-    __m256 below = at(jBegin);
-    for (int j = jBegin; j < jEnd; ++j) {
-        const __m256 above = at(j + 1);
-        const __m256 w = _mm256_mul_ps(scale, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
-        below = above;
-        float* const p = rows.origin[j] + at0;
-        for (int c = 0; c < NCh; ++c) {
-            float* const lo = p + c * rows.plane;
-            float* const hi = lo + rows.stride;
-            if (both) {
-                _mm256_storeu2_m128(hi, lo, _mm256_fmadd_ps(vv[c], w, _mm256_loadu2_m128(hi, lo)));
-            } else {
-                const __m128 sum = _mm_fmadd_ps(_mm256_castps256_ps128(vv[c]),
-                                                _mm256_castps256_ps128(w), _mm_loadu_ps(lo));
-                _mm_storeu_ps(lo, sum);
-            }
-        }
-    }
-}
-
 /// One row's part of a paired group: its offset dy from the splat centre, gamma dy^2, and
 /// the prefix and suffix of constant boundaries (SlabRange; pre = suf = n + 1, every
 /// boundary before the kernel, for a row outside it or past the rectangle).
@@ -369,7 +361,8 @@ int splatSectionsPairedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
     const RadialLanes radialOf{footprintOf, section, _mm256_set1_ps(e.a),
                                _mm256_set1_ps(fpTable.r2Max())};
     const __m256 vScale = _mm256_set1_ps(e.scale), vZero = _mm256_setzero_ps();
-    const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x0)), _mm256_setr_ps(0, 1, 2, 3, 0, 1, 2, 3));
+    const __m256 px =
+        _mm256_add_ps(_mm256_set1_ps(float(x0)), _mm256_setr_ps(0, 1, 2, 3, 0, 1, 2, 3));
     const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
     const __m256 inRect = _mm256_cmp_ps(px, _mm256_set1_ps(float(x1) + 0.5f), _CMP_LT_OQ);
     const __m256 lowHalf = _mm256_castsi256_ps(_mm256_setr_epi32(-1, -1, -1, -1, 0, 0, 0, 0));
@@ -402,15 +395,20 @@ int splatSectionsPairedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
         const int jBegin = std::min(a.range.jBegin, b.range.jBegin);
         const int jEnd = std::max(a.range.jEnd, b.range.jEnd);
         if (jBegin >= jEnd) continue;
-        const __m256 shift = _mm256_setr_m128(_mm_set1_ps(e.beta * a.dy), _mm_set1_ps(e.beta * b.dy));
+        const __m256 shift =
+            _mm256_setr_m128(_mm_set1_ps(e.beta * a.dy), _mm_set1_ps(e.beta * b.dy));
         const __m256 gyy = _mm256_setr_m128(_mm_set1_ps(a.gyy), _mm_set1_ps(b.gyy));
         const footprint::GaussianSlabLanes::Radial radial = radialOf(dx, shift, gyy, inRect);
         const __m256 plus = radial.pl, minus = _mm256_sub_ps(vZero, radial.pl);
         const __m256 vPre = ascending ? minus : plus, vSuf = ascending ? plus : minus;
-        const int preLo = std::min(a.range.pre, b.range.pre), preHi = std::max(a.range.pre, b.range.pre);
-        const int sufLo = std::min(a.range.suf, b.range.suf), sufHi = std::max(a.range.suf, b.range.suf);
+        const int preLo = std::min(a.range.pre, b.range.pre),
+                  preHi = std::max(a.range.pre, b.range.pre);
+        const int sufLo = std::min(a.range.suf, b.range.suf),
+                  sufHi = std::max(a.range.suf, b.range.suf);
         // The half whose row has boundary k before (after) the kernel: its constant.
-        auto half = [&](bool inA, bool inB) { return inA ? (inB ? _mm256_castsi256_ps(_mm256_set1_epi32(-1)) : lowHalf) : highHalf; };
+        auto half = [&](bool inA, bool inB) {
+            return inA ? (inB ? _mm256_castsi256_ps(_mm256_set1_epi32(-1)) : lowHalf) : highHalf;
+        };
         auto pAt = [&](int k) {
             if (k < preLo) return vPre;
             if (k >= sufHi) return vSuf;
@@ -419,8 +417,8 @@ int splatSectionsPairedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
             if (k >= sufLo) p = _mm256_blendv_ps(p, vSuf, half(k >= a.range.suf, k >= b.range.suf));
             return p;
         };
-        addPairedSections(rows, std::ptrdiff_t(y) * rows.stride + x0, y < y1, jBegin, jEnd, vScale,
-                          vv, pAt);
+        addSections(rows, std::ptrdiff_t(y) * rows.stride + x0, jBegin, jEnd, vScale, vv, pAt,
+                    AddTwoRows{rows.stride, y < y1});
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
 }
