@@ -85,24 +85,43 @@ void sheetRows(SheetBuffer<NCh>* const* sheets, int n, SheetRows& out) {
 FOOTPRINT_LANES_BEGIN
 /// Adds one 8-pixel group of a kernel's sections to the rows of slabs jBegin .. jEnd - 1: slab
 /// j gets values * scale * |at(j + 1) - at(j)|, at(b) the kernel's cumulative part (fraction
-/// or N P) at boundary b (the boundaries run back to front when compositing is).
-template <int NCh, class At>
+/// or N P) at boundary b (the boundaries run back to front when compositing is). add(q, v, w)
+/// adds v * w to a channel's row at q (addRow, or addTwoRows for two rows in one vector).
+template <int NCh, class At, class Add>
 [[gnu::always_inline]] inline void addSections(const SheetRows& rows, std::ptrdiff_t at0,
                                                int jBegin, int jEnd, __m256 scale,
-                                               const __m256 (&vv)[NCh], At at) {
+                                               const __m256 (&vv)[NCh], At at, Add add) {
     const __m256 signBit = _mm256_set1_ps(-0.0f);
     __m256 below = at(jBegin);
     for (int j = jBegin; j < jEnd; ++j) {
         const __m256 above = at(j + 1);
-        const __m256 w = _mm256_mul_ps(scale, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
+        const __m256 w =
+            _mm256_mul_ps(scale, _mm256_andnot_ps(signBit, _mm256_sub_ps(above, below)));
         below = above;
         float* const p = rows.origin[j] + at0;
-        for (int c = 0; c < NCh; ++c) {
-            float* const q = p + c * rows.plane;
-            _mm256_storeu_ps(q, _mm256_fmadd_ps(vv[c], w, _mm256_loadu_ps(q)));
-        }
+        for (int c = 0; c < NCh; ++c) add(p + c * rows.plane, vv[c], w);
     }
 }
+
+/// The 8 lanes of one row at q.
+[[gnu::always_inline]] inline void addRow(float* q, __m256 v, __m256 w) {
+    _mm256_storeu_ps(q, _mm256_fmadd_ps(v, w, _mm256_loadu_ps(q)));
+}
+
+/// Lanes 0-3 at q and, if `both`, lanes 4-7 at q + stride (the row below).
+struct AddTwoRows {
+    std::ptrdiff_t stride;
+    bool both;
+    [[gnu::always_inline]] void operator()(float* q, __m256 v, __m256 w) const {
+        float* const below = q + stride;
+        if (both) {
+            _mm256_storeu2_m128(below, q, _mm256_fmadd_ps(v, w, _mm256_loadu2_m128(below, q)));
+        } else {
+            _mm_storeu_ps(q, _mm_fmadd_ps(_mm256_castps256_ps128(v), _mm256_castps256_ps128(w),
+                                          _mm_loadu_ps(q)));
+        }
+    }
+};
 
 template <int NCh>
 int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
@@ -169,7 +188,7 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
                 return fraction(radial,
                                 _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
             };
-            addSections(rows, rowAt + x, jBegin, jEnd, weight, vv, fractionAt);
+            addSections(rows, rowAt + x, jBegin, jEnd, weight, vv, fractionAt, addRow);
         }
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
@@ -178,6 +197,67 @@ int splatSectionsLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&val
 /// Most boundaries of the Flat closed-form path (splatSectionsClosedLanes); kernels
 /// crossing more slabs take the general one.
 constexpr int kMaxFlat = 64;
+
+/// The Flat path's terms of one splat's boundaries (their depths are the same for every
+/// pixel): z, z^2, erf(z / (sigma sqrt 2)) and the cubic term, and the sign bit of N P
+/// beyond the chord on boundary b's side (-fp / 2 before the kernel's centre, +fp / 2
+/// behind it).
+struct FlatBoundaries {
+    alignas(32) float z[kMaxFlat + 8], zz[kMaxFlat + 8], e[kMaxFlat + 8], q[kMaxFlat + 8],
+        neg[kMaxFlat + 8];
+
+    /// The n + 1 boundaries tb (n < kMaxFlat), 8 at a time.
+    void compute(const float* tb, int n, float depthScale, const footprint::GaussianSlab& slab,
+                 const footprint::GaussianSlabLanes& section) {
+        for (int b = 0; b <= n; ++b) {
+            z[b] = depthScale * tb[b];
+            neg[b] = z[b] > 0.0f ? 0.0f : -0.0f;
+        }
+        for (int b = n + 1; b % 8; ++b) z[b] = 0.0f;
+        const __m256 vs = _mm256_set1_ps(slab.erfScale());
+        for (int b = 0; b <= n; b += 8) {
+            const __m256 vz = _mm256_load_ps(z + b), vzz = _mm256_mul_ps(vz, vz);
+            _mm256_store_ps(zz + b, vzz);
+            _mm256_store_ps(e + b, section.erf(_mm256_mul_ps(vz, vs)));
+            _mm256_store_ps(q + b, _mm256_mul_ps(section.cubic(), _mm256_mul_ps(vzz, vz)));
+        }
+    }
+
+    /// N P at boundary b for the lanes' radial part: inside the chord a erf(z) - b z + q,
+    /// beyond it `plus` (fp / 2) with the boundary's sign.
+    [[gnu::always_inline]] __m256 at(const footprint::GaussianSlabLanes::Radial& radial,
+                                     __m256 plus, int b) const {
+        const __m256 in = _mm256_cmp_ps(radial.l2, _mm256_broadcast_ss(zz + b), _CMP_GT_OQ);
+        const __m256 p = footprint::GaussianSlabLanes::inside(radial, _mm256_broadcast_ss(z + b),
+                                                              _mm256_broadcast_ss(e + b),
+                                                              _mm256_broadcast_ss(q + b));
+        const __m256 beyond = _mm256_xor_ps(plus, _mm256_broadcast_ss(neg + b));
+        return _mm256_blendv_ps(beyond, p, in);
+    }
+};
+
+/// The radial part of N P for 8 pixels at offsets (dx, dy) from the splat centre whose rays
+/// pass at r^2 = a (dx + beta dy)^2 + gamma dy^2 (shift = beta dy, gyy = gamma dy^2) and
+/// half the footprint: pl = fp / 2, 0 (and the chord 0) outside the kernel and where `keep`
+/// is clear.
+struct RadialLanes {
+    const footprint::FootprintLanes& footprintOf;
+    const footprint::GaussianSlabLanes& section;
+    __m256 a, r2Max;
+
+    [[gnu::always_inline]] footprint::GaussianSlabLanes::Radial operator()(__m256 dx, __m256 shift,
+                                                                           __m256 gyy,
+                                                                           __m256 keep) const {
+        const __m256 q = _mm256_add_ps(dx, shift);
+        const __m256 r2 =
+            _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(a, q), q, gyy), _mm256_setzero_ps());
+        const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, r2Max, _CMP_LT_OQ), keep);
+        footprint::GaussianSlabLanes::Radial radial = section.radial(
+            r2, _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), _mm256_set1_ps(0.5f))));
+        radial.l2 = _mm256_and_ps(inside, radial.l2);
+        return radial;
+    }
+};
 
 /// splatSectionsLanes with the kernel's closed form (footprint/gaussian_slab.h) instead of
 /// the table's fraction: per pixel the radial part of N P (exp, and half the footprint from
@@ -196,33 +276,16 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
     const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
     for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
     const __m256 lane = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7), vZero = _mm256_setzero_ps();
-    const __m256 vHalf = _mm256_set1_ps(0.5f);
-    const __m256 va = _mm256_set1_ps(e.a), vScale = _mm256_set1_ps(e.scale);
-    const __m256 vMax = _mm256_set1_ps(fpTable.r2Max());
+    const __m256 vScale = _mm256_set1_ps(e.scale);
     const footprint::FootprintLanes footprintOf(fpTable, poly);
     const footprint::GaussianSlabLanes section(slab);
+    const RadialLanes radialOf{footprintOf, section, _mm256_set1_ps(e.a),
+                               _mm256_set1_ps(fpTable.r2Max())};
     const __m256 vds = _mm256_set1_ps(e.depthScale), vtx = _mm256_set1_ps(e.tx);
     __m256 vv[NCh];
     for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
-    // Flat: per boundary z, z^2, erf(z / (sigma sqrt 2)) and the cubic term, 8 at a time.
-    // fneg: the sign bit of N P beyond the chord on boundary b's side (-fp / 2 before the
-    // kernel's centre, +fp / 2 behind it).
-    alignas(32) float fz[Flat ? kMaxFlat + 8 : 1], fzz[Flat ? kMaxFlat + 8 : 1],
-        fe[Flat ? kMaxFlat + 8 : 1], fq[Flat ? kMaxFlat + 8 : 1], fneg[Flat ? kMaxFlat + 8 : 1];
-    if constexpr (Flat) {
-        for (int b = 0; b <= n; ++b) {
-            fz[b] = e.depthScale * tb[b];
-            fneg[b] = fz[b] > 0.0f ? 0.0f : -0.0f;
-        }
-        for (int b = n + 1; b % 8; ++b) fz[b] = 0.0f;
-        const __m256 vs = _mm256_set1_ps(slab.erfScale());
-        for (int b = 0; b <= n; b += 8) {
-            const __m256 z = _mm256_load_ps(fz + b), zz = _mm256_mul_ps(z, z);
-            _mm256_store_ps(fzz + b, zz);
-            _mm256_store_ps(fe + b, section.erf(_mm256_mul_ps(z, vs)));
-            _mm256_store_ps(fq + b, _mm256_mul_ps(section.cubic(), _mm256_mul_ps(zz, z)));
-        }
-    }
+    FlatBoundaries flat;
+    if constexpr (Flat) flat.compute(tb, n, e.depthScale, slab, section);
     // As splatSectionsLanes: per row, the boundaries before the kernel's chord at the row's
     // smallest r^2 (N P = -fp / 2 front to back) and behind it (+fp / 2) are a prefix and
     // a suffix.
@@ -249,14 +312,9 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
         for (int x = x0; x <= x1; x += 8) {
             const __m256 px = _mm256_add_ps(_mm256_set1_ps(float(x)), lane);
             const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
-            const __m256 q = _mm256_add_ps(dx, vshift);
-            const __m256 r2 = _mm256_max_ps(_mm256_fmadd_ps(_mm256_mul_ps(va, q), q, vgyy), vZero);
-            const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(r2, vMax, _CMP_LT_OQ),
-                                                _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
             // Outside the kernel (and beyond the rectangle) the chord and fp are 0: so is N P.
-            footprint::GaussianSlabLanes::Radial radial =
-                section.radial(r2, _mm256_and_ps(inside, _mm256_mul_ps(footprintOf(r2), vHalf)));
-            radial.l2 = _mm256_and_ps(inside, radial.l2);
+            const footprint::GaussianSlabLanes::Radial radial =
+                radialOf(dx, vshift, vgyy, _mm256_cmp_ps(px, lastX, _CMP_LT_OQ));
             const __m256 plus = radial.pl, minus = _mm256_sub_ps(vZero, radial.pl);
             const __m256 vPre = ascending ? minus : plus, vSuf = ascending ? plus : minus;
             const __m256 tc = _mm256_fmadd_ps(vtx, dx, vtyy);
@@ -264,20 +322,103 @@ int splatSectionsClosedLanes(SheetBuffer<NCh>* const* sheets, int n, const float
                 if (b < pre) return vPre;
                 if (b >= suf) return vSuf;
                 if constexpr (Flat) {
-                    const __m256 in =
-                        _mm256_cmp_ps(radial.l2, _mm256_broadcast_ss(fzz + b), _CMP_GT_OQ);
-                    const __m256 p = footprint::GaussianSlabLanes::inside(
-                        radial, _mm256_broadcast_ss(fz + b), _mm256_broadcast_ss(fe + b),
-                        _mm256_broadcast_ss(fq + b));
-                    const __m256 beyond = _mm256_xor_ps(plus, _mm256_broadcast_ss(fneg + b));
-                    return _mm256_blendv_ps(beyond, p, in);
+                    return flat.at(radial, plus, b);
                 } else {
                     return section(radial,
                                    _mm256_mul_ps(vds, _mm256_sub_ps(_mm256_set1_ps(tb[b]), tc)));
                 }
             };
-            addSections(rows, rowAt + x, jBegin, jEnd, vScale, vv, pAt);
+            addSections(rows, rowAt + x, jBegin, jEnd, vScale, vv, pAt, addRow);
         }
+    }
+    return n * (x1 - x0 + 1) * (y1 - y0 + 1);
+}
+/// One row's part of a paired group: its offset dy from the splat centre, gamma dy^2, and
+/// the prefix and suffix of constant boundaries (SlabRange; pre = suf = n + 1, every
+/// boundary before the kernel, for a row outside it or past the rectangle).
+struct PairedRow {
+    float dy, gyy;
+    SlabRange range;
+};
+
+/// The Flat path (splatSectionsClosedLanes) for rectangles at most 4 pixels wide, as a
+/// kernel's rows are at small image sizes or where a tile's edge cuts it: rows y and y + 1
+/// share one vector (lanes 0-3 and 4-7) instead of each filling 8 lanes with at most 4
+/// pixels. Each lane computes what splatSectionsClosedLanes computes for its pixel, and a
+/// row's boundaries outside its own range take that row's constants, so the sheets receive
+/// the same sums bit for bit.
+template <int NCh>
+int splatSectionsPairedLanes(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh],
+                             float sx, float sy, const footprint::EllipticalFootprint& e,
+                             const PixelRect& rect, const footprint::FootprintTable& fpTable,
+                             const footprint::GaussianSlab& slab,
+                             const footprint::FootprintPoly* poly, const float* tb) {
+    const int ox = sheets[0]->originX(), oy = sheets[0]->originY();
+    const int x0 = rect.x0 - ox, x1 = rect.x1 - ox, y0 = rect.y0 - oy, y1 = rect.y1 - oy;
+    for (int j = 0; j < n; ++j) sheets[j]->markDirty(x0, x1, y0, y1);
+    const footprint::FootprintLanes footprintOf(fpTable, poly);
+    const footprint::GaussianSlabLanes section(slab);
+    const RadialLanes radialOf{footprintOf, section, _mm256_set1_ps(e.a),
+                               _mm256_set1_ps(fpTable.r2Max())};
+    const __m256 vScale = _mm256_set1_ps(e.scale), vZero = _mm256_setzero_ps();
+    const __m256 px =
+        _mm256_add_ps(_mm256_set1_ps(float(x0)), _mm256_setr_ps(0, 1, 2, 3, 0, 1, 2, 3));
+    const __m256 dx = _mm256_add_ps(px, _mm256_set1_ps(float(ox) + 0.5f - sx));
+    const __m256 inRect = _mm256_cmp_ps(px, _mm256_set1_ps(float(x1) + 0.5f), _CMP_LT_OQ);
+    const __m256 lowHalf = _mm256_castsi256_ps(_mm256_setr_epi32(-1, -1, -1, -1, 0, 0, 0, 0));
+    const __m256 highHalf = _mm256_castsi256_ps(_mm256_setr_epi32(0, 0, 0, 0, -1, -1, -1, -1));
+    __m256 vv[NCh];
+    for (int c = 0; c < NCh; ++c) vv[c] = _mm256_set1_ps(values[c]);
+    FlatBoundaries flat;
+    flat.compute(tb, n, e.depthScale, slab, section);
+    const bool ascending = tb[n] > tb[0];
+    SheetRows rows;
+    sheetRows(sheets, n, rows);
+    // As splatSectionsClosedLanes' rows (the depths do not depend on the pixel).
+    auto rowOf = [&](int y) {
+        PairedRow r;
+        r.dy = float(y + oy) + 0.5f - sy;
+        r.gyy = e.gamma * r.dy * r.dy;
+        r.range = {n + 1, n + 1, n, 0};  // (an empty range that leaves the other row's)
+        if (y > y1 || !(r.gyy < fpTable.r2Max())) return r;
+        const float chord = std::sqrt(std::max(slab.r2Max() - r.gyy, 0.0f));
+        const float dxA = float(x0 + ox) + 0.5f - sx, dxB = float(x1 + ox) + 0.5f - sx;
+        const float tcA = e.tx * dxA + e.ty * r.dy, tcB = e.tx * dxB + e.ty * r.dy;
+        const float tcLo = std::min(tcA, tcB), tcHi = std::max(tcA, tcB);
+        auto before = [&](int b) { return e.depthScale * (tb[b] - tcLo) <= -chord; };
+        auto behind = [&](int b) { return e.depthScale * (tb[b] - tcHi) >= chord; };
+        r.range = slabRange(n, ascending, before, behind);
+        return r;
+    };
+    for (int y = y0; y <= y1; y += 2) {
+        const PairedRow a = rowOf(y), b = rowOf(y + 1);
+        const int jBegin = std::min(a.range.jBegin, b.range.jBegin);
+        const int jEnd = std::max(a.range.jEnd, b.range.jEnd);
+        if (jBegin >= jEnd) continue;
+        const __m256 shift =
+            _mm256_setr_m128(_mm_set1_ps(e.beta * a.dy), _mm_set1_ps(e.beta * b.dy));
+        const __m256 gyy = _mm256_setr_m128(_mm_set1_ps(a.gyy), _mm_set1_ps(b.gyy));
+        const footprint::GaussianSlabLanes::Radial radial = radialOf(dx, shift, gyy, inRect);
+        const __m256 plus = radial.pl, minus = _mm256_sub_ps(vZero, radial.pl);
+        const __m256 vPre = ascending ? minus : plus, vSuf = ascending ? plus : minus;
+        const int preLo = std::min(a.range.pre, b.range.pre),
+                  preHi = std::max(a.range.pre, b.range.pre);
+        const int sufLo = std::min(a.range.suf, b.range.suf),
+                  sufHi = std::max(a.range.suf, b.range.suf);
+        // The half whose row has boundary k before (after) the kernel: its constant.
+        auto half = [&](bool inA, bool inB) {
+            return inA ? (inB ? _mm256_castsi256_ps(_mm256_set1_epi32(-1)) : lowHalf) : highHalf;
+        };
+        auto pAt = [&](int k) {
+            if (k < preLo) return vPre;
+            if (k >= sufHi) return vSuf;
+            __m256 p = flat.at(radial, plus, k);
+            if (k < preHi) p = _mm256_blendv_ps(p, vPre, half(k < a.range.pre, k < b.range.pre));
+            if (k >= sufLo) p = _mm256_blendv_ps(p, vSuf, half(k >= a.range.suf, k >= b.range.suf));
+            return p;
+        };
+        addSections(rows, std::ptrdiff_t(y) * rows.stride + x0, jBegin, jEnd, vScale, vv, pAt,
+                    AddTwoRows{rows.stride, y < y1});
     }
     return n * (x1 - x0 + 1) * (y1 - y0 + 1);
 }
@@ -309,7 +450,7 @@ template <int NCh>
 int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[NCh], float sx,
                   float sy, const footprint::EllipticalFootprint& e, const PixelRect& rect,
                   const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
-                  const float* tb) {
+                  const float* tb, bool pairNarrowRows = true) {
 #if defined(FOOTPRINT_HAVE_LANES)
     if constexpr (NCh != kLabelChannels)  // labels select by max: the scalar loop
         if (footprint::cpuHasLanes()) {
@@ -319,6 +460,9 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
             // Flat when the boundaries' depths vary over the footprint by < 1e-6 kernel units.
             const float drift =
                 e.depthScale * (std::abs(e.tx) * e.halfWidth + std::abs(e.ty) * e.halfHeight);
+            if (drift <= 1e-6f && n < kMaxFlat && pairNarrowRows && rect.x1 - rect.x0 < 4)
+                return splatSectionsPairedLanes(sheets, n, values, sx, sy, e, rect,
+                                                table.footprint(), *closed, poly, tb);
             if (drift <= 1e-6f && n < kMaxFlat)
                 return splatSectionsClosedLanes<NCh, true>(sheets, n, values, sx, sy, e, rect,
                                                            table.footprint(), *closed, poly, tb);
@@ -328,6 +472,17 @@ int splatSections(SheetBuffer<NCh>* const* sheets, int n, const float (&values)[
 #endif
     return splatSectionsScalar(sheets, n, values, sx, sy, e, rect, table, poly, tb);
 }
+
+}  // namespace
+
+int cutIntoSlabs(SheetBuffer<4>* const* sheets, int n, const float (&values)[4], float sx, float sy,
+                 const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                 const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
+                 const float* tb, bool pairNarrowRows) {
+    return splatSections(sheets, n, values, sx, sy, e, rect, table, poly, tb, pairNarrowRows);
+}
+
+namespace {
 
 /// Each splat is cut into the slabs it crosses: `span` slabs from `key` in visiting order;
 /// only those in [lo, hi) (exact bricks cut one group of slabs at a time: slab_sheets.h).

@@ -10,6 +10,11 @@
 #include "frame/workspace.h"
 #include "model/scene_impl.h"
 
+namespace footprint {
+class FootprintPoly;
+class SlabTable;
+}  // namespace footprint
+
 namespace splat {
 
 class Splatter {
@@ -47,6 +52,15 @@ SheetPlan orderOnSlabs(const Scene::Impl& scene, const Camera& camera,
 void addSlabSheets(const TileInputs& in, std::uint32_t first, std::uint32_t count, float* blocks,
                    int* rects);
 const Splatter& imageAlignedSplatter();
+/// The image-aligned splatter's step "cut": adds one kernel's sections in the n slabs
+/// between depths tb[0 .. n] (along its rays, relative to its centre) to sheets[0 .. n - 1],
+/// as the tile sweep does; returns the pixels visited. pairNarrowRows false computes
+/// rectangles at most 4 pixels wide one row per vector like wider ones (tests compare the
+/// two).
+int cutIntoSlabs(SheetBuffer<4>* const* sheets, int n, const float (&values)[4], float sx, float sy,
+                 const footprint::EllipticalFootprint& e, const PixelRect& rect,
+                 const footprint::SlabTable& table, const footprint::FootprintPoly* poly,
+                 const float* tb, bool pairNarrowRows);
 
 /// Index (0, 1, 2) of the volume axis most parallel to the ray direction in index space,
 /// S^-1 view (docs/design.md: anisotropic spacing is honoured), and the sign of that component.
