@@ -176,10 +176,11 @@ struct Quality {
     /// EWA").
     Ewa ewa = Ewa::Auto;
     /// Axis-aligned splatter, orthographic pre-classified dvr without clipping, labels, EWA or
-    /// merged levels: 0 splats every footprint into screen tiles (the default); n >= 1 uses
-    /// factorised sheets instead (splatters/factorised_sheets.h: one footprint stamp per
-    /// sheet on an intermediate image of n samples per voxel along the sheet, warped to the
-    /// screen once). -P (an experiment, any orthographic frame of the axis-aligned splatter):
+    /// merged levels: 0 splats every footprint into screen tiles (the default: n = 2 is faster
+    /// but loses accuracy at sharp opaque edges, docs/performance.md "Factorised sheets as the
+    /// default design: measured, not kept"); n >= 1 uses factorised sheets instead
+    /// (splatters/factorised_sheets.h: one footprint stamp per sheet on an intermediate image
+    /// of n samples per voxel along the sheet, warped to the screen once). -P (an experiment, any orthographic frame of the axis-aligned splatter):
     /// per-frame footprint stamps at P x P sub-pixel phases instead of the footprint
     /// polynomial per pixel. Other frames ignore it.
     int factorisedSheets = 0;

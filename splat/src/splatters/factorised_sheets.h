@@ -21,8 +21,11 @@
 // image is smooth and largest at opaque silhouettes. The image's detail is the footprint's,
 // so n is per voxel, not per pixel: on ch2 (the benchmark's MRI head) n = 2 keeps the
 // per-splat frame's error against the reference at 256^2 and 512^2 alike, n = 1 is a faster,
-// coarser setting; sharper edges need more (tests/test_factorised_sheets.cpp). Orthographic
-// views only: perspective rays are not parallel, so a sheet's voxels do not share one phase.
+// coarser setting; sharper edges need more (tests/test_factorised_sheets.cpp): the phantoms'
+// opaque edges need n = 4..8, which is why the default frame is the per-splat one
+// (docs/performance.md "Factorised sheets as the default design: measured, not kept").
+// Orthographic views only: perspective rays are not parallel, so a sheet's voxels do not
+// share one phase.
 #include "model/scene_impl.h"
 
 namespace splat {
