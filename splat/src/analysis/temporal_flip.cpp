@@ -34,10 +34,13 @@ TemporalFlip::TemporalFlip(const PoppingOptions& options, const Volume& geometry
 }
 
 void TemporalFlip::addView(std::size_t n, const CameraParams& camera,
-                           const std::vector<Image>& frames, std::vector<RendererSeries>& series) {
+                           const std::vector<Image>& frames,
+                           const std::vector<FlipImage>& perceived,
+                           std::vector<RendererSeries>& series) {
     if (!enabled_) return;
     Past view{Camera(camera, geometry_),
-              scene_ ? referenceDepth(*scene_, camera) : options_.depthFrame(camera), frames};
+              scene_ ? referenceDepth(*scene_, camera) : options_.depthFrame(camera), frames,
+              perceived};
     past_.push_back(std::move(view));
     if (past_.size() > kFar + 1) past_.pop_front();
     const Past& now = past_.back();
@@ -51,9 +54,7 @@ double TemporalFlip::pairFlip(const Past& earlier, const Past& later, std::size_
     const WarpedFrame warped =
         warpFrame(earlier.frames[renderer], earlier.depth, earlier.camera, later.frames[renderer],
                   later.depth, later.camera, options_.warp);
-    FlipOptions fo;
-    fo.pixelsPerDegree = options_.pixelsPerDegree;
-    return warpedFlip(later.frames[renderer], warped, fo);
+    return warpedFlip(later.perceived[renderer], warped);
 }
 
 void TemporalFlip::finish(std::vector<RendererSeries>& series) const {

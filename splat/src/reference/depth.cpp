@@ -140,12 +140,12 @@ Image dvrMedianDepth(const Scene& scene, const Camera& camera, bool skipEmpty) {
             rho.resize(std::size_t(steps) + 1);
             // Post-classified, empty space has the transfer function's extinction at b.
             std::optional<OccupiedSpans> spans;
-            if (pre && skipEmpty) spans.emplace(field.grid1(), volume, ray, t0, t0 + steps * dt, dt);
+            if (pre && skipEmpty)
+                spans.emplace(field.grid1(), volume, ray, t0, t0 + steps * dt, dt);
             double tau = 0;
             for (int n = 0; n <= steps; ++n) {
                 const double t = t0 + n * dt;
-                rho[n] =
-                    spans && !spans->occupied(t) ? 0.0 : extinction(ray.origin + t * ray.dir);
+                rho[n] = spans && !spans->occupied(t) ? 0.0 : extinction(ray.origin + t * ray.dir);
                 tau += rho[n] * dt;
                 if (tau > kOpaque) {
                     rho.resize(std::size_t(n) + 1);
