@@ -39,22 +39,23 @@ void TemporalFlip::addView(std::size_t n, const CameraParams& camera,
                            std::vector<RendererSeries>& series) {
     if (!enabled_) return;
     Past view{Camera(camera, geometry_),
-              scene_ ? referenceDepth(*scene_, camera) : options_.depthFrame(camera), frames,
-              perceived};
+              scene_ ? referenceDepth(*scene_, camera) : options_.depthFrame(camera), frames};
     past_.push_back(std::move(view));
     if (past_.size() > kFar + 1) past_.pop_front();
     const Past& now = past_.back();
     for (std::size_t k = 0; k < series.size(); ++k) {
-        if (n >= 1) series[k].flipWarp1.push_back(pairFlip(past_[past_.size() - 2], now, k));
-        if (n >= kFar) series[k].flipWarp7.push_back(pairFlip(past_.front(), now, k));
+        if (n >= 1)
+            series[k].flipWarp1.push_back(pairFlip(past_[past_.size() - 2], now, perceived[k], k));
+        if (n >= kFar) series[k].flipWarp7.push_back(pairFlip(past_.front(), now, perceived[k], k));
     }
 }
 
-double TemporalFlip::pairFlip(const Past& earlier, const Past& later, std::size_t renderer) const {
+double TemporalFlip::pairFlip(const Past& earlier, const Past& later, const FlipImage& laterFrame,
+                              std::size_t renderer) const {
     const WarpedFrame warped =
         warpFrame(earlier.frames[renderer], earlier.depth, earlier.camera, later.frames[renderer],
                   later.depth, later.camera, options_.warp);
-    return warpedFlip(later.perceived[renderer], warped);
+    return warpedFlip(laterFrame, warped);
 }
 
 void TemporalFlip::finish(std::vector<RendererSeries>& series) const {

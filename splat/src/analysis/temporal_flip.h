@@ -30,9 +30,10 @@ class TemporalFlip {
         Camera camera;
         Image depth;
         std::vector<Image> frames;
-        std::vector<FlipImage> perceived;
     };
-    double pairFlip(const Past& earlier, const Past& later, std::size_t renderer) const;
+    /// FLIP_k of renderer's frame of `later` (perceived: `laterFrame`) and `earlier` warped to it.
+    double pairFlip(const Past& earlier, const Past& later, const FlipImage& laterFrame,
+                    std::size_t renderer) const;
 
     const PoppingOptions& options_;
     const Volume& geometry_;
