@@ -13,6 +13,7 @@
 #include <numbers>
 #include <vector>
 
+#include "analysis/flip_image.h"
 #include "splat/error.h"
 #include "splat/flip.h"
 #include "splat/image_io.h"
@@ -147,6 +148,30 @@ TEST_CASE("flip: identical images give exactly zero", "[flip]") {
     CHECK(std::all_of(map.begin(), map.end(), [](float v) { return v == 0.0f; }));
     CHECK(flipMean(a, a) == 0.0);
     CHECK(flipMeanSrgb(a, a) == 0.0);
+}
+
+TEST_CASE("flip: images perceived once give the pair's map bit for bit", "[flip]") {
+    // A frame compared with several (analysis/flip_image.h) is filtered once; the maps are
+    // the pair's own, at any pixels per degree, in both orders.
+    const Image a = scene(67, 43, 1), b = scene(67, 43, 2);
+    for (const double ppd : {10.0, 67.02}) {
+        FlipOptions o;
+        o.pixelsPerDegree = ppd;
+        const analysis::FlipImage pa(a, o), pb(b, o);
+        const std::vector<float> pair = flipErrorMap(a, b, o),
+                                 once = analysis::flipErrorMap(pa, pb);
+        CHECK(once == pair);
+        CHECK(analysis::flipErrorMap(pb, pa) == flipErrorMap(b, a, o));
+        CHECK(analysis::flipMean(pa, pb) == flipMean(a, b, o));
+        CHECK(flipMean(a, b, o) > 0.01);
+    }
+    // Different sizes or observers are refused.
+    FlipOptions near;
+    near.pixelsPerDegree = 10;
+    CHECK_THROWS_AS(analysis::flipMean(analysis::FlipImage(a), analysis::FlipImage(a, near)),
+                    Error);
+    CHECK_THROWS_AS(
+        analysis::flipMean(analysis::FlipImage(a), analysis::FlipImage(scene(43, 67, 1))), Error);
 }
 
 TEST_CASE("flip: the error map lies in [0, 1], also for out-of-range and NaN input", "[flip]") {

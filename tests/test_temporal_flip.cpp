@@ -12,6 +12,7 @@
 
 #include "cli_util.h"
 #include "gaussian_pop_util.h"
+#include "reference/reference_frame.h"
 #include "splat/depth.h"
 #include "splat/gaussians.h"
 #include "splat/popping.h"
@@ -184,6 +185,31 @@ TEST_CASE("temporal flip: the median-opacity depth", "[temporal]") {
     s.mode = RenderMode::Mip;
     const Scene mip(makeSynthetic("blob", 16), s);
     for (const glm::vec4& p : referenceDepth(mip, c).pixels) CHECK(p.a == 0);
+}
+
+TEST_CASE("reference depth: skipping the empty bricks changes no depth", "[temporal]") {
+    // Pre-classified, the depth march takes the samples outside the field's occupied bricks as
+    // 0 without evaluating them: the same sums, so the same depths bit for bit, orthographic
+    // and perspective, on a volume with empty space around and inside it.
+    for (const Projection projection : {Projection::Orthographic, Projection::Perspective}) {
+        RenderSettings s;
+        s.transfer = TransferFunction::preset("ct-bone");
+        s.camera.width = s.camera.height = 48;
+        s.camera.azimuthDeg = 33;
+        s.camera.elevationDeg = 21;
+        s.camera.projection = projection;
+        const Scene scene(makeSynthetic("ct-phantom", 40), s);
+        const Camera camera(s.camera, scene.volume());
+        const Image skipped = dvrMedianDepth(scene, camera, true);
+        const Image full = dvrMedianDepth(scene, camera, false);
+        int valid = 0, empty = 0;
+        for (std::size_t p = 0; p < full.pixels.size(); ++p) {
+            (full.pixels[p].a > 0 ? valid : empty) += 1;
+            CHECK(skipped.pixels[p] == full.pixels[p]);
+        }
+        CHECK(valid > 300);
+        CHECK(empty > 100);
+    }
 }
 
 TEST_CASE("temporal flip: a textured plane warps exactly, up to the sampling", "[temporal]") {

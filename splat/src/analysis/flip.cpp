@@ -29,6 +29,7 @@
 #include <utility>
 #include <vector>
 
+#include "analysis/flip_image.h"
 #include "splat/error.h"
 
 namespace splat {
@@ -457,17 +458,9 @@ Image srgbDecoded(const Image& im) {
     return out;
 }
 
-}  // namespace
-
-std::vector<float> flipErrorMap(const Image& test, const Image& reference,
-                                const FlipOptions& options) {
-    checkInputs(test, reference, options);
-    const int w = test.width, h = test.height;
-    const Filters filters(options.pixelsPerDegree);
-    RowPassed scratch(filters, w, h);
-    const Perceived t = perceive(test, filters, scratch);
-    const Perceived r = perceive(reference, filters, scratch);
-
+// Per pixel ΔE of two perceived images of the same size.
+std::vector<float> errorMap(const Perceived& t, const Perceived& r) {
+    const int w = t.edge.width, h = t.edge.height;
     static const ColourRemap remap;
     std::vector<float> map(std::size_t(w) * std::size_t(h));
     forRows(h, [&](int y, NoScratch&) {
@@ -490,6 +483,16 @@ std::vector<float> flipErrorMap(const Image& test, const Image& reference,
     return map;
 }
 
+}  // namespace
+
+std::vector<float> flipErrorMap(const Image& test, const Image& reference,
+                                const FlipOptions& options) {
+    checkInputs(test, reference, options);
+    const Filters filters(options.pixelsPerDegree);
+    RowPassed scratch(filters, test.width, test.height);
+    return errorMap(perceive(test, filters, scratch), perceive(reference, filters, scratch));
+}
+
 double flipMean(const Image& test, const Image& reference, const FlipOptions& options) {
     return meanOf(flipErrorMap(test, reference, options));
 }
@@ -503,5 +506,36 @@ std::vector<float> flipErrorMapSrgb(const Image& test, const Image& reference,
 double flipMeanSrgb(const Image& test, const Image& reference, const FlipOptions& options) {
     return meanOf(flipErrorMapSrgb(test, reference, options));
 }
+
+namespace analysis {
+
+struct FlipImage::Maps {
+    Perceived perceived;
+};
+
+FlipImage::FlipImage(const Image& image, const FlipOptions& options)
+    : width_(image.width), height_(image.height), pixelsPerDegree_(options.pixelsPerDegree) {
+    checkInputs(image, image, options);
+    const Filters filters(options.pixelsPerDegree);
+    RowPassed scratch(filters, image.width, image.height);
+    maps_ = std::make_shared<const Maps>(Maps{perceive(image, filters, scratch)});
+}
+
+std::vector<float> flipErrorMap(const FlipImage& test, const FlipImage& reference) {
+    if (test.width() != reference.width() || test.height() != reference.height())
+        throw Error("flip: image sizes differ (" + std::to_string(test.width()) + "x" +
+                    std::to_string(test.height()) + " vs reference " +
+                    std::to_string(reference.width()) + "x" + std::to_string(reference.height()) +
+                    ")");
+    if (test.pixelsPerDegree() != reference.pixelsPerDegree())
+        throw Error("flip: the two images were perceived at different pixels per degree");
+    return errorMap(test.maps().perceived, reference.maps().perceived);
+}
+
+double flipMean(const FlipImage& test, const FlipImage& reference) {
+    return meanOf(flipErrorMap(test, reference));
+}
+
+}  // namespace analysis
 
 }  // namespace splat

@@ -13,6 +13,7 @@
 #include <numeric>
 
 #include "frame/stopwatch.h"
+#include "analysis/flip_image.h"
 #include "analysis/median.h"
 #include "analysis/temporal_flip.h"
 #include "frame_journal.h"
@@ -64,10 +65,12 @@ std::vector<std::string> rendererNames(const PoppingOptions& options) {
     return options.names;
 }
 
-/// One view rendered by every renderer.
+/// One view rendered by every renderer; a sweep's views with FLIP also the frames as FLIP
+/// perceives them (each compared with the reference, the previous view and its warped past).
 struct View {
     std::vector<Image> images;
     std::vector<RenderStats> stats;
+    std::vector<analysis::FlipImage> perceived;
 };
 
 class Analyzer {
@@ -165,6 +168,7 @@ class Analyzer {
                 for (const glm::vec4& p : im.pixels)
                     peak = std::max({peak, double(std::abs(p.r)), double(std::abs(p.g)),
                                      double(std::abs(p.b))});
+            perceive(cur);
             measureView(r, v, cur, prev, frameMs);
             measureWarped(r, v, cur);
             prev = std::move(cur);
@@ -180,7 +184,7 @@ class Analyzer {
         if (!options_.renderFrame && !options_.renderNamed && sceneTruth)
             renderSequence(*scene_, kinds_, path, so, [&](SequenceFrame&& f) {
                 readUpTo(f.view);
-                View cur{std::move(f.images), std::move(f.stats)};
+                View cur{std::move(f.images), std::move(f.stats), {}};
                 if (!options_.frameJournal.empty())
                     for (std::size_t k = 0; k < kinds_.size(); ++k)
                         journal::storeFrame(journalFile(r.angles[f.view], k), cur.images[k],
@@ -255,11 +259,12 @@ class Analyzer {
             s.thumbnails.push_back(downscale(cur.images[k], options_.thumbnail));
             if (ref_ >= 0) {
                 s.e.push_back(rmsDiff(cur.images[k], cur.images[ref_]));
-                s.flipRef.push_back(flip(cur.images[k], cur.images[ref_]));
+                // FLIP of identical images is exactly 0 (splat/flip.h).
+                s.flipRef.push_back(int(k) == ref_ ? 0.0 : flip(cur, cur, k, ref_));
             }
             if (n > 0) {
                 s.T.push_back(rmsDiff(cur.images[k], prev.images[k]));
-                s.flipT.push_back(flip(cur.images[k], prev.images[k]));
+                s.flipT.push_back(flip(cur, prev, k, k));
                 if (ref_ >= 0)
                     s.J.push_back(rmsDiff(cur.images[k], cur.images[ref_], &prev.images[k],
                                           &prev.images[ref_]));
@@ -276,7 +281,7 @@ class Analyzer {
         if (!temporal_.enabled()) return;
         std::vector<Image> shown;
         for (const Image& im : cur.images) shown.push_back(display(im));
-        temporal_.addView(n, cameraAt_(r.angles[n]), shown, r.series);
+        temporal_.addView(n, cameraAt_(r.angles[n]), shown, cur.perceived, r.series);
     }
 
   private:
@@ -459,12 +464,18 @@ class Analyzer {
         return out;
     }
 
-    /// Mean LDR-FLIP of two frames.
-    double flip(const Image& test, const Image& reference) const {
-        if (!options_.flip) return 0;
+    /// The view's frames as FLIP perceives them (shown as display() shows them), once.
+    void perceive(View& v) const {
+        if (!options_.flip) return;
         FlipOptions fo;
         fo.pixelsPerDegree = options_.pixelsPerDegree;
-        return flipMean(display(test), display(reference), fo);
+        for (const Image& im : v.images) v.perceived.emplace_back(display(im), fo);
+    }
+
+    /// Mean LDR-FLIP of renderer k's frame of `test` against renderer j's of `reference`.
+    double flip(const View& test, const View& reference, std::size_t k, std::size_t j) const {
+        if (!options_.flip) return 0;
+        return analysis::flipMean(test.perceived[k], reference.perceived[j]);
     }
 
     const Scene* scene_;

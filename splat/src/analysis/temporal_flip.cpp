@@ -34,7 +34,9 @@ TemporalFlip::TemporalFlip(const PoppingOptions& options, const Volume& geometry
 }
 
 void TemporalFlip::addView(std::size_t n, const CameraParams& camera,
-                           const std::vector<Image>& frames, std::vector<RendererSeries>& series) {
+                           const std::vector<Image>& frames,
+                           const std::vector<FlipImage>& perceived,
+                           std::vector<RendererSeries>& series) {
     if (!enabled_) return;
     Past view{Camera(camera, geometry_),
               scene_ ? referenceDepth(*scene_, camera) : options_.depthFrame(camera), frames};
@@ -42,18 +44,18 @@ void TemporalFlip::addView(std::size_t n, const CameraParams& camera,
     if (past_.size() > kFar + 1) past_.pop_front();
     const Past& now = past_.back();
     for (std::size_t k = 0; k < series.size(); ++k) {
-        if (n >= 1) series[k].flipWarp1.push_back(pairFlip(past_[past_.size() - 2], now, k));
-        if (n >= kFar) series[k].flipWarp7.push_back(pairFlip(past_.front(), now, k));
+        if (n >= 1)
+            series[k].flipWarp1.push_back(pairFlip(past_[past_.size() - 2], now, perceived[k], k));
+        if (n >= kFar) series[k].flipWarp7.push_back(pairFlip(past_.front(), now, perceived[k], k));
     }
 }
 
-double TemporalFlip::pairFlip(const Past& earlier, const Past& later, std::size_t renderer) const {
+double TemporalFlip::pairFlip(const Past& earlier, const Past& later, const FlipImage& laterFrame,
+                              std::size_t renderer) const {
     const WarpedFrame warped =
         warpFrame(earlier.frames[renderer], earlier.depth, earlier.camera, later.frames[renderer],
                   later.depth, later.camera, options_.warp);
-    FlipOptions fo;
-    fo.pixelsPerDegree = options_.pixelsPerDegree;
-    return warpedFlip(later.frames[renderer], warped, fo);
+    return warpedFlip(laterFrame, warped);
 }
 
 void TemporalFlip::finish(std::vector<RendererSeries>& series) const {

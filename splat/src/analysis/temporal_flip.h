@@ -5,6 +5,7 @@
 #include <deque>
 #include <vector>
 
+#include "analysis/flip_image.h"
 #include "splat/popping.h"
 #include "splat/scene.h"
 
@@ -16,10 +17,11 @@ class TemporalFlip {
     /// the cameras (the Scene's volume, or a Gaussian scene's geometry()).
     TemporalFlip(const PoppingOptions& options, const Volume& geometry, const Scene* scene);
     bool enabled() const { return enabled_; }
-    /// View n of the sweep (views in order): `frames` per renderer as FLIP sees them.
+    /// View n of the sweep (views in order): `frames` per renderer as FLIP sees them, and
+    /// `perceived` the same perceived by FLIP (analysis/flip_image.h).
     /// Appends FLIP_1 (n >= 1) and FLIP_7 (n >= 7) to each series.
     void addView(std::size_t n, const CameraParams& camera, const std::vector<Image>& frames,
-                 std::vector<RendererSeries>& series);
+                 const std::vector<FlipImage>& perceived, std::vector<RendererSeries>& series);
     /// The means over the pairs with valid pixels.
     void finish(std::vector<RendererSeries>& series) const;
 
@@ -29,7 +31,9 @@ class TemporalFlip {
         Image depth;
         std::vector<Image> frames;
     };
-    double pairFlip(const Past& earlier, const Past& later, std::size_t renderer) const;
+    /// FLIP_k of renderer's frame of `later` (perceived: `laterFrame`) and `earlier` warped to it.
+    double pairFlip(const Past& earlier, const Past& later, const FlipImage& laterFrame,
+                    std::size_t renderer) const;
 
     const PoppingOptions& options_;
     const Volume& geometry_;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "analysis/flip_image.h"
 #include "splat/error.h"
 
 namespace splat {
@@ -97,11 +98,22 @@ WarpedFrame warpFrame(const Image& earlier, const Image& earlierDepth, const Cam
 
 double warpedFlip(const Image& later, const WarpedFrame& warped, const FlipOptions& options) {
     if (warped.validCount == 0) return -1;
-    const std::vector<float> map = flipErrorMap(later, warped.image, options);
+    return analysis::warpedFlip(analysis::FlipImage(later, options), warped);
+}
+
+namespace analysis {
+
+double warpedFlip(const FlipImage& later, const WarpedFrame& warped) {
+    if (warped.validCount == 0) return -1;
+    FlipOptions options;
+    options.pixelsPerDegree = later.pixelsPerDegree();
+    const std::vector<float> map = flipErrorMap(later, FlipImage(warped.image, options));
     double sum = 0;
     for (std::size_t p = 0; p < map.size(); ++p)
         if (warped.valid[p]) sum += map[p];
     return sum / double(warped.validCount);
 }
+
+}  // namespace analysis
 
 }  // namespace splat

@@ -3,7 +3,8 @@
 // spacing (stopping once the optical depth exceeds 20) through the reference's extinction field
 // rho(x) (pre-classified: the kernel sum of the splats' rho_i; post-classified: the transfer
 // function's extinction of f(x)); the optical depth is integrated by the trapezoid rule and t_1/2
-// interpolated linearly within the step where it is crossed.
+// interpolated linearly within the step where it is crossed. Pre-classified, the samples outside
+// the field's occupied bricks are 0 without being evaluated (the same sums, fewer lookups).
 #include "splat/depth.h"
 
 #include <tbb/parallel_for.h>
@@ -12,10 +13,12 @@
 #include <cmath>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "model/scene_impl.h"
 #include "reference/field.h"
+#include "reference/reference_frame.h"
 
 namespace splat {
 
@@ -84,7 +87,33 @@ double medianOpacityDepth(const std::vector<double>& rho, double t0, double dt) 
     return t0 + (double(n - 1) + f) * dt;
 }
 
-Image dvrDepth(const Scene& scene, const Camera& camera) {
+/// Pre-classified: which samples of a ray may see extinction. The field is exactly 0 outside
+/// the bricks the field grid marks occupied (reference/field.h), so a sample there is 0
+/// without its sum. Samples within a thousandth of a step of an occupied segment are evaluated
+/// too, so that the segments' and the samples' rounding cannot skip a non-zero sample.
+class OccupiedSpans {
+  public:
+    OccupiedSpans(const FieldGrid<1>& grid, const Volume& volume, const Ray& ray, double t0,
+                  double t1, double dt)
+        : margin_(1e-3 * dt) {
+        const glm::dvec3 p0 = (ray.origin - volume.origin) / volume.spacing;
+        raySegments(grid, p0, ray.dir / volume.spacing, t0, t1, segments_);
+    }
+    /// Whether the sample at t (called with t increasing) lies in or near an occupied segment.
+    bool occupied(double t) {
+        while (next_ < segments_.size() && t > segments_[next_].b + margin_) ++next_;
+        return next_ < segments_.size() && t >= segments_[next_].a - margin_;
+    }
+
+  private:
+    double margin_;
+    std::vector<Segment> segments_;
+    std::size_t next_ = 0;
+};
+
+}  // namespace
+
+Image dvrMedianDepth(const Scene& scene, const Camera& camera, bool skipEmpty) {
     const Scene::Impl& impl = scene.impl();
     const Volume& volume = *impl.volume;
     const ReferenceField& field = impl.state<DepthField>().field();
@@ -109,9 +138,14 @@ Image dvrDepth(const Scene& scene, const Camera& camera) {
             if (!(t1 > t0)) continue;
             const int steps = int(std::ceil((t1 - t0) / dt));
             rho.resize(std::size_t(steps) + 1);
+            // Post-classified, empty space has the transfer function's extinction at b.
+            std::optional<OccupiedSpans> spans;
+            if (pre && skipEmpty)
+                spans.emplace(field.grid1(), volume, ray, t0, t0 + steps * dt, dt);
             double tau = 0;
             for (int n = 0; n <= steps; ++n) {
-                rho[n] = extinction(ray.origin + (t0 + n * dt) * ray.dir);
+                const double t = t0 + n * dt;
+                rho[n] = spans && !spans->occupied(t) ? 0.0 : extinction(ray.origin + t * ray.dir);
                 tau += rho[n] * dt;
                 if (tau > kOpaque) {
                     rho.resize(std::size_t(n) + 1);
@@ -125,8 +159,6 @@ Image dvrDepth(const Scene& scene, const Camera& camera) {
     return depth;
 }
 
-}  // namespace
-
 Image referenceDepth(const Scene& scene, const CameraParams& params) {
     const RenderSettings& s = scene.settings();
     if (s.mode == RenderMode::Iso) {
@@ -138,7 +170,7 @@ Image referenceDepth(const Scene& scene, const CameraParams& params) {
     const Camera camera(params, scene.volume());
     if (s.mode != RenderMode::Dvr) return Image(camera.width(), camera.height());
     Image depth;
-    runOnThreads(s.threads, [&] { depth = dvrDepth(scene, camera); });
+    runOnThreads(s.threads, [&] { depth = dvrMedianDepth(scene, camera); });
     return depth;
 }
 

@@ -47,4 +47,8 @@ Image referenceFrame(const Scene::Impl& scene, const Camera& camera, const Rende
 Image filteredReferenceFrame(const Scene::Impl& scene, const Camera& camera,
                              const RenderSettings& s, RenderStats& stats, Image* depth);
 
+/// The dvr median-opacity depth of referenceDepth (splat/depth.h) on the calling thread's arena.
+/// `skipEmpty` false evaluates every sample, also where the field is 0 (the tests compare).
+Image dvrMedianDepth(const Scene& scene, const Camera& camera, bool skipEmpty = true);
+
 }  // namespace splat
