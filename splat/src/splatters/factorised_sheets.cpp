@@ -348,7 +348,6 @@ struct BandBuffer {
     std::vector<int> nextClosed;  ///< per block, the first opaque block at or after it
     int opaqueCount = 0;
     std::size_t weights = 0, hidden = 0;
-    std::vector<int> rowX0, rowX1;  ///< per band row, the columns written since its composite
     float* at(int y, int x) {
         return &sheet[4 * (std::size_t(y) * stride + std::size_t(x + margin))];
     }
@@ -572,24 +571,6 @@ void prefetchRows(const Rows& list, int q, int vLo, int vHi) {
     }
 }
 
-/// Composites band rows [from, to) of the sheet buffer (each over the columns written since
-/// its last composite, within the window) into `out` and clears them; returns the first row
-/// not composited. A sheet's rows are composited as soon as no later row of its voxels writes
-/// them, while they are still in the cache.
-int compositeRows(const Factorisation& f, int from, int to, CompositeOrder order, Composited& out,
-                  BandBuffer& band) {
-    for (int y = from; y < std::min(to, band.rows); ++y) {
-        int& x0 = band.rowX0[std::size_t(y)];
-        int& x1 = band.rowX1[std::size_t(y)];
-        if (x1 < x0) continue;
-        compositeAndClear(band.at(y, 0), x0, x1, std::max(x0, 0), std::min(x1, f.width - 1),
-                          std::size_t(band.row0 + y) * f.width, order, out);
-        x0 = std::numeric_limits<int>::max();
-        x1 = -1;
-    }
-    return std::max(from, std::min(to, band.rows));
-}
-
 /// Adds the stamps of sheet q's splats that meet the band into its buffer. Front to back with
 /// early termination, a splat is skipped when the blocks under its stamp's box (stampW
 /// columns, wider than the footprint's support) are all opaque: testing the support alone
@@ -599,7 +580,7 @@ int compositeRows(const Factorisation& f, int from, int to, CompositeOrder order
 /// samples add splat by splat (addStampRows).
 template <class Rows>
 Written addSheet(const Factorisation& f, const Rows& list, int q, int next, const SheetStamp& st,
-                 CompositeOrder order, Composited& out, BandBuffer& band) {
+                 BandBuffer& band) {
     const int n = f.n;
     // Voxel rows whose stamp rows n v + st.b + dB - b0 + [yMin, yMax] meet the band.
     const int top = st.b + f.dB - f.b0;
@@ -609,10 +590,7 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, int next, cons
     if (next >= 0 && vLo <= vHi) prefetchRows(list, next, vLo, vHi);
     RowRun run{band.vals, f.stampW + 2};
     Written w;
-    int flushed = 0;  // band rows [0, flushed) composited
     for (int v = vLo; v <= vHi; ++v) {
-        // Rows above the next voxel row's stamp are complete: composite them while hot.
-        flushed = compositeRows(f, flushed, n * v + top - band.row0 + st.yMin, order, out, band);
         const auto [pFirst, pEnd] = list.range(q, v);
         const int row = n * v + top - band.row0;  // stamp row 0, band rows
         const int ys = std::max(st.yMin, -row), ye = std::min(st.yMax + 1, band.rows - row);
@@ -653,12 +631,7 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, int next, cons
         w.x1 = std::max(w.x1, last);
         w.y0 = std::min(w.y0, row + ys);
         w.y1 = std::max(w.y1, row + ye - 1);
-        for (int y = row + ys; y < row + ye; ++y) {
-            band.rowX0[std::size_t(y)] = std::min(band.rowX0[std::size_t(y)], first);
-            band.rowX1[std::size_t(y)] = std::max(band.rowX1[std::size_t(y)], last);
-        }
     }
-    compositeRows(f, flushed, band.rows, order, out, band);
     return w;
 }
 
@@ -707,8 +680,6 @@ std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Row
     band.sheet.assign(4 * std::size_t(band.stride) * std::size_t(rows), 0.0f);
     if (f.n <= 2)
         band.vals.assign(4 * (std::size_t(f.rowLength) + 2 * std::size_t(f.stampW) + 8), 0.0f);
-    band.rowX0.assign(std::size_t(rows), std::numeric_limits<int>::max());
-    band.rowX1.assign(std::size_t(rows), -1);
     band.terminates = order == CompositeOrder::FrontToBack && earlyTermination > 0;
     band.threshold = float(1.0 - earlyTermination);
     const int blocks = (f.width + kBlock - 1) / kBlock;
@@ -719,9 +690,13 @@ std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Row
     for (int k = 0; k < sheets && !(band.terminates && band.opaqueCount == blocks); ++k) {
         const int q = f.ascending ? k : sheets - 1 - k;
         const int next = k + 1 < sheets ? (f.ascending ? q + 1 : q - 1) : -1;
-        const Written w = addSheet(f, list, q, next, stamps[std::size_t(q)], order, out, band);
+        const Written w = addSheet(f, list, q, next, stamps[std::size_t(q)], band);
         if (w.x1 < w.x0) continue;
+        // Composite the written rectangle (its part inside the window), then clear it.
         const int c0 = std::max(w.x0, 0), c1 = std::min(w.x1, f.width - 1);
+        for (int y = w.y0; y <= w.y1; ++y)
+            compositeAndClear(band.at(y, 0), w.x0, w.x1, c0, c1, std::size_t(row0 + y) * f.width,
+                              order, out);
         if (band.terminates && c1 >= c0) markOpaqueBlocks(f, out, c0, c1, band);
     }
     return {band.weights, band.hidden};
