@@ -407,13 +407,20 @@ template <int Taps>
 inline void convolveRowLanes(float* out, const float* vals, const float* w, int taps, int x0,
                              int x1) {
     if constexpr (Taps > 0) {
-        __m256 wt[Taps];
-        for (int t = 0; t < Taps; ++t) wt[t] = _mm256_set1_ps(w[4 * t]);
+        // The voxel pairs (x - t, x - t + 1) of output pair x held in registers: two loads
+        // per output pair instead of Taps.
+        __m256 wt[Taps], vt[Taps];
+        for (int t = 0; t < Taps; ++t) {
+            wt[t] = _mm256_set1_ps(w[4 * t]);
+            vt[t] = _mm256_loadu_ps(vals + 4 * (x0 - t));
+        }
         for (int x = x0; x <= x1; x += 2) {
             __m256 acc = _mm256_loadu_ps(out + 4 * x);
-            for (int t = Taps - 1; t >= 0; --t)
-                acc = _mm256_fmadd_ps(wt[t], _mm256_loadu_ps(vals + 4 * (x - t)), acc);
+            for (int t = Taps - 1; t >= 0; --t) acc = _mm256_fmadd_ps(wt[t], vt[t], acc);
             _mm256_storeu_ps(out + 4 * x, acc);
+            for (int t = Taps - 1; t > 1; --t) vt[t] = vt[t - 2];
+            if constexpr (Taps > 1) vt[1] = _mm256_loadu_ps(vals + 4 * (x + 1));
+            vt[0] = _mm256_loadu_ps(vals + 4 * (x + 2));
         }
     } else {
         for (int x = x0; x <= x1; x += 2) {
@@ -436,13 +443,18 @@ inline void convolvePairsLanes(float* out, const float* vals, const float* w, in
         return _mm256_broadcast_ps(reinterpret_cast<const __m128*>(vals + 4 * u));
     };
     if constexpr (Pairs > 0) {
-        __m256 wk[Pairs];
-        for (int k = 0; k < Pairs; ++k) wk[k] = _mm256_loadu_ps(w + 8 * k);
+        // The voxels m - k of output pair m held in registers, each loaded once per row.
+        __m256 wk[Pairs], vk[Pairs];
+        for (int k = 0; k < Pairs; ++k) {
+            wk[k] = _mm256_loadu_ps(w + 8 * k);
+            vk[k] = voxel(x0 / 2 - k);
+        }
         for (int x = x0; x <= x1; x += 2) {
             __m256 acc = _mm256_loadu_ps(out + 4 * x);
-            const int m = x / 2;
-            for (int k = Pairs - 1; k >= 0; --k) acc = _mm256_fmadd_ps(wk[k], voxel(m - k), acc);
+            for (int k = Pairs - 1; k >= 0; --k) acc = _mm256_fmadd_ps(wk[k], vk[k], acc);
             _mm256_storeu_ps(out + 4 * x, acc);
+            for (int k = Pairs - 1; k > 0; --k) vk[k] = vk[k - 1];
+            vk[0] = voxel(x / 2 + 1);
         }
     } else {
         for (int x = x0; x <= x1; x += 2) {
