@@ -52,7 +52,7 @@ void writeSeriesB(const fs::path& dir) {
         s.seriesNumber = 4;
         s.description = "scout";
         s.stored = {1, 2, 3, 4};
-        writeDicomSlice(dir / ("b" + std::to_string(k) + ".dcm"), s);
+        writeDicomSlice(dir / ("b" + std::to_string(k)).append(".dcm"), s);
     }
 }
 
