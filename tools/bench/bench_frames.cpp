@@ -108,6 +108,10 @@ int renderRotation(const std::string& spec, const std::string& tf,
     int factorised = 0;
     app.add_option("--factorised-sheets", factorised,
                    "axis-aligned: factorised sheets with N samples per voxel (0: off)");
+    double warpTolerance = -1;
+    app.add_option("--warp-tolerance", warpTolerance,
+                   "factorised sheets: per-splat pixels where the warp's third difference "
+                   "exceeds this (0: off)");
     // --size N means N x N.
     for (std::size_t i = 0; i + 1 < args.size(); ++i)
         if (args[i] == "--size" && args[i + 1].find_first_of("xX") == std::string::npos)
@@ -129,6 +133,7 @@ int renderRotation(const std::string& spec, const std::string& tf,
     // Given, it wins over the frame design a --quality preset chose.
     if (app.get_option("--factorised-sheets")->count() > 0)
         s.quality.factorisedSheets = factorised;
+    if (warpTolerance >= 0) s.quality.warpTolerance = warpTolerance;
     frames = std::max(1, frames);
     const double elevation = s.camera.elevationDeg;
     const bool warmup = warmupFlag != 0;
@@ -190,7 +195,9 @@ int renderRotation(const std::string& spec, const std::string& tf,
              << ", \"project_ms\": " << st.projectMs << ", \"order_ms\": " << st.orderMs
              << ", \"bin_ms\": " << st.binMs << ", \"tiles_ms\": " << st.tilesMs
              << ", \"footprint_pixels\": " << st.footprintPixels
-             << ", \"culled_splats\": " << st.culledSplats << ", \"sheets\": " << st.sheets
+             << ", \"culled_splats\": " << st.culledSplats
+             << ", \"warp_fix_pixels\": " << st.warpFixPixels
+             << ", \"warp_fix_tiles\": " << st.warpFixTiles << ", \"sheets\": " << st.sheets
              << ", \"lod_level\": " << st.lodLevel << ", \"lod_splats\": " << st.lodSplats
              << ", \"pixel_samples\": " << st.pixelSamples
              << ", \"pixel_filter_change\": " << st.pixelFilterChange

@@ -184,6 +184,11 @@ struct Quality {
     /// per-frame footprint stamps at P x P sub-pixel phases instead of the footprint
     /// polynomial per pixel. Other frames ignore it.
     int factorisedSheets = 0;
+    /// Factorised sheets (factorisedSheets >= 1): a pixel whose spline taps on the
+    /// intermediate image have a third difference above this, in any premultiplied channel,
+    /// is an edge the warp cannot follow and is rendered by the per-splat frame instead, in
+    /// the tiles that hold such pixels (0: every pixel warped).
+    double warpTolerance = 0;
     /// The EWA low-pass when pixelFilter is 0, pixels (pbrt-v4's Gaussian pixel filter).
     static constexpr double kEwaDefaultSigma = 0.5;
     /// Ewa::Auto turns EWA on while a voxel covers fewer pixels than this (measured: docs/accuracy.md "Aliasing and EWA").
@@ -242,6 +247,9 @@ struct RenderStats {
     /// a kernel straddles or lies behind the perspective near plane (eye inside or within
     /// two kernel radii of the volume's kernels), where a local-affine footprint is invalid.
     std::size_t exactPixels = 0;
+    /// Factorised sheets with Quality::warpTolerance: pixels taken from the per-splat frame
+    /// (edges the warp cannot follow), and the tiles it rendered for them.
+    std::size_t warpFixPixels = 0, warpFixTiles = 0;
     /// Why pixels went to the exact path (empty when none did): a splatter's frame with
     /// exactPixels > 0 is the reference's, and comparing it with the reference says nothing.
     /// The command line prints it as a warning; popping and study reports mark such frames.

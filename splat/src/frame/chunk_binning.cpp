@@ -41,22 +41,26 @@ PixelRect footprintRectOfCentres(float x0, float x1, float y0, float y1,
 }
 }  // namespace
 
-Occlusion::Occlusion(const TileGrid& grid, const std::vector<TileAccumulator>& tiles, bool cull)
+Occlusion::Occlusion(const TileGrid& grid, const std::vector<TileAccumulator>& tiles, bool cull,
+                     const std::vector<std::uint8_t>* only)
     : g_(grid),
-      cull_(cull),
+      cull_(cull || only),
       mask_(std::size_t(grid.count()), 0),
       blocksX_(std::size_t(grid.count()), 0) {
-    if (!cull) return;
+    if (!cull_) return;
     tbb::parallel_for(0, g_.count(), [&](int t) {
         const TileAccumulator& acc = tiles[std::size_t(t)];
         const int bx = (acc.width() + kBlock - 1) / kBlock,
                   by = (acc.height() + kBlock - 1) / kBlock;
         blocksX_[std::size_t(t)] = bx;
         std::uint64_t m = 0;
-        for (int y = 0; y < by; ++y)
-            for (int x = 0; x < bx; ++x)
-                if (acc.rectOpaque(x * kBlock, y * kBlock, x * kBlock, y * kBlock))
-                    m |= std::uint64_t(1) << (y * bx + x);
+        if (only && !(*only)[std::size_t(t)])
+            m = bx * by == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << (bx * by)) - 1;
+        else if (cull)
+            for (int y = 0; y < by; ++y)
+                for (int x = 0; x < bx; ++x)
+                    if (acc.rectOpaque(x * kBlock, y * kBlock, x * kBlock, y * kBlock))
+                        m |= std::uint64_t(1) << (y * bx + x);
         mask_[std::size_t(t)] = m;
     });
 }

@@ -19,10 +19,13 @@
 namespace splat {
 
 /// The tiles' opaque 4x4 blocks at the start of a chunk, one bit per block (early splat
-/// elimination; all clear unless `cull`).
+/// elimination; all clear unless `cull`). With `only` (one flag per tile), the tiles not
+/// flagged count as opaque everywhere: a frame of those tiles alone bins and draws nothing
+/// for the others, and skips the bricks that reach none of its tiles.
 class Occlusion {
   public:
-    Occlusion(const TileGrid& grid, const std::vector<TileAccumulator>& tiles, bool cull);
+    Occlusion(const TileGrid& grid, const std::vector<TileAccumulator>& tiles, bool cull,
+              const std::vector<std::uint8_t>* only = nullptr);
     bool enabled() const { return cull_; }
     /// True unless tile (tx, ty) is opaque over every block the box `r` (image pixels)
     /// touches.

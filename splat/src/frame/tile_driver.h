@@ -64,6 +64,9 @@ struct TileInputs {
     const float *er, *eg, *eb;      ///< this view's shaded emission; null: the list's own
     const PolicyContext& policy;    ///< the frame's compositing policy and its parameters
     Image* isoPositions = nullptr;  ///< iso: per pixel, the hit's fractional sheet position
+    /// Streaming splatters (rasterizeChunks): one flag per tile of the frame's grid, the
+    /// tiles to render (null: all); the others are left empty.
+    const std::vector<std::uint8_t>* tiles = nullptr;
 };
 
 /// Most sheets one splat may span (the image-aligned splatter's limit) plus one.
@@ -382,13 +385,14 @@ Image rasterizeChunks(const TileInputs& in, const Policy& policy, const Cutter& 
     FrameProgress progress(in.settings.progress, sc.count, "chunks");
     for (std::size_t c = 0; c < sc.count; ++c) {
         const auto t0 = Clock::now();
-        const Occlusion occlusion(g, tiles, cull);
+        const Occlusion occlusion(g, tiles, cull, in.tiles);
         hidden += sc.gather(c, bins.ids, bins.runs, BrickTest(projector, occlusion));
         const VisitOrder order{&bins.ids, bins.ids.size(), false};
         hidden += binChunk(projector, order, bins.runs, g, occlusion, fields, bins);
         const auto t1 = Clock::now();
         tbb::parallel_for(0, g.count(), 1, [&](int t) {
             if (bins.begin[t] == bins.begin[t + 1] || progress.stopped()) return;
+            if (in.tiles && !(*in.tiles)[std::size_t(t)]) return;  // a huge footprint's entry
             const DenormalsAreZero ftz;
             const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
             sortBySheet(cutter, &bins.records[bins.begin[t]], &bins.records[bins.begin[t + 1]],

@@ -786,10 +786,35 @@ __attribute__((target("avx"))) void warpPairLanes(const glm::vec4* rgba, std::si
 }
 #endif
 
+/// The largest third difference, over the premultiplied channels, of the four samples from
+/// `o` in steps of `step` (a row of taps along a, or a column across rows): zero for any
+/// quadratic, which the Catmull-Rom spline reproduces, so it measures what the spline cannot
+/// follow (a step of height h between two taps gives up to 3 h).
+inline float thirdDifference(const glm::vec4* rgba, std::size_t o, std::size_t step) {
+    const glm::vec4 d = rgba[o + 3 * step] - 3.0f * rgba[o + 2 * step] +
+                        3.0f * rgba[o + step] - rgba[o];
+    const glm::vec4 a = glm::abs(d);
+    return std::max(std::max(a.x, a.y), std::max(a.z, a.w));
+}
+
+/// Whether the pixel's 4 x 4 taps hold an edge the warp cannot follow: a third difference
+/// along any of the four rows or four columns above `tolerance`.
+inline bool warpEdge(const glm::vec4* rgba, std::size_t width, const WarpTaps& t,
+                     float tolerance) {
+    for (int j = 0; j < 4; ++j) {
+        if (thirdDifference(rgba, t.o + std::size_t(j) * width, 1) > tolerance) return true;
+        if (thirdDifference(rgba, t.o + std::size_t(j), width) > tolerance) return true;
+    }
+    return false;
+}
+
 /// The screen image: the composited window at each pixel centre, by the Catmull-Rom spline
 /// through its samples (warpSum, two pixels at a time where the lanes are), clamped
-/// (clampWarped).
-Image warp(const Factorisation& f, const Composited& w, int width, int height) {
+/// (clampWarped). With `edges`, also flags (1) the pixels whose taps hold an edge the
+/// spline cannot follow (warpEdge at `tolerance`); pixels outside the window are never
+/// flagged (no splat reaches them).
+Image warp(const Factorisation& f, const Composited& w, int width, int height,
+           std::vector<std::uint8_t>* edges, float tolerance) {
     // The window as one (r, g, b, a) per sample: a tap is one load.
     std::vector<glm::vec4> rgba(w.r.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rgba.size(), 16384),
@@ -804,8 +829,13 @@ Image warp(const Factorisation& f, const Composited& w, int width, int height) {
 #else
     const bool lanes = false;
 #endif
+    if (edges) edges->assign(std::size_t(width) * std::size_t(height), 0);
     tbb::parallel_for(0, height, [&](int y) {
         WarpTaps t0, t1;
+        if (edges)
+            for (int x = 0; x < width; ++x)
+                if (warpTaps(f, x, y, t0) && warpEdge(rgba.data(), rowSamples, t0, tolerance))
+                    (*edges)[std::size_t(y) * std::size_t(width) + std::size_t(x)] = 1;
         for (int x = 0; x < width; ++x) {
             if (!warpTaps(f, x, y, t0)) continue;
 #if defined(FOOTPRINT_HAVE_LANES)
@@ -835,7 +865,8 @@ bool factorisedSheetsApply(const Camera& camera, const RenderSettings& s, bool l
 
 Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
                              const RenderSettings& s, const float* er, const float* eg,
-                             const float* eb, RenderStats& stats) {
+                             const float* eb, RenderStats& stats,
+                             std::vector<std::uint8_t>* edges) {
     const auto start = Clock::now();
     const Factorisation f = factorise(scene, camera, s);
     const glm::ivec3 dims = scene.volume->dims;
@@ -880,7 +911,8 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
                                           : renderBand(f, listRows, sheets, stamps, row0, rows,
                                                        s.order, s.quality.earlyTermination, w);
     });
-    Image image = warp(f, w, camera.width(), camera.height());
+    Image image = warp(f, w, camera.width(), camera.height(), edges,
+                       float(s.quality.warpTolerance));
     stats.tilesMs = msSince(tiles);
     stats.sheetAxis = f.m;
     stats.sheetSign = sheetAxis(camera.view, scene.volume->spacing).sign;

@@ -26,6 +26,9 @@
 // (docs/performance.md "Factorised sheets as the default design: measured, not kept").
 // Orthographic views only: perspective rays are not parallel, so a sheet's voxels do not
 // share one phase.
+#include <cstdint>
+#include <vector>
+
 #include "model/scene_impl.h"
 
 namespace splat {
@@ -38,9 +41,12 @@ bool factorisedSheetsApply(const Camera& camera, const RenderSettings& settings,
 
 /// The frame (premultiplied colour and opacity, no background) of the scene's splats in
 /// `camera` by factorised sheets; `er`, `eg`, `eb`: this view's shaded emission, or null for
-/// the list's own.
+/// the list's own. With `edges`, also one flag per pixel (row-major): 1 where the pixel's
+/// spline taps hold an edge the warp cannot follow (a third difference above
+/// Quality::warpTolerance in any channel), which the caller renders per splat instead.
 Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
                              const RenderSettings& settings, const float* er, const float* eg,
-                             const float* eb, RenderStats& stats);
+                             const float* eb, RenderStats& stats,
+                             std::vector<std::uint8_t>* edges = nullptr);
 
 }  // namespace splat

@@ -5,6 +5,7 @@
 //
 // The stages are free functions over plain arrays (frame/, splatters/); the two splatters
 // differ only in `order` and in how `tiles` cuts a kernel into sheets.
+#include <algorithm>
 #include <chrono>
 
 #include "frame/clip_cut.h"
@@ -90,6 +91,46 @@ Image isoDepthFromSheets(const Image& positions, const SheetPlan& plan, const Ca
     return depth;
 }
 
+/// Factorised sheets with Quality::warpTolerance: the pixels flagged in `edges` (where the
+/// warp cannot follow the intermediate image) taken from the per-splat frame, which renders
+/// only the tiles holding them (their pixels are the whole per-splat frame's bit for bit:
+/// the other tiles count as opaque to its culling, which only skips what they alone need).
+void fixEdges(const Splatter& splatter, const Scene::Impl& scene, const Camera& camera,
+              const RenderSettings& s, const Emission& e, const std::vector<std::uint8_t>& edges,
+              FrameWorkspace& work, RenderStats& stats, Image& image) {
+    const TileGrid g(camera.width(), camera.height(), s.quality.tileSize);
+    std::vector<std::uint8_t> tiles(std::size_t(g.count()), 0);
+    std::size_t flagged = 0;
+    for (int y = 0; y < camera.height(); ++y)
+        for (int x = 0; x < camera.width(); ++x)
+            if (edges[std::size_t(y) * std::size_t(camera.width()) + std::size_t(x)]) {
+                tiles[std::size_t(g.tileOf(y) * g.tilesX + g.tileOf(x))] = 1;
+                ++flagged;
+            }
+    if (flagged == 0) return;
+    RenderStats fixStats;
+    const SheetPlan plan = splatter.order(scene, camera, s, work, fixStats);
+    const PolicyContext ctx = policyContext(scene, camera, s);
+    TileInputs in{scene, camera, s, work.proj, work.bins, plan, e.r, e.g, e.b, ctx, nullptr};
+    in.tiles = &tiles;
+    const Image exact = splatter.rasterize(in, work, &fixStats);
+    // Whole tiles: the pixels beside a flagged one are near the same edge, and the per-splat
+    // frame has drawn them anyway.
+    for (int t = 0; t < g.count(); ++t) {
+        if (!tiles[std::size_t(t)]) continue;
+        const int ox = (t % g.tilesX) * g.tileSize, oy = (t / g.tilesX) * g.tileSize;
+        const int w = std::min(g.tileSize, g.width - ox), h = std::min(g.tileSize, g.height - oy);
+        for (int y = oy; y < oy + h; ++y)
+            std::copy_n(&exact.at(ox, y), w, &image.at(ox, y));
+        stats.warpFixPixels += std::size_t(w) * std::size_t(h);
+        ++stats.warpFixTiles;
+    }
+    stats.binMs += fixStats.binMs;
+    stats.tilesMs += fixStats.tilesMs;
+    stats.footprintPixels += fixStats.footprintPixels;
+    stats.culledSplats += fixStats.culledSplats;
+}
+
 }  // namespace
 
 Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSettings& s,
@@ -103,7 +144,11 @@ Image splatFrame(const Scene::Impl& scene, const Camera& camera, const RenderSet
     const Emission e = shade(scene, camera, *work, stats);
     if (!depth && factorisedSheetsApply(camera, s, scene.settings.labels.enabled,
                                         s.clipping.enabled(), stats.ewaSigma, scene.level)) {
-        Image image = renderFactorisedSheets(scene, camera, s, e.r, e.g, e.b, stats);
+        std::vector<std::uint8_t> edges;
+        const bool fix = s.quality.warpTolerance > 0 && splatter.streams();
+        Image image =
+            renderFactorisedSheets(scene, camera, s, e.r, e.g, e.b, stats, fix ? &edges : nullptr);
+        if (fix) fixEdges(splatter, scene, camera, s, e, edges, *work, stats, image);
         applyBackground(image, s.mode, s.background, scene.splats.background);
         return image;
     }
