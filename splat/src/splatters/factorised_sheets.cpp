@@ -786,33 +786,50 @@ __attribute__((target("avx"))) void warpPairLanes(const glm::vec4* rgba, std::si
 }
 #endif
 
-/// The largest third difference, over the premultiplied channels, of the four samples from
-/// `o` in steps of `step` (a row of taps along a, or a column across rows): zero for any
-/// quadratic, which the Catmull-Rom spline reproduces, so it measures what the spline cannot
-/// follow (a step of height h between two taps gives up to 3 h).
-inline float thirdDifference(const glm::vec4* rgba, std::size_t o, std::size_t step) {
-    const glm::vec4 d = rgba[o + 3 * step] - 3.0f * rgba[o + 2 * step] +
-                        3.0f * rgba[o + step] - rgba[o];
-    const glm::vec4 a = glm::abs(d);
-    return std::max(std::max(a.x, a.y), std::max(a.z, a.w));
-}
-
-/// Whether the pixel's 4 x 4 taps hold an edge the warp cannot follow: a third difference
-/// along any of the four rows or four columns above `tolerance`.
-inline bool warpEdge(const glm::vec4* rgba, std::size_t width, const WarpTaps& t,
-                     float tolerance) {
-    for (int j = 0; j < 4; ++j) {
-        if (thirdDifference(rgba, t.o + std::size_t(j) * width, 1) > tolerance) return true;
-        if (thirdDifference(rgba, t.o + std::size_t(j), width) > tolerance) return true;
+/// The warp's error at pixel (x, y), estimated: the spline through every other sample of the
+/// window (spacing 2 / n voxels) against the spline through every sample (warpSum of `t`).
+/// Where the image is smooth the spline's error is of order h^3, so the coarse one's is 8
+/// times the fine one's and their difference over 7 is the fine one's; at an edge sharper
+/// than the samples both are wrong by a fraction of the edge and the estimate is large. The
+/// largest over the premultiplied channels; a pixel too near the window's edge for the coarse
+/// taps is estimated by the largest change between its fine taps.
+float warpError(const Factorisation& f, const glm::vec4* rgba, int x, int y, const WarpTaps& t) {
+    const std::size_t width = std::size_t(f.width);
+    const glm::vec4 fine = warpSum(rgba, width, t);
+    const glm::dvec2 p = f.sheet({x + 0.5, y + 0.5});
+    const double ca = 0.5 * ((p.x - f.U0) * f.n - f.a0), cb = 0.5 * ((p.y - f.V0) * f.n - f.b0);
+    const double fa = std::floor(ca), fb = std::floor(cb);
+    glm::vec4 d;
+    if (fa >= 1 && fb >= 1 && 2 * (fa + 2) < f.width && 2 * (fb + 2) < f.height) {
+        float wa[4], wb[4];
+        catmullRom(float(ca - fa), wa);
+        catmullRom(float(cb - fb), wb);
+        const std::size_t o = 2 * ((std::size_t(fb) - 1) * width + std::size_t(fa) - 1);
+        glm::vec4 coarse(0.0f);
+        for (int j = 0; j < 4; ++j) {
+            glm::vec4 row(0.0f);
+            for (int i = 0; i < 4; ++i) row += wa[i] * rgba[o + 2 * (std::size_t(j) * width + i)];
+            coarse += wb[j] * row;
+        }
+        d = glm::abs(coarse - fine) / 7.0f;
+    } else {
+        glm::vec4 lo(1e30f), hi(-1e30f);
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i) {
+                const glm::vec4& v = rgba[t.o + std::size_t(j) * width + std::size_t(i)];
+                lo = glm::min(lo, v);
+                hi = glm::max(hi, v);
+            }
+        d = hi - lo;
     }
-    return false;
+    return std::max(std::max(d.x, d.y), std::max(d.z, d.w));
 }
 
 /// The screen image: the composited window at each pixel centre, by the Catmull-Rom spline
 /// through its samples (warpSum, two pixels at a time where the lanes are), clamped
-/// (clampWarped). With `edges`, also flags (1) the pixels whose taps hold an edge the
-/// spline cannot follow (warpEdge at `tolerance`); pixels outside the window are never
-/// flagged (no splat reaches them).
+/// (clampWarped). With `edges`, also flags (1) the pixels whose estimated warp error
+/// (warpError) is above `tolerance`; pixels outside the window are never flagged (no splat
+/// reaches them).
 Image warp(const Factorisation& f, const Composited& w, int width, int height,
            std::vector<std::uint8_t>* edges, float tolerance) {
     // The window as one (r, g, b, a) per sample: a tap is one load.
@@ -834,7 +851,7 @@ Image warp(const Factorisation& f, const Composited& w, int width, int height,
         WarpTaps t0, t1;
         if (edges)
             for (int x = 0; x < width; ++x)
-                if (warpTaps(f, x, y, t0) && warpEdge(rgba.data(), rowSamples, t0, tolerance))
+                if (warpTaps(f, x, y, t0) && warpError(f, rgba.data(), x, y, t0) > tolerance)
                     (*edges)[std::size_t(y) * std::size_t(width) + std::size_t(x)] = 1;
         for (int x = 0; x < width; ++x) {
             if (!warpTaps(f, x, y, t0)) continue;
