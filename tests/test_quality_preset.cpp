@@ -29,7 +29,8 @@ RenderSettings settingsOf(const std::vector<std::pair<std::string, std::string>>
 bool sameQuality(const Quality& a, const Quality& b) {
     return a.slab == b.slab && a.earlyTermination == b.earlyTermination &&
            a.referenceStep == b.referenceStep && a.referenceTolerance == b.referenceTolerance &&
-           a.factorisedSheets == b.factorisedSheets && a.tileSize == b.tileSize && a.lod == b.lod &&
+           a.factorisedSheets == b.factorisedSheets && a.warpTolerance == b.warpTolerance &&
+           a.tileSize == b.tileSize && a.lod == b.lod &&
            a.ewa == b.ewa && a.pixelFilter == b.pixelFilter;
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "image_diff.h"
+#include "splat/options.h"
 #include "splat/render.h"
 #include "splat/synthetic.h"
 
@@ -56,7 +57,7 @@ TEST_CASE("warp edges: each tile is the per-splat frame's or the warped one's, b
         const Image perSplat = render(v, edgeSettings(azimuth, 15, 0, 0));
         const Image warped = render(v, edgeSettings(azimuth, 15, 2, 0));
         RenderStats stats;
-        const Image mixed = render(v, edgeSettings(azimuth, 15, 2, 0.3), &stats);
+        const Image mixed = render(v, edgeSettings(azimuth, 15, 2, 0.01), &stats);
         const int tiles = (96 + 15) / 16;
         int fromSplats = 0, fromWarp = 0;
         for (int ty = 0; ty < tiles; ++ty)
@@ -90,7 +91,7 @@ TEST_CASE("warp edges: flagging every edge restores the per-splat frame's accura
         const Image r = render(v, ref);
         const double perSplat = rmseRgb(render(v, edgeSettings(azimuth, 15, 0, 0)), r);
         const double warped = rmseRgb(render(v, edgeSettings(azimuth, 15, 2, 0)), r);
-        const double fixed = rmseRgb(render(v, edgeSettings(azimuth, 15, 2, 0.03)), r);
+        const double fixed = rmseRgb(render(v, edgeSettings(azimuth, 15, 2, 0.001)), r);
         INFO("azimuth " << azimuth << ": per-splat " << perSplat << ", n = 2 " << warped
                         << ", n = 2 with edge tiles " << fixed);
         CHECK(warped > 1.5 * perSplat);  // the case the edge tiles are for
@@ -101,7 +102,7 @@ TEST_CASE("warp edges: flagging every edge restores the per-splat frame's accura
 TEST_CASE("warp edges: any thread count gives the same image bit for bit",
           "[factorised][splatter][warp-edges]") {
     const Volume v = makeSynthetic("phantom", 48);
-    RenderSettings s = edgeSettings(70, -10, 2, 0.03);
+    RenderSettings s = edgeSettings(70, -10, 2, 0.003);
     s.quality.earlyTermination = 1.0 / 256.0;
     s.threads = 1;
     RenderStats stats;
@@ -110,5 +111,32 @@ TEST_CASE("warp edges: any thread count gives the same image bit for bit",
     for (int t : {2, 3}) {
         s.threads = t;
         CHECK(test::maxDiff(render(v, s), one) == 0.0f);
+    }
+}
+
+TEST_CASE("warp edges: --warp-tolerance is checked, and said to be ignored where it cannot apply",
+          "[options][warp-edges]") {
+    OptionValues values(kRenderOptions);
+    for (const char* bad : {"-0.1", "1.5", "nan"}) {
+        values.set("warp-tolerance", bad);
+        CHECK_THROWS_WITH(parseRenderOptions(values),
+                          "--warp-tolerance: the warp's error tolerance must be in [0, 1]");
+    }
+    values.set("warp-tolerance", "0.01");
+    CHECK(parseRenderOptions(values).quality.warpTolerance == 0.01);
+    for (const auto& [option, value, why] :
+         {std::tuple<const char*, const char*, const char*>{"renderer", "sheet", "axis renderer"},
+          {"mode", "mip", "applies to dvr"},
+          {"projection", "perspective", "orthographic views"}}) {
+        OptionValues v(kRenderOptions);
+        v.set("warp-tolerance", "0.01");
+        v.set(option, value);
+        std::vector<std::string> warnings;
+        const RenderSettings s = renderSettingsFrom(
+            v, RenderUse{}, [&](const std::string& line) { warnings.push_back(line); });
+        INFO(option << " " << value);
+        REQUIRE(warnings.size() == 1);
+        CHECK(warnings[0].find(why) != std::string::npos);
+        CHECK(s.quality.warpTolerance == 0);
     }
 }

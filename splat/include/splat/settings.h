@@ -184,10 +184,11 @@ struct Quality {
     /// per-frame footprint stamps at P x P sub-pixel phases instead of the footprint
     /// polynomial per pixel. Other frames ignore it.
     int factorisedSheets = 0;
-    /// Factorised sheets (factorisedSheets >= 1): a pixel whose spline taps on the
-    /// intermediate image have a third difference above this, in any premultiplied channel,
-    /// is an edge the warp cannot follow and is rendered by the per-splat frame instead, in
-    /// the tiles that hold such pixels (0: every pixel warped).
+    /// Factorised sheets with per-splat edge tiles (`--warp-tolerance`): > 0 renders the
+    /// frames factorised sheets apply to by factorised sheets (factorisedSheets samples per
+    /// voxel, 2 when it is 0), and every tile holding a pixel whose estimated warp error (the
+    /// spline through every other intermediate sample against the spline through all, over 7,
+    /// in any premultiplied channel) exceeds this by the per-splat frame instead (0: off).
     double warpTolerance = 0;
     /// The EWA low-pass when pixelFilter is 0, pixels (pbrt-v4's Gaussian pixel filter).
     static constexpr double kEwaDefaultSigma = 0.5;

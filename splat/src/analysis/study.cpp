@@ -500,6 +500,7 @@ RenderSettings frameOf(const Scene& scene, const RenderSettings& s) {
     frame.quality.slab = s.quality.slab;
     frame.quality.earlyTermination = s.quality.earlyTermination;
     frame.quality.factorisedSheets = s.quality.factorisedSheets;
+    frame.quality.warpTolerance = s.quality.warpTolerance;
     frame.quality.referenceStep = s.quality.referenceStep;
     frame.quality.referenceTolerance = s.quality.referenceTolerance;
     frame.quality.tileSize = s.quality.tileSize;

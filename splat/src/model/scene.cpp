@@ -208,6 +208,8 @@ void validateFrame(const RenderSettings& s) {
     if (!(q.earlyTermination >= 0 && q.earlyTermination < 1))
         throw Error("early termination threshold must be in [0, 1)");
     if (q.tileSize < 8 || q.tileSize > 32) throw Error("tile size must be between 8 and 32 pixels");
+    if (!(q.warpTolerance >= 0 && q.warpTolerance <= 1))
+        throw Error("warp tolerance must be in [0, 1] (0: off)");
     if (!(q.lod.pixels >= 0 && q.lod.pixels <= 64))
         throw Error("level of detail threshold must be between 0 (off) and 64 pixels per voxel");
     if (!(q.pixelFilter >= 0 && q.pixelFilter <= 4))

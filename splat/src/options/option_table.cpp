@@ -59,6 +59,17 @@ std::string ignoredEarlyTermination(const S& s, const U& u, const V&) {
                "--early-termination applies to front-to-back compositing, not to --order btf";
     return why;
 }
+std::string ignoredWarpTolerance(const S& s, const U& u, const V&) {
+    if (u.oneRenderer && s.renderer != RendererKind::Axis)
+        return "--warp-tolerance applies to the axis renderer (factorised sheets), not to " +
+               renderer(s);
+    if (s.mode != RenderMode::Dvr)
+        return "--warp-tolerance applies to dvr (factorised sheets), not to " + mode(s);
+    if (perspective(s))
+        return "--warp-tolerance applies to orthographic views (factorised sheets), not to "
+               "perspective ones";
+    return {};
+}
 std::string ignoredLod(const S& s, const U& u, const V&) {
     if (!reference(s, u)) return {};
     return "--lod applies to the splatters, not to the reference renderer";
@@ -246,6 +257,11 @@ std::vector<OptionSpec> makeTable() {
         {"threads", T::Integer, "0", "worker threads (0 = all cores)", kQ, kFrame, R},
         {"tile-size", T::Integer, "32", "splatters: screen tile edge in pixels (8..32)", kQ, kFrame,
          R, P::None, ignoredTileSize},
+        {"warp-tolerance", T::Real, "0",
+         "axis renderer, orthographic dvr: factorised sheets (2 samples per voxel; 1 with "
+         "--quality fast) warped to the screen, with the tiles whose estimated warp error "
+         "exceeds this rendered per splat (0..1; 0 = off: per-splat footprints)",
+         kQ, kFrame, R, P::None, ignoredWarpTolerance},
         {"lod", T::Text, "0",
          "splatters: level of detail, pixels per voxel below which 2x2x2 voxels are "
          "merged into one splat of twice the size, repeatedly (0..64; 0 = off), or auto: "
@@ -564,6 +580,7 @@ const std::vector<std::string_view>& studyKnobs() {
                                                         "quality",
                                                         "slab",
                                                         "early-termination",
+                                                        "warp-tolerance",
                                                         "size",
                                                         "order",
                                                         "classify",

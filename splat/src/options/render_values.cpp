@@ -130,6 +130,10 @@ void parseQuality(const OptionValues& v, RenderSettings& s) {
     if (!(early >= 0 && early < 1))
         throw OptionError("--early-termination: early termination threshold must be in [0, 1)");
     q.earlyTermination = early;
+    const double warp = v.real("warp-tolerance");
+    if (!(warp >= 0 && warp <= 1))
+        throw OptionError("--warp-tolerance: the warp's error tolerance must be in [0, 1]");
+    q.warpTolerance = warp;
     const long long threads = v.integer("threads"), tile = v.integer("tile-size");
     if (threads < 0 || threads > 1024)
         throw OptionError("--threads must be between 0 (all cores) and 1024");
@@ -435,6 +439,8 @@ void applyOption(RenderSettings& s, std::string_view name, const std::string& te
         q.earlyTermination = pq.earlyTermination;
     else if (name == "tile-size")
         q.tileSize = pq.tileSize;
+    else if (name == "warp-tolerance")
+        q.warpTolerance = pq.warpTolerance;
     else if (name == "lod")
         q.lod = pq.lod;
     else if (name == "ewa")

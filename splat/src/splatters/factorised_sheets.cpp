@@ -24,6 +24,10 @@ namespace {
 
 constexpr int kBand = 16;  ///< intermediate rows per band: the unit of parallel work
 constexpr int kBlock = 8;  ///< early termination: a band's opacity is tested per 8 columns
+/// Samples per voxel when Quality::warpTolerance asks for factorised sheets and
+/// Quality::factorisedSheets does not choose: two keep the per-splat frame's error on ch2
+/// (docs/performance.md), and the edge tiles take the sharper edges.
+constexpr int kEdgeTileSamples = 2;
 
 /// The view's factorisation: sheets along axis m (sheet q, voxel (u, v) on the screen at
 /// c + J (u + shear.x q, v + shear.y q)) and the intermediate grid, sample (a, b) at sheet
@@ -71,7 +75,7 @@ Factorisation factorise(const Scene::Impl& scene, const Camera& camera, const Re
     const glm::dvec2 colM = column(f.m);
     f.shear = {(f.colV.y * colM.x - f.colV.x * colM.y) * f.invDet,
                (f.colU.x * colM.y - f.colU.y * colM.x) * f.invDet};
-    f.n = std::max(1, s.quality.factorisedSheets);
+    f.n = s.quality.factorisedSheets > 0 ? s.quality.factorisedSheets : kEdgeTileSamples;
     f.e = footprint::ellipticalFootprint(sp, camera.right * camera.pixelSize,
                                          -camera.up * camera.pixelSize, camera.view,
                                          scene.kernel.radius());
@@ -874,7 +878,8 @@ Image warp(const Factorisation& f, const Composited& w, int width, int height,
 
 bool factorisedSheetsApply(const Camera& camera, const RenderSettings& s, bool labels, bool clipped,
                            double lowPass, int level) {
-    return s.quality.factorisedSheets > 0 && s.renderer == RendererKind::Axis &&
+    return (s.quality.factorisedSheets > 0 || s.quality.warpTolerance > 0) &&
+           s.renderer == RendererKind::Axis &&
            !camera.perspective() && s.mode == RenderMode::Dvr &&
            s.classification == Classification::Pre && !labels && !clipped && !(lowPass > 0) &&
            level == 0;
