@@ -108,10 +108,6 @@ int renderRotation(const std::string& spec, const std::string& tf,
     int factorised = 0;
     app.add_option("--factorised-sheets", factorised,
                    "axis-aligned: factorised sheets with N samples per voxel (0: off)");
-    double warpTolerance = -1;
-    app.add_option("--warp-tolerance", warpTolerance,
-                   "factorised sheets: per-splat pixels where the warp's third difference "
-                   "exceeds this (0: off)");
     // --size N means N x N.
     for (std::size_t i = 0; i + 1 < args.size(); ++i)
         if (args[i] == "--size" && args[i + 1].find_first_of("xX") == std::string::npos)
@@ -133,7 +129,6 @@ int renderRotation(const std::string& spec, const std::string& tf,
     // Given, it wins over the frame design a --quality preset chose.
     if (app.get_option("--factorised-sheets")->count() > 0)
         s.quality.factorisedSheets = factorised;
-    if (warpTolerance >= 0) s.quality.warpTolerance = warpTolerance;
     frames = std::max(1, frames);
     const double elevation = s.camera.elevationDeg;
     const bool warmup = warmupFlag != 0;

@@ -5,6 +5,8 @@
 # per frame over a FRAMES-frame rotation (elevation 15), settings interleaved in rounds, its
 # ratio to the per-splat frame, and each setting's RMSE against the reference ray caster on
 # frames 0 and 1.
+# A setting N:T adds per-splat edge tiles (--warp-tolerance T) to n = N, and the table then
+# gives the tiles taken from the per-splat frame (median per frame).
 # Usage: bash tools/bench/factorised_sheets.sh [BUILD] (default build; needs bench_frames).
 # Environment: SIZES (default "256 512"), SETTINGS (default "0 1 2 -16"), ROUNDS (default 2),
 # FRAMES (default 6), VOLUME (default ch2; any volume argument, e.g. synthetic:phantom:512),
@@ -36,9 +38,11 @@ for S in $SIZES; do
     for r in $(seq 1 "$ROUNDS"); do
         for N in $SETTINGS; do
             mkdir -p "$OUT/${S}_$N"
+            edges=()
+            case "$N" in *:*) edges=(--warp-tolerance "${N#*:}") ;; esac
             nice "$BIN" render "$VOLUME" "$TF" --renderer axis --size "$S" --frames "$FRAMES" \
-                --factorised-sheets="$N" --save 0,1 --out "$OUT/${S}_$N" "${EXTRA_ARGS[@]}" \
-                > "$OUT/${S}_${N}_r$r.json"
+                --factorised-sheets="${N%%:*}" "${edges[@]}" --save 0,1 --out "$OUT/${S}_$N" \
+                "${EXTRA_ARGS[@]}" > "$OUT/${S}_${N}_r$r.json"
         done
     done
 done
@@ -48,13 +52,14 @@ out, binary, sizes, settings = sys.argv[1], sys.argv[2], sys.argv[3].split(), sy
 for s in sizes:
     base = None
     for n in settings:
-        cpu = [f["cpu_ms"] for p in glob.glob(f"{out}/{s}_{n}_r*.json")
-               for f in json.load(open(p))["frames"]]
-        med = statistics.median(cpu)
+        frames = [f for p in glob.glob(f"{out}/{s}_{n}_r*.json") for f in json.load(open(p))["frames"]]
+        med = statistics.median(f["cpu_ms"] for f in frames)
+        tiles = statistics.median(f.get("warp_fix_tiles", 0) for f in frames)
         base = base or med
         errs = [json.loads(subprocess.check_output(
             [binary, "compare", f"{out}/{s}_{n}/frame_{k}.f32", f"{out}/{s}_ref/frame_{k}.f32",
              s, s]))["rmse"] for k in (0, 1)]
         print(f"{s}^2 setting {n:>4}: CPU {med:6.1f} ms per frame, {med / base:.2f}x per-splat; "
-              f"RMSE vs reference {errs[0]:.2e} {errs[1]:.2e}")
+              f"RMSE vs reference {errs[0]:.2e} {errs[1]:.2e}"
+              + (f"; edge tiles {tiles:g}" if ":" in n else ""))
 PY
