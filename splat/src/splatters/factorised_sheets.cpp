@@ -731,6 +731,7 @@ inline void catmullRom(float t, float (&w)[4]) {
 struct WarpTaps {
     std::size_t o;
     float wa[4], wb[4];
+    double ga, gb;  ///< the pixel centre in window samples (for warpError)
 };
 
 /// The taps of the pixel centre (x + 1/2, y + 1/2); false when they leave the window.
@@ -739,6 +740,8 @@ bool warpTaps(const Factorisation& f, int x, int y, WarpTaps& t) {
     const double ga = (p.x - f.U0) * f.n - f.a0, gb = (p.y - f.V0) * f.n - f.b0;
     const double fa = std::floor(ga), fb = std::floor(gb);
     if (!(fa >= 1 && fb >= 1 && fa + 2 < f.width && fb + 2 < f.height)) return false;
+    t.ga = ga;
+    t.gb = gb;
     catmullRom(float(ga - fa), t.wa);
     catmullRom(float(gb - fb), t.wb);
     t.o = (std::size_t(fb) - 1) * std::size_t(f.width) + std::size_t(fa) - 1;
@@ -790,18 +793,18 @@ __attribute__((target("avx"))) void warpPairLanes(const glm::vec4* rgba, std::si
 }
 #endif
 
-/// The warp's error at pixel (x, y), estimated: the spline through every other sample of the
-/// window (spacing 2 / n voxels) against the spline through every sample (warpSum of `t`).
+/// The warp's error at the pixel of taps `t`, estimated: the spline through every other
+/// sample of the window (spacing 2 / n voxels) against `fine`, the spline through every
+/// sample (warpSum of `t`).
 /// Where the image is smooth the spline's error is of order h^3, so the coarse one's is 8
 /// times the fine one's and their difference over 7 is the fine one's; at an edge sharper
 /// than the samples both are wrong by a fraction of the edge and the estimate is large. The
 /// largest over the premultiplied channels; a pixel too near the window's edge for the coarse
 /// taps is estimated by the largest change between its fine taps.
-float warpError(const Factorisation& f, const glm::vec4* rgba, int x, int y, const WarpTaps& t) {
+float warpError(const Factorisation& f, const glm::vec4* rgba, const WarpTaps& t,
+                const glm::vec4& fine) {
     const std::size_t width = std::size_t(f.width);
-    const glm::vec4 fine = warpSum(rgba, width, t);
-    const glm::dvec2 p = f.sheet({x + 0.5, y + 0.5});
-    const double ca = 0.5 * ((p.x - f.U0) * f.n - f.a0), cb = 0.5 * ((p.y - f.V0) * f.n - f.b0);
+    const double ca = 0.5 * t.ga, cb = 0.5 * t.gb;
     const double fa = std::floor(ca), fb = std::floor(cb);
     glm::vec4 d;
     if (fa >= 1 && fb >= 1 && 2 * (fa + 2) < f.width && 2 * (fb + 2) < f.height) {
@@ -831,11 +834,12 @@ float warpError(const Factorisation& f, const glm::vec4* rgba, int x, int y, con
 
 /// The screen image: the composited window at each pixel centre, by the Catmull-Rom spline
 /// through its samples (warpSum, two pixels at a time where the lanes are), clamped
-/// (clampWarped). With `edges`, also flags (1) the pixels whose estimated warp error
-/// (warpError) is above `tolerance`; pixels outside the window are never flagged (no splat
-/// reaches them).
+/// (clampWarped). With `edges`, also flags (1) pixels whose estimated warp error (warpError)
+/// is above `tolerance`, at least one in each row of each `tile`-pixel screen tile that holds
+/// such a pixel (after one, the rest of the tile's row is not tested); pixels outside the
+/// window are never flagged (no splat reaches them).
 Image warp(const Factorisation& f, const Composited& w, int width, int height,
-           std::vector<std::uint8_t>* edges, float tolerance) {
+           std::vector<std::uint8_t>* edges, float tolerance, int tile) {
     // The window as one (r, g, b, a) per sample: a tap is one load.
     std::vector<glm::vec4> rgba(w.r.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rgba.size(), 16384),
@@ -853,10 +857,14 @@ Image warp(const Factorisation& f, const Composited& w, int width, int height,
     if (edges) edges->assign(std::size_t(width) * std::size_t(height), 0);
     tbb::parallel_for(0, height, [&](int y) {
         WarpTaps t0, t1;
-        if (edges)
-            for (int x = 0; x < width; ++x)
-                if (warpTaps(f, x, y, t0) && warpError(f, rgba.data(), x, y, t0) > tolerance)
-                    (*edges)[std::size_t(y) * std::size_t(width) + std::size_t(x)] = 1;
+        int flaggedTile = -1;  // the tile of this row flagged last
+        const auto test = [&](int x, const WarpTaps& t, const glm::vec4& sum) {
+            if (!edges || x / tile == flaggedTile) return;
+            if (warpError(f, rgba.data(), t, sum) > tolerance) {
+                (*edges)[std::size_t(y) * std::size_t(width) + std::size_t(x)] = 1;
+                flaggedTile = x / tile;
+            }
+        };
         for (int x = 0; x < width; ++x) {
             if (!warpTaps(f, x, y, t0)) continue;
 #if defined(FOOTPRINT_HAVE_LANES)
@@ -864,11 +872,15 @@ Image warp(const Factorisation& f, const Composited& w, int width, int height,
                 glm::vec4 s0, s1;
                 warpPairLanes(rgba.data(), rowSamples, t0, t1, s0, s1);
                 image.at(x, y) = clampWarped(s0);
-                image.at(++x, y) = clampWarped(s1);
+                image.at(x + 1, y) = clampWarped(s1);
+                test(x, t0, s0);
+                test(++x, t1, s1);
                 continue;
             }
 #endif
-            image.at(x, y) = clampWarped(warpSum(rgba.data(), rowSamples, t0));
+            const glm::vec4 sum = warpSum(rgba.data(), rowSamples, t0);
+            image.at(x, y) = clampWarped(sum);
+            test(x, t0, sum);
         }
     });
     return image;
@@ -934,7 +946,7 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
                                                        s.order, s.quality.earlyTermination, w);
     });
     Image image = warp(f, w, camera.width(), camera.height(), edges,
-                       float(s.quality.warpTolerance));
+                       float(s.quality.warpTolerance), s.quality.tileSize);
     stats.tilesMs = msSince(tiles);
     stats.sheetAxis = f.m;
     stats.sheetSign = sheetAxis(camera.view, scene.volume->spacing).sign;

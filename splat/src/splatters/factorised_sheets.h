@@ -42,8 +42,9 @@ bool factorisedSheetsApply(const Camera& camera, const RenderSettings& settings,
 /// The frame (premultiplied colour and opacity, no background) of the scene's splats in
 /// `camera` by factorised sheets; `er`, `eg`, `eb`: this view's shaded emission, or null for
 /// the list's own. With `edges`, also one flag per pixel (row-major): 1 where the pixel's
-/// spline taps hold an edge the warp cannot follow (a third difference above
-/// Quality::warpTolerance in any channel), which the caller renders per splat instead.
+/// estimated warp error exceeds Quality::warpTolerance (tested until one pixel per row of
+/// each screen tile of Quality::tileSize is flagged), whose tiles the caller renders per
+/// splat instead.
 Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
                              const RenderSettings& settings, const float* er, const float* eg,
                              const float* eb, RenderStats& stats,
