@@ -266,7 +266,9 @@ class Bench:
         frames, save = a.frames, a.error_frames
         tag = f"{name}_{size}_{threads}_{renderer}_{slab}_{vtk_step}_{lod}_{quality}".replace(
             ":", "_")
-        preset = [] if quality == "default" else ["--quality", quality]
+        preset = ([] if quality == "default" else
+                  ["--warp-tolerance", quality[len("warp="):]] if quality.startswith("warp=")
+                  else ["--quality", quality])
         splat_ms, vtk_ms, splat_runs = [], [], []
         vtk = Vtk(mha, info, size, threads)
         cameras = None
@@ -627,14 +629,16 @@ def refine_metaimage(src, dst, factor):
 def label(r):
     """A row's splat renderer as the tables name it."""
     rend = r["renderer"] if r["renderer"] == "axis" else f"{r['renderer']} slab {r['slab']:g}"
-    if r.get("quality", "default") != "default":  # the preset sets the slab itself
+    if r.get("quality", "default").startswith("warp="):  # factorised sheets, edge tiles
+        rend = f"{r['renderer']} --warp-tolerance {r['quality'][len('warp='):]}"
+    elif r.get("quality", "default") != "default":  # the preset sets the slab itself
         rend = f"{r['renderer']} --quality {r['quality']}"
     return rend + (f" lod {r['lod']}" if str(r.get("lod", "0")) != "0" else "")
 
 
 def plan(quick, lod_auto, presets_only=False):
-    """(volume, size, threads, renderer, slab, VTK step, level of detail[, --quality]) per
-    row."""
+    """(volume, size, threads, renderer, slab, VTK step, level of detail[, --quality preset
+    or warp=T for --warp-tolerance T]) per row."""
     if quick:
         return [("ch2", 256, 2, "axis", 1.0, 1.0, "0"), ("ch2", 256, 2, "axis", 1.0, 1.0, "0", "fast")]
     if presets_only:
@@ -651,6 +655,9 @@ def plan(quick, lod_auto, presets_only=False):
     if lod_auto:
         rows += [(v, s, 2, "axis", 1.0, 1.0, "auto") for v, s in LOD_AUTO_ROWS]
     rows += [r for s in (256, 512) for r in preset_rows(s)[1:]]
+    # Factorised sheets with per-splat edge tiles (docs/speed-vs-accuracy.md).
+    rows += [("ch2", s, 2, "axis", 1.0, 1.0, "0", "warp=0.01") for s in (256, 512, 1024)]
+    rows += [("phantom:512", 512, 2, "axis", 1.0, 1.0, "0", "warp=0.01")]
     return rows
 
 
