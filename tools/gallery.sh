@@ -73,3 +73,4 @@ $S render synthetic:ct-phantom:128 --classify post --azimuth 120 --elevation 15 
 $S render synthetic:ct-phantom:128 --mode mip --azimuth 90 --size 320x320 -o $G/ct_hu_mip.png
 # Aliasing with and without EWA (docs/accuracy.md "Aliasing and EWA").
 bash tools/gallery_ewa.sh
+bash tools/gallery_edges.sh
