@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -19,6 +20,13 @@
 #include "splatters/splatter.h"
 
 namespace splat {
+
+namespace detail {
+/// Whether bands pass over hidden sheet rows by their spans (SheetRowSpans) and composite the
+/// blocks a sheet wrote only (compositeSheet); off only in the test that checks the image is
+/// the same without.
+std::atomic<bool> factorisedSheetsSkipHidden{true};
+}  // namespace detail
 
 namespace {
 
@@ -240,9 +248,17 @@ struct SplatValues {
 struct RowU {
     const std::uint16_t* at;
     int u(std::size_t p) const { return at[p]; }
-    /// The first of positions [p, end) whose u is at least `u`.
-    std::size_t seek(std::size_t p, std::size_t end, int u) const {
-        return std::size_t(std::lower_bound(at + p, at + end, u) - at);
+    /// The first of positions [p, end) (the rest of a row whose last u is `last`) whose u is
+    /// at least `u`. A row holds each u once, so u grows by at least 1 a position: the answer
+    /// is at most u - u(p) positions after p and at most last - u before end - 1, which pins
+    /// it in a row whose voxels are all splats and leaves the bisection a short stretch
+    /// otherwise (it reads the row where the answer is, not its hidden middle).
+    std::size_t seek(std::size_t p, std::size_t end, int last, int u) const {
+        if (p >= end || at[p] >= u) return p;
+        if (last < u) return end;
+        const auto lo = std::max(std::ptrdiff_t(p) + 1, std::ptrdiff_t(end) - 1 - (last - u));
+        const auto hi = std::min(std::ptrdiff_t(end) - 1, std::ptrdiff_t(p) + (u - at[p]));
+        return std::size_t(std::lower_bound(at + lo, at + hi + 1, u) - at);
     }
 };
 
@@ -268,6 +284,44 @@ struct GatheredRows : RowU, SplatValues {
         const std::size_t r = std::size_t(q) * std::size_t(rows) + std::size_t(v);
         return {row[r], row[r + 1]};
     }
+};
+
+/// A sheet row in brief: the u of its first and last splat and how many it holds (0: empty).
+struct RowSpan {
+    std::uint16_t lo = 0, hi = 0;
+    std::uint32_t count = 0;
+};
+
+/// The rows' spans per sheet axis (Scene::Impl::state), each axis's made on its first frame
+/// from the rows it reads (one pass over the rows, two list reads each): row v of sheet q at
+/// q * rows + v. A band tests a sheet's rows against its opaque blocks from these alone, so a
+/// hidden row costs neither the list's cache lines nor a bisection (rowHidden).
+class SheetRowSpans {
+  public:
+    explicit SheetRowSpans(const Scene::Impl&) {}
+    template <class Rows>
+    const std::vector<RowSpan>& get(int m, int sheets, const Rows& list) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        std::unique_ptr<std::vector<RowSpan>>& s = spans_[std::size_t(m)];
+        if (!s) {
+            s = std::make_unique<std::vector<RowSpan>>(std::size_t(sheets) *
+                                                       std::size_t(list.rows));
+            for (int q = 0; q < sheets; ++q)
+                for (int v = 0; v < list.rows; ++v) {
+                    const auto [p, end] = list.range(q, v);
+                    if (p == end) continue;
+                    RowSpan& r = (*s)[std::size_t(q) * std::size_t(list.rows) + std::size_t(v)];
+                    r.lo = std::uint16_t(list.u(p));
+                    r.hi = std::uint16_t(list.u(end - 1));
+                    r.count = std::uint32_t(end - p);
+                }
+        }
+        return *s;
+    }
+
+  private:
+    std::mutex mutex_;
+    std::unique_ptr<std::vector<RowSpan>> spans_[3];
 };
 
 /// The composited intermediate window: premultiplied colour and opacity, row-major.
@@ -339,11 +393,14 @@ void compositeAndClear(float* row, int x0, int x1, int c0, int c1, std::size_t o
 }
 
 /// A band's state across sheets: the sheet buffer (interleaved tau, E_r, E_g, E_b per sample,
-/// `stride` samples a row with `margin` samples before the window's column 0) and, front to
-/// back with early termination, the 8-column blocks whose every pixel is opaque.
+/// `stride` samples a row with `margin` samples before the window's column 0), the 8-column
+/// blocks of the window the sheet has written and, front to back with early termination, those
+/// whose every pixel is opaque.
 struct BandBuffer {
-    int row0, rows, margin, stride;
+    int row0, rows, margin, stride, width;
     std::vector<float> sheet;
+    /// Per block of the window: a stamp of this sheet reached it.
+    std::vector<std::uint8_t> written;
     std::vector<float> vals;  ///< a row of splat values (RowRun), zero between uses
     bool terminates;
     float threshold;
@@ -360,8 +417,26 @@ struct BandBuffer {
     int firstOpen(int c0) const {
         return std::max(c0, nextOpen[std::size_t(c0 / kBlock)] * kBlock);
     }
+    /// The first column at or after c0 in an opaque block.
+    int firstClosed(int c0) const {
+        return std::max(c0, nextClosed[std::size_t(c0 / kBlock)] * kBlock);
+    }
     /// The last column of the open stretch that holds column c (c in an open block).
     int openUntil(int c) const { return nextClosed[std::size_t(c / kBlock)] * kBlock - 1; }
+    /// Notes columns [c0, c1] (their part in the window) as written.
+    void markWritten(int c0, int c1) {
+        c0 = std::max(c0, 0);
+        c1 = std::min(c1, width - 1);
+        if (c0 <= c1)
+            std::fill(written.begin() + c0 / kBlock, written.begin() + c1 / kBlock + 1,
+                      std::uint8_t(1));
+    }
+    /// Whether columns [c0, c1] within the window are all in opaque blocks (none: true).
+    bool opaqueOver(int c0, int c1) const {
+        c0 = std::max(c0, 0);
+        c1 = std::min(c1, width - 1);
+        return c0 > c1 || firstOpen(c0) > c1;
+    }
 };
 
 /// The written rectangle of a band's sheet buffer: columns [x0, x1], band rows [y0, y1].
@@ -494,6 +569,9 @@ FOOTPRINT_LANES_END
 /// u at col0 + n u), then clears its values.
 void convolveRun(RowRun& run, const SheetStamp& st, int n, int row, int ys, int ye, int col0,
                  BandBuffer& band) {
+    // The rows' columns, each past its last weight by at most two (a padded tap, a pair's
+    // second output), which gain zeros.
+    band.markWritten(col0 + n * run.uLo + st.xMin, col0 + n * run.uHi + st.xMax + 2);
     const float* vals = &run.vals[4 * std::size_t(run.pad)];
     for (int y = ys; y < ye; ++y) {
         const int taps = st.count[std::size_t(y)], base = col0 + st.x0[std::size_t(y)];
@@ -533,7 +611,8 @@ inline int floorDiv(int x, int y) { return x >= 0 ? x / y : -((-x + y - 1) / y);
 /// bisection (a row is sorted by u).
 template <class Rows>
 std::size_t addRowRuns(const Factorisation& f, const Rows& list, std::size_t p, std::size_t pEnd,
-                       const SheetStamp& st, RowPlace at, RowRun& run, BandBuffer& band) {
+                       int uLast, const SheetStamp& st, RowPlace at, RowRun& run,
+                       BandBuffer& band) {
     const int n = f.n, box = f.stampW - 1;
     // Columns of the splats inside the window: hi = col + xMax >= 0, lo = col + xMin < width.
     const int colLo = -st.xMax, colHi = f.width - 1 - st.xMin;
@@ -542,7 +621,7 @@ std::size_t addRowRuns(const Factorisation& f, const Rows& list, std::size_t p, 
         int col = n * list.u(p) + at.col0;
         int end = colHi;  // the last column of the visible stretch
         if (col < colLo) {
-            p = list.seek(p + 1, pEnd, floorDiv(colLo - at.col0 + n - 1, n));
+            p = list.seek(p + 1, pEnd, uLast, floorDiv(colLo - at.col0 + n - 1, n));
             continue;
         }
         if (col > colHi) break;
@@ -551,7 +630,7 @@ std::size_t addRowRuns(const Factorisation& f, const Rows& list, std::size_t p, 
             if (open > std::min(col + box, f.width - 1)) {
                 // On to the first splat whose box reaches the open block.
                 const std::size_t next =
-                    list.seek(p + 1, pEnd, floorDiv(open - box - at.col0 + n - 1, n));
+                    list.seek(p + 1, pEnd, uLast, floorDiv(open - box - at.col0 + n - 1, n));
                 band.hidden += next - p;
                 p = next;
                 continue;
@@ -587,33 +666,114 @@ void prefetchRows(const Rows& list, int q, int vLo, int vHi) {
     }
 }
 
+/// Sheet q's voxel rows [vLo, vHi] whose stamp rows meet the band: row v's stamp row 0 at
+/// band row n v + top, column 0 of voxel u's stamp at n u + col0.
+struct SheetRows {
+    int vLo, vHi, top, col0;
+};
+
+SheetRows sheetRows(const Factorisation& f, const SheetStamp& st, const BandBuffer& band,
+                    int rows) {
+    const int n = f.n;
+    const int top = st.b + f.dB - f.b0 - band.row0;
+    return {std::max(0, -floorDiv(top + st.yMax, n)),
+            std::min(floorDiv(band.rows - 1 - top - st.yMin, n), rows - 1), top,
+            st.a + f.dA - f.a0};
+}
+
+/// Whether a sheet row with splats from u = lo to hi adds nothing to the band, front to back
+/// with early termination: the columns of their stamps' boxes (stampW from n u + col0) are
+/// all over opaque blocks or outside the window, so each splat would be skipped as hidden by
+/// the test of addRowRuns (the same blocks, per splat); and opacity only grows, so what is
+/// hidden stays hidden until the band ends.
+bool rowHidden(const Factorisation& f, const SheetRows& r, const BandBuffer& band, int lo, int hi) {
+    return band.opaqueOver(f.n * lo + r.col0, f.n * hi + r.col0 + f.stampW - 1);
+}
+
+/// Whether sheet q's rows `r` add nothing to the band (from their spans, `spans` at the
+/// sheet's row 0, without reading the list): they hold no splat, or front to back with early
+/// termination their splats together are hidden (rowHidden of the rows' joint span). `hidden`
+/// gains their splats when they are hidden.
+bool sheetAddsNothing(const Factorisation& f, const SheetRows& r, const RowSpan* spans,
+                      const BandBuffer& band, std::size_t& hidden) {
+    int lo = std::numeric_limits<int>::max(), hi = -1;
+    std::size_t splats = 0;
+    for (int v = r.vLo; v <= r.vHi; ++v) {
+        const RowSpan& s = spans[v];
+        if (s.count == 0) continue;
+        lo = std::min(lo, int(s.lo));
+        hi = std::max(hi, int(s.hi));
+        splats += s.count;
+    }
+    if (splats == 0) return true;
+    if (!band.terminates || !rowHidden(f, r, band, lo, hi)) return false;
+    hidden += splats;
+    return true;
+}
+
+/// prefetchRows from the rows' spans (`spans` at sheet q's row 0): of each row of sheet q that
+/// is neither empty nor hidden (rowHidden), the lines of its first and last splats (where a
+/// row's visible splats are once opaque blocks cover its middle, which seek passes over
+/// unread), and the rest of the row while the band has no opaque block under it, up to 2048
+/// positions of the list in all.
+template <class Rows>
+void prefetchSheetRows(const Factorisation& f, const Rows& list, int q, const SheetRows& r,
+                       const RowSpan* spans, const BandBuffer& band) {
+    auto line = [&](std::size_t p) {
+        __builtin_prefetch(list.at + p);
+        if (list.entry) __builtin_prefetch(list.entry + p);
+    };
+    std::size_t budget = 2048;
+    for (int v = r.vLo; v <= r.vHi; ++v) {
+        const RowSpan& s = spans[v];
+        if (s.count == 0) continue;
+        const int c0 = std::max(f.n * s.lo + r.col0, 0);
+        const int c1 = std::min(f.n * s.hi + r.col0 + f.stampW - 1, f.width - 1);
+        if (c0 > c1 || (band.terminates && band.firstOpen(c0) > c1)) continue;  // rowHidden
+        const auto [p, end] = list.range(q, v);
+        line(p);
+        line(end - 1);
+        if (budget < end - p || (band.terminates && band.firstClosed(c0) <= c1)) continue;
+        for (std::size_t x = p + 32; x < end - 1; x += 32) line(x);
+        budget -= end - p;
+    }
+}
+
 /// Adds the stamps of sheet q's splats that meet the band into its buffer. Front to back with
 /// early termination, a splat is skipped when the blocks under its stamp's box (stampW
 /// columns, wider than the footprint's support) are all opaque: testing the support alone
 /// culls a few per cent more at no measurable saving and composites less into nearly opaque
 /// edges (ch2 at 512², early termination 1/32: RMSE 2.6e-3 against 2.4e-3 at azimuth 120°).
 /// One or two samples per voxel add a row's runs of splats as convolutions (convolveRun), more
-/// samples add splat by splat (addStampRows).
+/// samples add splat by splat (addStampRows). `spans` (the sheet's rows' spans, or null)
+/// passes over the rows that hold no splat or are hidden whole (rowHidden) before reading them.
 template <class Rows>
-Written addSheet(const Factorisation& f, const Rows& list, int q, int next, const SheetStamp& st,
-                 BandBuffer& band) {
+Written addSheet(const Factorisation& f, const Rows& list, int q, const SheetStamp& st,
+                 const RowSpan* spans, BandBuffer& band) {
     const int n = f.n;
-    // Voxel rows whose stamp rows n v + st.b + dB - b0 + [yMin, yMax] meet the band.
-    const int top = st.b + f.dB - f.b0;
-    const int vLo = std::max(0, -floorDiv(top + st.yMax - band.row0, n));
-    const int vHi = std::min(floorDiv(band.row0 + band.rows - 1 - top - st.yMin, n), list.rows - 1);
-    const int col0 = st.a + f.dA - f.a0;  // stamp column 0 of u = 0
-    if (next >= 0 && vLo <= vHi) prefetchRows(list, next, vLo, vHi);
+    const SheetRows rows = sheetRows(f, st, band, list.rows);
+    const int vLo = rows.vLo, vHi = rows.vHi, col0 = rows.col0;
     RowRun run{band.vals, f.stampW + 2};
     Written w;
     for (int v = vLo; v <= vHi; ++v) {
+        if (spans) {
+            const RowSpan& s = spans[v];
+            if (s.count == 0) continue;
+            if (band.opaqueCount > 0 && rowHidden(f, rows, band, s.lo, s.hi)) {
+                band.hidden += s.count;
+                continue;
+            }
+        }
         const auto [pFirst, pEnd] = list.range(q, v);
-        const int row = n * v + top - band.row0;  // stamp row 0, band rows
+        if (pFirst == pEnd) continue;
+        const int uLast = spans ? spans[v].hi : list.u(pEnd - 1);  // the row's last splat
+        const int row = n * v + rows.top;                          // stamp row 0, band rows
         const int ys = std::max(st.yMin, -row), ye = std::min(st.yMax + 1, band.rows - row);
         std::size_t drawn = 0;
         int first = std::numeric_limits<int>::max(), last = -1;  // columns of the drawn
         if (n <= 2) {
-            drawn = addRowRuns(f, list, pFirst, pEnd, st, RowPlace{row, ys, ye, col0}, run, band);
+            drawn = addRowRuns(f, list, pFirst, pEnd, uLast, st, RowPlace{row, ys, ye, col0}, run,
+                               band);
             if (drawn) {
                 first = n * run.first + col0 + st.xMin;
                 last = n * run.last + col0 + st.xMax;
@@ -627,7 +787,7 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, int next, cons
                     const int open = band.firstOpen(std::max(col, 0));
                     if (open > std::min(col + f.stampW - 1, f.width - 1)) {
                         const std::size_t next = list.seek(
-                            p + 1, pEnd, floorDiv(open - (f.stampW - 1) - col0 + n - 1, n));
+                            p + 1, pEnd, uLast, floorDiv(open - (f.stampW - 1) - col0 + n - 1, n));
                         band.hidden += next - p;
                         p = next - 1;
                         continue;
@@ -635,6 +795,7 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, int next, cons
                 }
                 addStampRows(band.at(row + ys, col), 4 * std::size_t(band.stride), st, ys, ye,
                              list.value(p));
+                band.markWritten(lo, hi + 1);
                 ++drawn;
                 first = std::min(first, lo);
                 last = hi;
@@ -651,12 +812,40 @@ Written addSheet(const Factorisation& f, const Rows& list, int q, int next, cons
     return w;
 }
 
-/// Marks the blocks of columns [c0, c1] whose every pixel of the band is now opaque.
+/// Composites the sheet's written rectangle `w` of the band's buffer into `out` and clears it:
+/// in the window, the stretches of written blocks only (compositeAndClear; the blocks between
+/// hold zeros, which would make no change, so a row whose visible splats are at its two ends
+/// is not composited across its hidden middle); outside it, clears what stamps wrote there.
+void compositeSheet(const Factorisation& f, const Written& w, CompositeOrder order, Composited& out,
+                    BandBuffer& band) {
+    const int c0 = std::max(w.x0, 0), c1 = std::min(w.x1, f.width - 1);
+    for (int y = w.y0; y <= w.y1; ++y) {
+        float* row = band.at(y, 0);
+        if (w.x0 < 0) std::fill(row + 4 * w.x0, row + 4 * std::min(0, w.x1 + 1), 0.0f);
+        if (w.x1 >= f.width)
+            std::fill(row + 4 * std::max(f.width, w.x0), row + 4 * (w.x1 + 1), 0.0f);
+    }
+    if (c1 < c0) return;
+    const int bEnd = c1 / kBlock;
+    for (int b = c0 / kBlock; b <= bEnd; ++b) {
+        if (!band.written[std::size_t(b)]) continue;
+        int e = b;
+        while (e < bEnd && band.written[std::size_t(e) + 1]) ++e;
+        const int s0 = std::max(b * kBlock, c0), s1 = std::min(e * kBlock + kBlock - 1, c1);
+        for (int y = w.y0; y <= w.y1; ++y)
+            compositeAndClear(band.at(y, 0), s0, s1, s0, s1, std::size_t(band.row0 + y) * f.width,
+                              order, out);
+        b = e;
+    }
+}
+
+/// Marks the blocks of columns [c0, c1] whose every pixel of the band is now opaque (of those
+/// the sheet wrote: the others are as they were).
 void markOpaqueBlocks(const Factorisation& f, const Composited& out, int c0, int c1,
                       BandBuffer& band) {
     bool marked = false;
     for (int b = c0 / kBlock; b <= c1 / kBlock; ++b) {
-        if (band.opaque[std::size_t(b)]) continue;
+        if (band.opaque[std::size_t(b)] || !band.written[std::size_t(b)]) continue;
         bool all = true;
         const int xe = std::min(f.width, (b + 1) * kBlock);
         for (int y = 0; y < band.rows && all; ++y)
@@ -680,12 +869,15 @@ void markOpaqueBlocks(const Factorisation& f, const Composited& out, int c0, int
 }
 
 /// One band of the window, rows [row0, row0 + rows): every sheet in visiting order, its
-/// splats' stamps added into the band's sheet buffer, then composited into `out`. Front to
-/// back, the band ends when all its column blocks are opaque. Returns the samples added and
-/// the splats skipped as hidden.
+/// splats' stamps added into the band's sheet buffer, then composited into `out` by its
+/// written blocks (compositeSheet). Front to back, the band passes over the sheets and rows
+/// its opaque blocks hide whole, as their spans tell (`rowSpans`: sheetAddsNothing, addSheet),
+/// and ends when all its column blocks are opaque. Returns the samples added and the splats
+/// skipped as hidden.
 template <class Rows>
 std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Rows& list, int sheets,
-                                               const std::vector<SheetStamp>& stamps, int row0,
+                                               const std::vector<SheetStamp>& stamps,
+                                               const std::vector<RowSpan>& rowSpans, int row0,
                                                int rows, CompositeOrder order,
                                                double earlyTermination, Composited& out) {
     BandBuffer band;
@@ -699,21 +891,42 @@ std::pair<std::size_t, std::size_t> renderBand(const Factorisation& f, const Row
     band.terminates = order == CompositeOrder::FrontToBack && earlyTermination > 0;
     band.threshold = float(1.0 - earlyTermination);
     const int blocks = (f.width + kBlock - 1) / kBlock;
+    band.width = f.width;
+    band.written.assign(std::size_t(blocks), 0);
     band.opaque.assign(std::size_t(blocks), 0);
     band.nextOpen.resize(std::size_t(blocks) + 1);
     for (int b = 0; b <= blocks; ++b) band.nextOpen[std::size_t(b)] = b;
     band.nextClosed.assign(std::size_t(blocks) + 1, blocks);
+    // The test's switch off: every row read, every written rectangle composited whole.
+    const bool skip = detail::factorisedSheetsSkipHidden.load(std::memory_order_relaxed);
+    const RowSpan* spans = skip ? rowSpans.data() : nullptr;
+    auto sheetSpans = [&](int q) {
+        return spans ? spans + std::size_t(q) * std::size_t(list.rows) : nullptr;
+    };
     for (int k = 0; k < sheets && !(band.terminates && band.opaqueCount == blocks); ++k) {
         const int q = f.ascending ? k : sheets - 1 - k;
-        const int next = k + 1 < sheets ? (f.ascending ? q + 1 : q - 1) : -1;
-        const Written w = addSheet(f, list, q, next, stamps[std::size_t(q)], band);
+        // Until a block is opaque nothing is hidden: the rows are read as they come.
+        const bool hiding = spans && band.opaqueCount > 0;
+        if (hiding && sheetAddsNothing(f, sheetRows(f, stamps[std::size_t(q)], band, list.rows),
+                                       sheetSpans(q), band, band.hidden))
+            continue;
+        // The next sheet's rows asked for while this one's are added (prefetchRows).
+        if (const int next = f.ascending ? q + 1 : q - 1; k + 1 < sheets) {
+            const SheetRows r = sheetRows(f, stamps[std::size_t(next)], band, list.rows);
+            if (hiding && r.vLo <= r.vHi)
+                prefetchSheetRows(f, list, next, r, sheetSpans(next), band);
+            else if (r.vLo <= r.vHi)
+                prefetchRows(list, next, r.vLo, r.vHi);
+        }
+        const Written w = addSheet(f, list, q, stamps[std::size_t(q)], sheetSpans(q), band);
         if (w.x1 < w.x0) continue;
-        // Composite the written rectangle (its part inside the window), then clear it.
+        if (!skip) band.markWritten(w.x0, w.x1);
+        compositeSheet(f, w, order, out, band);
         const int c0 = std::max(w.x0, 0), c1 = std::min(w.x1, f.width - 1);
-        for (int y = w.y0; y <= w.y1; ++y)
-            compositeAndClear(band.at(y, 0), w.x0, w.x1, c0, c1, std::size_t(row0 + y) * f.width,
-                              order, out);
-        if (band.terminates && c1 >= c0) markOpaqueBlocks(f, out, c0, c1, band);
+        if (c1 < c0) continue;
+        if (band.terminates) markOpaqueBlocks(f, out, c0, c1, band);
+        std::fill(band.written.begin() + c0 / kBlock, band.written.begin() + c1 / kBlock + 1,
+                  std::uint8_t(0));
     }
     return {band.weights, band.hidden};
 }
@@ -925,6 +1138,9 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
                             std::size_t(cells.cellsX()),
                             f.m,
                             dims[f.v]};
+    SheetRowSpans& rowSpans = scene.state<SheetRowSpans>();
+    const std::vector<RowSpan>& spans =
+        f.m == 0 ? rowSpans.get(0, sheets, gatheredRows) : rowSpans.get(f.m, sheets, listRows);
     std::vector<SheetStamp> stamps(static_cast<std::size_t>(sheets));
     tbb::parallel_for(0, sheets,
                       [&](int q) { stamps[std::size_t(q)] = sheetStamp(f, q, scene.table); });
@@ -940,10 +1156,11 @@ Image renderFactorisedSheets(const Scene::Impl& scene, const Camera& camera,
     std::vector<std::pair<std::size_t, std::size_t>> counts(static_cast<std::size_t>(bands));
     tbb::parallel_for(0, bands, [&](int k) {
         const int row0 = k * kBand, rows = std::min(kBand, f.height - row0);
-        counts[std::size_t(k)] = f.m == 0 ? renderBand(f, gatheredRows, sheets, stamps, row0, rows,
-                                                       s.order, s.quality.earlyTermination, w)
-                                          : renderBand(f, listRows, sheets, stamps, row0, rows,
-                                                       s.order, s.quality.earlyTermination, w);
+        counts[std::size_t(k)] = f.m == 0
+                                     ? renderBand(f, gatheredRows, sheets, stamps, spans, row0,
+                                                  rows, s.order, s.quality.earlyTermination, w)
+                                     : renderBand(f, listRows, sheets, stamps, spans, row0, rows,
+                                                  s.order, s.quality.earlyTermination, w);
     });
     Image image = warp(f, w, camera.width(), camera.height(), edges,
                        float(s.quality.warpTolerance), s.quality.tileSize);
