@@ -970,15 +970,22 @@ inline glm::vec4 clampWarped(const glm::vec4& sum) {
 
 /// The spline's sum at one pixel: rows of four taps, then the four rows, each a product then
 /// a sum (the order warpPairLanes keeps).
-glm::vec4 warpSum(const glm::vec4* rgba, std::size_t width, const WarpTaps& t) {
+/// The sum over the 4 x 4 samples from `o`, `step` apart along a row and `rowStep` across
+/// rows, with weights wa along a row and wb across rows.
+glm::vec4 splineSum(const glm::vec4* rgba, std::size_t o, std::size_t step, std::size_t rowStep,
+                    const float (&wa)[4], const float (&wb)[4]) {
     glm::vec4 sum(0.0f);
     for (int j = 0; j < 4; ++j) {
-        const std::size_t r = t.o + std::size_t(j) * width;
+        const std::size_t r = o + std::size_t(j) * rowStep;
         glm::vec4 row(0.0f);
-        for (int i = 0; i < 4; ++i) row += t.wa[i] * rgba[r + std::size_t(i)];
-        sum += t.wb[j] * row;
+        for (int i = 0; i < 4; ++i) row += wa[i] * rgba[r + std::size_t(i) * step];
+        sum += wb[j] * row;
     }
     return sum;
+}
+
+glm::vec4 warpSum(const glm::vec4* rgba, std::size_t width, const WarpTaps& t) {
+    return splineSum(rgba, t.o, 1, width, t.wa, t.wb);
 }
 
 #if defined(FOOTPRINT_HAVE_LANES)
@@ -1025,13 +1032,7 @@ float warpError(const Factorisation& f, const glm::vec4* rgba, const WarpTaps& t
         catmullRom(float(ca - fa), wa);
         catmullRom(float(cb - fb), wb);
         const std::size_t o = 2 * ((std::size_t(fb) - 1) * width + std::size_t(fa) - 1);
-        glm::vec4 coarse(0.0f);
-        for (int j = 0; j < 4; ++j) {
-            glm::vec4 row(0.0f);
-            for (int i = 0; i < 4; ++i) row += wa[i] * rgba[o + 2 * (std::size_t(j) * width + i)];
-            coarse += wb[j] * row;
-        }
-        d = glm::abs(coarse - fine) / 7.0f;
+        d = glm::abs(splineSum(rgba, o, 2, 2 * width, wa, wb) - fine) / 7.0f;
     } else {
         glm::vec4 lo(1e30f), hi(-1e30f);
         for (int j = 0; j < 4; ++j)

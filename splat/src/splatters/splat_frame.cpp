@@ -100,14 +100,14 @@ void fixEdges(const Splatter& splatter, const Scene::Impl& scene, const Camera& 
               FrameWorkspace& work, RenderStats& stats, Image& image) {
     const TileGrid g(camera.width(), camera.height(), s.quality.tileSize);
     std::vector<std::uint8_t> tiles(std::size_t(g.count()), 0);
-    std::size_t flagged = 0;
+    bool any = false;
     for (int y = 0; y < camera.height(); ++y)
         for (int x = 0; x < camera.width(); ++x)
             if (edges[std::size_t(y) * std::size_t(camera.width()) + std::size_t(x)]) {
                 tiles[std::size_t(g.tileOf(y) * g.tilesX + g.tileOf(x))] = 1;
-                ++flagged;
+                any = true;
             }
-    if (flagged == 0) return;
+    if (!any) return;
     RenderStats fixStats;
     const SheetPlan plan = splatter.order(scene, camera, s, work, fixStats);
     const PolicyContext ctx = policyContext(scene, camera, s);
